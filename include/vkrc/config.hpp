@@ -1,0 +1,55 @@
+// Compile-time configuration: the thread policy and the namespace it selects.
+//
+// VKRC_MULTI_THREAD=1 selects the multi-thread policy (atomic reference
+// counts, real locks where Vulkan demands external synchronisation); anything
+// else the single-thread one. The CMake targets vkrc::st and vkrc::mt set it
+// for their users. Each policy lives in its own inline namespace (vkrc::st or
+// vkrc::mt) so both libraries can be linked into one program, while a
+// translation unit compiled for one policy cannot link against the other.
+
+// Deliberately outside the include guard: a translation unit that includes
+// vkrc headers, changes VKRC_MULTI_THREAD and includes them again would
+// silently mix two object layouts, so it must not compile.
+#if defined(VKRC_MULTI_THREAD) && VKRC_MULTI_THREAD
+#  define VKRC_DETAIL_POLICY_NOW 2
+#else
+#  define VKRC_DETAIL_POLICY_NOW 1
+#endif
+#if defined(VKRC_DETAIL_POLICY_SEEN) && VKRC_DETAIL_POLICY_SEEN != VKRC_DETAIL_POLICY_NOW
+#  error "vkrc: this translation unit includes vkrc under both thread policies (VKRC_MULTI_THREAD changed between includes); use one policy per translation unit"
+#endif
+#ifndef VKRC_DETAIL_POLICY_SEEN
+#  if VKRC_DETAIL_POLICY_NOW == 2
+#    define VKRC_DETAIL_POLICY_SEEN 2
+#  else
+#    define VKRC_DETAIL_POLICY_SEEN 1
+#  endif
+#endif
+#undef VKRC_DETAIL_POLICY_NOW
+
+#ifndef VKRC_CONFIG_HPP
+#define VKRC_CONFIG_HPP
+
+#if VKRC_DETAIL_POLICY_SEEN == 2
+#  define VKRC_POLICY_NAMESPACE mt
+#  define VKRC_IS_MULTI_THREAD 1
+#else
+#  define VKRC_POLICY_NAMESPACE st
+#  define VKRC_IS_MULTI_THREAD 0
+#endif
+
+// Hot-path checks that cost time (bounds of mapped writes, device identity of
+// recorded handles) are compiled in when VKRC_RUNTIME_CHECKS is 1: on by
+// default in debug builds, off with NDEBUG. Checks that are free stay on.
+#ifndef VKRC_RUNTIME_CHECKS
+#  ifdef NDEBUG
+#    define VKRC_RUNTIME_CHECKS 0
+#  else
+#    define VKRC_RUNTIME_CHECKS 1
+#  endif
+#endif
+
+#define VKRC_BEGIN_NAMESPACE namespace vkrc { inline namespace VKRC_POLICY_NAMESPACE {
+#define VKRC_END_NAMESPACE } }
+
+#endif

@@ -1,0 +1,111 @@
+// State blocks behind Device and Queue, and the deferred-destruction queue.
+// Included by device.hpp.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include <deque>
+#include <memory>
+
+VKRC_BEGIN_NAMESPACE
+namespace detail {
+
+struct QueueState {
+    VkQueue queue = VK_NULL_HANDLE;
+    std::uint32_t family_index = 0;
+    std::uint32_t index = 0;
+    // Signalled by every vkrc submit with the next value: the only GPU-side
+    // tracking vkrc does.
+    VkSemaphore timeline = VK_NULL_HANDLE;
+    std::atomic<std::uint64_t> submitted{0};  // written under mutex, read by retirements
+    std::atomic<std::uint64_t> completed{0};  // last value seen reached (a cache)
+    mutable Mutex mutex;
+};
+
+// Work to run once the GPU is done with an object: destroying its Vulkan
+// handle, or returning its memory to an allocator. A plain function pointer
+// and two words, so that queued actions hold no references and a Device with
+// pending actions is still torn down when its last handle goes.
+struct DeferredAction {
+    void (*run)(DeviceState& device, std::uint64_t handle, void* context) noexcept = nullptr;
+    std::uint64_t handle = 0;
+    void* context = nullptr;
+};
+
+class DeviceState final : public RefCounted {
+public:
+    ~DeviceState() override;
+
+    // Runs the action now when no vkrc-submitted work is pending on any
+    // queue, otherwise once all work submitted before this call has completed.
+    // Actions run in the order they were queued, so an object queued after
+    // another (an image after its view) is destroyed after it.
+    void destroy_after_gpu(DeferredAction action) noexcept;
+    // Runs the queued actions whose work has completed; never blocks on the GPU.
+    void collect() noexcept;
+    // Marks the device lost: the GPU will touch nothing any more, so every
+    // queued action may run.
+    void mark_lost() noexcept { lost.store(true, std::memory_order_relaxed); }
+    std::size_t deferred_count() const noexcept;
+
+    VkDevice device = VK_NULL_HANDLE;
+    DeviceFunctions fn;
+    PhysicalDevice physical_device;
+    Ownership ownership = Ownership::owned;
+    std::vector<std::string> enabled_extensions;
+    std::vector<std::unique_ptr<QueueState>> queues;
+    std::atomic<bool> lost{false};
+
+private:
+    // Reads the queues' timelines; true when everything submitted has completed.
+    bool idle_now() noexcept;
+    void take_ready(std::vector<DeferredAction>& out) noexcept;
+
+    // Actions queued while the same work was pending share one batch.
+    struct Batch {
+        std::vector<std::uint64_t> wait_values;  // per queue
+        std::vector<DeferredAction> actions;
+    };
+    mutable Mutex deferred_mutex_;
+    std::deque<Batch> deferred_;
+    std::size_t deferred_actions_ = 0;
+};
+
+// Converts any Vulkan handle to the word stored in a DeferredAction.
+template <class VkHandle>
+std::uint64_t handle_bits(VkHandle handle) noexcept {
+    return (std::uint64_t)(handle);
+}
+template <class VkHandle>
+VkHandle handle_from_bits(std::uint64_t bits) noexcept {
+    return (VkHandle)(bits);
+}
+
+// Queues vkDestroyX(device, handle, nullptr) to run after the GPU is done.
+// Usage: defer_destroy<&DeviceFunctions::vkDestroyBuffer>(device, buffer);
+template <auto DestroyMember, class VkHandle>
+void defer_destroy(DeviceState& device, VkHandle handle) noexcept {
+    if (handle == VK_NULL_HANDLE) return;
+    device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
+                                  (d.fn.*DestroyMember)(d.device, handle_from_bits<VkHandle>(bits), nullptr);
+                              },
+                              handle_bits(handle), nullptr});
+}
+
+}  // namespace detail
+
+inline VkDevice Device::vk() const noexcept { return state_->device; }
+inline const DeviceFunctions& Device::fn() const noexcept { return state_->fn; }
+inline const PhysicalDevice& Device::physical_device() const noexcept { return state_->physical_device; }
+inline const Instance& Device::instance() const noexcept { return state_->physical_device.instance(); }
+
+inline VkQueue Queue::vk() const noexcept { return queue_->queue; }
+inline std::uint32_t Queue::family_index() const noexcept { return queue_->family_index; }
+inline std::uint32_t Queue::index() const noexcept { return queue_->index; }
+inline VkSemaphore Queue::timeline_semaphore() const noexcept { return queue_->timeline; }
+inline Mutex& Queue::mutex() const noexcept { return queue_->mutex; }
+inline std::uint64_t Queue::last_submitted_value() const noexcept {
+    return queue_->submitted.load(std::memory_order_acquire);
+}
+
+VKRC_END_NAMESPACE

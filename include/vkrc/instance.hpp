@@ -1,0 +1,135 @@
+// Instance, debug messages and physical devices.
+#pragma once
+
+#include "vkrc/error.hpp"
+#include "vkrc/functions.hpp"
+#include "vkrc/handle.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class InstanceState;
+class PhysicalDeviceState;
+}  // namespace detail
+
+class PhysicalDevice;
+
+// One message from VK_EXT_debug_utils (the validation layer among others).
+struct DebugMessage {
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity;
+    VkDebugUtilsMessageTypeFlagsEXT types;
+    const char* message_id_name;  // may be null
+    const char* message;
+};
+using DebugCallback = std::function<void(const DebugMessage&)>;
+
+// Writes "vkrc [warning|error|info|verbose] <id>: <message>" to stderr.
+void print_debug_message(const DebugMessage& message);
+
+// Mirrors VkInstanceCreateInfo, plus vkrc conveniences.
+struct InstanceCreateInfo {
+    const char* application_name = "vkrc application";
+    std::uint32_t application_version = 0;
+    std::uint32_t api_version = VK_API_VERSION_1_3;
+    std::vector<const char*> enabled_layer_names;
+    std::vector<const char*> enabled_extension_names;
+    // Adds VK_LAYER_KHRONOS_validation and VK_EXT_debug_utils.
+    bool validation = false;
+    // Installs a debug-utils messenger for the instance's whole life (and for
+    // vkCreateInstance/vkDestroyInstance themselves). Null with validation on
+    // means print_debug_message. Set it without validation to hear other layers.
+    DebugCallback debug_callback;
+    VkDebugUtilsMessageSeverityFlagsEXT debug_severities =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    // Entry point every function is loaded through; null means the loader's.
+    PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
+    // Chained into VkInstanceCreateInfo::pNext (e.g. VkValidationFeaturesEXT).
+    const void* next = nullptr;
+};
+
+class Instance : public Handle<detail::InstanceState> {
+public:
+    Instance() noexcept = default;
+    static Instance create(const InstanceCreateInfo& info = {});
+    // Wraps an instance made elsewhere. With Ownership::owned vkrc destroys it.
+    static Instance adopt(VkInstance instance, Ownership ownership, std::uint32_t api_version,
+                          PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+
+    VkInstance vk() const noexcept;
+    const InstanceFunctions& fn() const noexcept;
+    const GlobalFunctions& global_fn() const noexcept;
+    std::uint32_t api_version() const noexcept;
+    bool extension_enabled(const char* name) const noexcept;
+
+    std::vector<PhysicalDevice> physical_devices() const;
+
+    // Names of the available instance layers / extensions (for choosing what to enable).
+    static std::vector<std::string> available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+    static std::vector<std::string> available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+
+private:
+    using Handle::Handle;
+    friend class PhysicalDevice;
+};
+
+// What a device must offer to be chosen. Every unmet item is reported.
+struct DeviceRequirements {
+    std::uint32_t min_api_version = VK_API_VERSION_1_3;
+    VkQueueFlags queue_flags = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+    std::vector<const char*> required_extensions;
+    // A queue family of the chosen device must be able to present to it.
+    VkSurfaceKHR present_surface = VK_NULL_HANDLE;
+    // Devices of earlier types in this list win; CPU devices (lavapipe) are accepted.
+    std::vector<VkPhysicalDeviceType> preferred_types = {
+        VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
+        VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_CPU, VK_PHYSICAL_DEVICE_TYPE_OTHER};
+    // Only a device whose name contains this text (e.g. from an environment variable).
+    std::string name_contains;
+};
+
+// Thrown when no physical device meets the requirements; what() lists every
+// device with the reasons it was rejected.
+class NoSuitableDeviceError : public std::runtime_error {
+public:
+    NoSuitableDeviceError(std::string message, std::vector<std::string> rejections)
+        : std::runtime_error(std::move(message)), rejections_(std::move(rejections)) {}
+    // One line per rejected device: "<name>: <reason>; <reason>".
+    const std::vector<std::string>& rejections() const noexcept { return rejections_; }
+
+private:
+    std::vector<std::string> rejections_;
+};
+
+// A physical device; keeps its Instance alive. Properties are read once.
+class PhysicalDevice : public Handle<detail::PhysicalDeviceState> {
+public:
+    PhysicalDevice() noexcept = default;
+    // Chooses the best device that meets the requirements, or throws
+    // NoSuitableDeviceError naming each device and why it was rejected.
+    static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements = {});
+    // The reasons this device fails the requirements; empty when it meets them.
+    std::vector<std::string> unmet_requirements(const DeviceRequirements& requirements) const;
+
+    VkPhysicalDevice vk() const noexcept;
+    const Instance& instance() const noexcept;
+    const InstanceFunctions& fn() const noexcept;
+    const VkPhysicalDeviceProperties& properties() const noexcept;
+    const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept;
+    const std::vector<VkQueueFamilyProperties>& queue_families() const noexcept;
+    const char* name() const noexcept { return properties().deviceName; }
+    bool supports_extension(const char* name) const noexcept;
+    // First family with all the flags (and presentation to surface if given), or -1.
+    int find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_surface = VK_NULL_HANDLE) const;
+
+private:
+    using Handle::Handle;
+    friend class Instance;
+};
+
+VKRC_END_NAMESPACE
+
+#include "vkrc/detail/instance_state.hpp"

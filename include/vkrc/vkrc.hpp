@@ -1,0 +1,9 @@
+// The whole of vkrc. Each object family also has its own header.
+#pragma once
+
+#include "vkrc/config.hpp"
+#include "vkrc/device.hpp"
+#include "vkrc/error.hpp"
+#include "vkrc/functions.hpp"
+#include "vkrc/handle.hpp"
+#include "vkrc/instance.hpp"

@@ -1,0 +1,188 @@
+#include "vkrc/instance.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace {
+
+constexpr const char* validation_layer = "VK_LAYER_KHRONOS_validation";
+
+VKAPI_ATTR VkBool32 VKAPI_CALL debug_trampoline(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                VkDebugUtilsMessageTypeFlagsEXT types,
+                                                const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    const auto& callback = *static_cast<const DebugCallback*>(user);
+    callback(DebugMessage{severity, types, data->pMessageIdName, data->pMessage});
+    return VK_FALSE;  // never abort the call that produced the message
+}
+
+void add_unique(std::vector<const char*>& names, const char* name) {
+    auto same = [&](const char* n) { return std::strcmp(n, name) == 0; };
+    if (std::none_of(names.begin(), names.end(), same)) names.push_back(name);
+}
+
+template <class T, class F>
+std::vector<T> enumerate(F&& call, const char* what) {
+    std::uint32_t count = 0;
+    std::vector<T> items;
+    VkResult r;
+    do {
+        check(call(&count, nullptr), what);
+        items.resize(count);
+        r = check(call(&count, items.data()), what);
+    } while (r == VK_INCOMPLETE);
+    items.resize(count);
+    return items;
+}
+
+}  // namespace
+
+void print_debug_message(const DebugMessage& message) {
+    const char* level = (message.severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)     ? "error"
+                        : (message.severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) ? "warning"
+                        : (message.severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT)    ? "info"
+                                                                                               : "verbose";
+    std::fprintf(stderr, "vkrc [%s] %s: %s\n", level, message.message_id_name ? message.message_id_name : "-",
+                 message.message);
+}
+
+namespace detail {
+InstanceState::~InstanceState() {
+    if (messenger != VK_NULL_HANDLE) fn.vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
+    if (ownership == Ownership::owned && instance != VK_NULL_HANDLE) fn.vkDestroyInstance(instance, nullptr);
+}
+}  // namespace detail
+
+Instance Instance::create(const InstanceCreateInfo& info) {
+    auto global = GlobalFunctions::load(info.get_instance_proc_addr);
+
+    std::vector<const char*> layers = info.enabled_layer_names;
+    std::vector<const char*> extensions = info.enabled_extension_names;
+    if (info.validation) {
+        add_unique(layers, validation_layer);
+        add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    }
+    std::unique_ptr<DebugCallback> callback;
+    if (info.debug_callback || info.validation) {
+        add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        callback = std::make_unique<DebugCallback>(info.debug_callback ? info.debug_callback
+                                                                       : DebugCallback(print_debug_message));
+    }
+
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = info.application_name;
+    app.applicationVersion = info.application_version;
+    app.pEngineName = "vkrc";
+    app.apiVersion = info.api_version;
+
+    // The same messenger description is chained into vkCreateInstance so that
+    // messages from instance creation and destruction reach the callback too.
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    messenger_info.messageSeverity = info.debug_severities;
+    messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                                 VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                                 VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    messenger_info.pfnUserCallback = debug_trampoline;
+    messenger_info.pUserData = callback.get();
+    messenger_info.pNext = info.next;
+
+    VkInstanceCreateInfo create{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    create.pNext = callback ? &messenger_info : info.next;
+    create.pApplicationInfo = &app;
+    create.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+    create.ppEnabledLayerNames = layers.data();
+    create.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    create.ppEnabledExtensionNames = extensions.data();
+
+    VkInstance raw = VK_NULL_HANDLE;
+    check(global.vkCreateInstance(&create, nullptr, &raw), "vkCreateInstance");
+
+    // From here the state owns the instance: an exception below destroys it.
+    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
+    auto& s = *instance.state_;
+    s.instance = raw;
+    s.api_version = info.api_version;
+    s.global_fn = global;
+    s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
+    s.enabled_extensions.assign(extensions.begin(), extensions.end());
+    if (callback) {
+        messenger_info.pNext = nullptr;
+        check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
+              "vkCreateDebugUtilsMessengerEXT");
+    }
+    s.debug_callback = std::move(callback);
+    return instance;
+}
+
+Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_version,
+                         PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+    if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Instance::adopt: the VkInstance is VK_NULL_HANDLE");
+    auto global = GlobalFunctions::load(get_instance_proc_addr);
+    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
+    auto& s = *instance.state_;
+    s.instance = raw;
+    s.ownership = ownership;
+    s.api_version = api_version;
+    s.global_fn = global;
+    s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
+    return instance;
+}
+
+bool Instance::extension_enabled(const char* name) const noexcept {
+    const auto& e = state_->enabled_extensions;
+    return std::find(e.begin(), e.end(), name) != e.end();
+}
+
+std::vector<std::string> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+    auto global = GlobalFunctions::load(get_instance_proc_addr);
+    auto props = enumerate<VkLayerProperties>(
+        [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
+        "vkEnumerateInstanceLayerProperties");
+    std::vector<std::string> names;
+    for (const auto& p : props) names.emplace_back(p.layerName);
+    return names;
+}
+
+std::vector<std::string> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+    auto global = GlobalFunctions::load(get_instance_proc_addr);
+    auto props = enumerate<VkExtensionProperties>(
+        [&](std::uint32_t* n, VkExtensionProperties* p) {
+            return global.vkEnumerateInstanceExtensionProperties(nullptr, n, p);
+        },
+        "vkEnumerateInstanceExtensionProperties");
+    std::vector<std::string> names;
+    for (const auto& p : props) names.emplace_back(p.extensionName);
+    return names;
+}
+
+std::vector<PhysicalDevice> Instance::physical_devices() const {
+    const auto& f = fn();
+    auto raws = enumerate<VkPhysicalDevice>(
+        [&](std::uint32_t* n, VkPhysicalDevice* p) { return f.vkEnumeratePhysicalDevices(vk(), n, p); },
+        "vkEnumeratePhysicalDevices");
+    std::vector<PhysicalDevice> devices;
+    for (VkPhysicalDevice raw : raws) {
+        PhysicalDevice device(detail::Ref<detail::PhysicalDeviceState>(new detail::PhysicalDeviceState));
+        auto& s = *device.state_;
+        s.instance = *this;
+        s.physical_device = raw;
+        f.vkGetPhysicalDeviceProperties(raw, &s.properties);
+        f.vkGetPhysicalDeviceMemoryProperties(raw, &s.memory_properties);
+        std::uint32_t families = 0;
+        f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, nullptr);
+        s.queue_families.resize(families);
+        f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, s.queue_families.data());
+        auto exts = enumerate<VkExtensionProperties>(
+            [&](std::uint32_t* n, VkExtensionProperties* p) {
+                return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
+            },
+            "vkEnumerateDeviceExtensionProperties");
+        for (const auto& e : exts) s.extensions.emplace_back(e.extensionName);
+        devices.push_back(std::move(device));
+    }
+    return devices;
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,104 @@
+#include "vkrc/instance.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace {
+std::string version_string(std::uint32_t v) {
+    return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+           std::to_string(VK_API_VERSION_PATCH(v));
+}
+}  // namespace
+
+bool PhysicalDevice::supports_extension(const char* name) const noexcept {
+    const auto& e = state_->extensions;
+    return std::find(e.begin(), e.end(), name) != e.end();
+}
+
+int PhysicalDevice::find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_surface) const {
+    const auto& families = queue_families();
+    for (std::uint32_t i = 0; i < families.size(); ++i) {
+        if ((families[i].queueFlags & flags) != flags) continue;
+        if (present_surface != VK_NULL_HANDLE) {
+            VkBool32 supported = VK_FALSE;
+            check(fn().vkGetPhysicalDeviceSurfaceSupportKHR(vk(), i, present_surface, &supported),
+                  "vkGetPhysicalDeviceSurfaceSupportKHR");
+            if (!supported) continue;
+        }
+        return static_cast<int>(i);
+    }
+    return -1;
+}
+
+std::vector<std::string> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
+    std::vector<std::string> reasons;
+    const auto& props = properties();
+    if (props.apiVersion < req.min_api_version) {
+        reasons.push_back("supports Vulkan " + version_string(props.apiVersion) + ", needs " +
+                          version_string(req.min_api_version));
+    }
+    if (std::find(req.preferred_types.begin(), req.preferred_types.end(), props.deviceType) ==
+        req.preferred_types.end()) {
+        reasons.push_back("device type " + std::to_string(props.deviceType) + " is not among the accepted types");
+    }
+    if (!req.name_contains.empty() && std::strstr(props.deviceName, req.name_contains.c_str()) == nullptr) {
+        reasons.push_back("name does not contain \"" + req.name_contains + "\"");
+    }
+    for (const char* ext : req.required_extensions) {
+        if (!supports_extension(ext)) reasons.push_back(std::string("lacks extension ") + ext);
+    }
+    if (find_queue_family(req.queue_flags) < 0) {
+        reasons.push_back("no queue family with flags 0x" + [&] {
+            char buf[16];
+            std::snprintf(buf, sizeof buf, "%x", req.queue_flags);
+            return std::string(buf);
+        }());
+    } else if (req.present_surface != VK_NULL_HANDLE && find_queue_family(req.queue_flags, req.present_surface) < 0) {
+        reasons.push_back("no queue family with those flags can present to the surface");
+    }
+    if (props.apiVersion >= VK_API_VERSION_1_3) {
+        // vkrc is built on these three features; Vulkan 1.3 makes only two of them mandatory.
+        VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
+        VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+        fn().vkGetPhysicalDeviceFeatures2(vk(), &f);
+        if (!f12.timelineSemaphore) reasons.push_back("lacks feature timelineSemaphore");
+        if (!f13.synchronization2) reasons.push_back("lacks feature synchronization2");
+        if (!f13.dynamicRendering) reasons.push_back("lacks feature dynamicRendering");
+    }
+    return reasons;
+}
+
+PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequirements& req) {
+    auto devices = instance.physical_devices();
+    std::vector<std::string> rejections;
+    PhysicalDevice best;
+    std::size_t best_rank = SIZE_MAX;
+    for (auto& device : devices) {
+        auto reasons = device.unmet_requirements(req);
+        if (!reasons.empty()) {
+            std::string line = std::string(device.name()) + ": ";
+            for (std::size_t i = 0; i < reasons.size(); ++i) line += (i ? "; " : "") + reasons[i];
+            rejections.push_back(std::move(line));
+            continue;
+        }
+        auto type = device.properties().deviceType;
+        auto rank = static_cast<std::size_t>(
+            std::find(req.preferred_types.begin(), req.preferred_types.end(), type) - req.preferred_types.begin());
+        if (rank < best_rank) {
+            best_rank = rank;
+            best = device;
+        }
+    }
+    if (best) return best;
+    std::string message = devices.empty() ? "vkrc: no Vulkan physical device found (is a Vulkan driver installed?)"
+                                          : "vkrc: no suitable Vulkan physical device";
+    for (const auto& r : rejections) message += "\n  rejected " + r;
+    throw NoSuitableDeviceError(std::move(message), std::move(rejections));
+}
+
+VKRC_END_NAMESPACE

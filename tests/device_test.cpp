@@ -1,0 +1,230 @@
+#include "support/vk_test.hpp"
+
+#include <algorithm>
+#include <array>
+#include <thread>
+
+namespace {
+
+using vkrc_test::ValidationLog;
+using vkrc_test::VulkanTest;
+
+struct Chain {
+    vkrc::Instance instance;
+    vkrc::PhysicalDevice physical;
+    vkrc::Device device;
+    vkrc::Queue queue;
+};
+
+Chain make_chain(const std::shared_ptr<ValidationLog>& log) {
+    Chain c;
+    c.instance = vkrc::Instance::create(vkrc_test::validated_instance_info(log));
+    c.physical = vkrc::PhysicalDevice::select(c.instance, vkrc_test::test_device_requirements());
+    c.device = vkrc::Device::create(c.physical);
+    c.queue = c.device.default_queue();
+    return c;
+}
+
+// Drops the four handles in every one of the 24 orders: children keep their
+// parents alive, so each order must be clean.
+TEST(DestructionOrder, EveryOrderIsClean) {
+    std::array<int, 4> order{0, 1, 2, 3};
+    int runs = 0;
+    do {
+        auto log = std::make_shared<ValidationLog>();
+        Chain c = make_chain(log);
+        for (int which : order) {
+            switch (which) {
+                case 0: c.instance.reset(); break;
+                case 1: c.physical.reset(); break;
+                case 2: c.device.reset(); break;
+                case 3: c.queue = {}; break;
+            }
+        }
+        vkrc_test::expect_no_validation_messages(*log);
+        ++runs;
+    } while (std::next_permutation(order.begin(), order.end()));
+    EXPECT_EQ(runs, 24);
+}
+
+TEST_F(VulkanTest, ChildrenKeepParentsAlive) {
+    VkDevice raw = device.vk();
+    EXPECT_EQ(instance.use_count(), 2u);  // the fixture's handle and the physical device's
+    instance.reset();
+    physical_device.reset();
+    device.reset();
+    // The queue alone keeps the device, physical device and instance alive.
+    ASSERT_TRUE(queue);
+    EXPECT_EQ(queue.device().vk(), raw);
+    EXPECT_TRUE(queue.device().instance());
+    queue.wait_idle();
+    EXPECT_EQ(queue.device().physical_device().instance().physical_devices().size() > 0, true);
+}
+
+TEST_F(VulkanTest, CopiesAndMovesShareOneDevice) {
+    vkrc::Device copy = device;
+    EXPECT_EQ(device.use_count(), copy.use_count());
+    vkrc::Device moved = std::move(copy);
+    EXPECT_FALSE(copy);  // NOLINT(bugprone-use-after-move)
+    EXPECT_TRUE(moved == device);
+    moved = moved;  // self-assignment keeps it
+    EXPECT_EQ(moved.vk(), device.vk());
+}
+
+TEST_F(VulkanTest, QueuesAreFoundByFamilyAndIndex) {
+    EXPECT_TRUE(device.queue(queue.family_index(), 0) == queue);
+    EXPECT_THROW(device.queue(queue.family_index(), 7), vkrc::UsageError);
+    EXPECT_THROW(device.queue(999), vkrc::UsageError);
+}
+
+TEST_F(VulkanTest, BadQueueRequestsNameTheProblem) {
+    vkrc::DeviceCreateInfo info;
+    info.queue_requests = {{999, {1.0f}}};
+    try {
+        vkrc::Device::create(physical_device, info);
+        FAIL();
+    } catch (const vkrc::UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("queue family 999 does not exist"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(VulkanTest, FunctionTableReachesUnwrappedFunctions) {
+    ASSERT_NE(device.fn().vkCmdDraw, nullptr);
+    ASSERT_NE(device.fn().vkQueueSubmit2, nullptr);
+    ASSERT_NE(device.fn().vkCmdBeginRendering, nullptr);
+    // A raw call with raw handles, next to the wrappers.
+    VkFence fence = VK_NULL_HANDLE;
+    VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    ASSERT_EQ(device.fn().vkCreateFence(device.vk(), &info, nullptr, &fence), VK_SUCCESS);
+    device.fn().vkDestroyFence(device.vk(), fence, nullptr);
+}
+
+TEST_F(VulkanTest, AdoptedBorrowedDeviceIsNotDestroyed) {
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    q.queueFamilyIndex = queue.family_index();
+    q.queueCount = 1;
+    q.pQueuePriorities = &priority;
+    VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    f12.timelineSemaphore = VK_TRUE;
+    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f12};
+    info.queueCreateInfoCount = 1;
+    info.pQueueCreateInfos = &q;
+    VkDevice raw = VK_NULL_HANDLE;
+    ASSERT_EQ(physical_device.fn().vkCreateDevice(physical_device.vk(), &info, nullptr, &raw), VK_SUCCESS);
+    std::vector<vkrc::QueueRequest> queues{{queue.family_index(), {1.0f}}};
+    {
+        auto borrowed = vkrc::Device::adopt(physical_device, raw, vkrc::Ownership::borrowed, queues);
+        borrowed.default_queue().wait_idle();
+    }
+    // Still valid after the wrapper went; the test destroys it itself.
+    auto destroy = reinterpret_cast<PFN_vkDestroyDevice>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDestroyDevice"));
+    auto wait = reinterpret_cast<PFN_vkDeviceWaitIdle>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDeviceWaitIdle"));
+    EXPECT_EQ(wait(raw), VK_SUCCESS);
+    destroy(raw, nullptr);
+}
+
+// Blocks the queue on a semaphore the host signals later, so "the GPU may
+// still use it" is true for as long as the test wants.
+struct BlockedQueue {
+    vkrc::Device device;
+    VkSemaphore gate = VK_NULL_HANDLE;
+
+    BlockedQueue(const vkrc::Device& d, const vkrc::Queue& q) : device(d) {
+        VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+        type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+        VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+        vkrc::check(d.fn().vkCreateSemaphore(d.vk(), &info, nullptr, &gate), "vkCreateSemaphore");
+        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        wait.semaphore = gate;
+        wait.value = 1;
+        wait.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit.waitSemaphoreInfoCount = 1;
+        submit.pWaitSemaphoreInfos = &wait;
+        q.submit({&submit, 1});
+    }
+    void open() const {
+        VkSemaphoreSignalInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
+        signal.semaphore = gate;
+        signal.value = 1;
+        vkrc::check(device.fn().vkSignalSemaphore(device.vk(), &signal), "vkSignalSemaphore");
+    }
+    // The gate may still be waited on: its destruction goes through the same
+    // deferral as any vkrc object's.
+    ~BlockedQueue() { vkrc::detail::defer_destroy<&vkrc::DeviceFunctions::vkDestroySemaphore>(*device.state(), gate); }
+};
+
+int actions_run = 0;
+void count_action(vkrc::detail::DeviceState&, std::uint64_t handle, void*) noexcept { actions_run += int(handle); }
+
+TEST_F(VulkanTest, DestructionWaitsForSubmittedWork) {
+    actions_run = 0;
+    auto& state = *device.state();
+    state.destroy_after_gpu({count_action, 1, nullptr});
+    EXPECT_EQ(actions_run, 1) << "nothing submitted: runs at once";
+
+    BlockedQueue blocked(device, queue);
+    state.destroy_after_gpu({count_action, 10, nullptr});
+    state.destroy_after_gpu({count_action, 100, nullptr});
+    EXPECT_EQ(actions_run, 1);
+    EXPECT_EQ(device.deferred_count(), 2u);
+    device.collect_garbage();
+    EXPECT_EQ(actions_run, 1) << "the queue is still blocked";
+
+    blocked.open();
+    queue.wait_idle();
+    EXPECT_EQ(actions_run, 111);
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+TEST(DeferredDestruction, DeviceTeardownDrainsPendingWork) {
+    actions_run = 0;
+    auto log = std::make_shared<ValidationLog>();
+    {
+        Chain c = make_chain(log);
+        BlockedQueue blocked(c.device, c.queue);
+        c.device.state()->destroy_after_gpu({count_action, 5, nullptr});
+        EXPECT_EQ(actions_run, 0);
+        blocked.open();
+        // Every handle goes here, the queue's work possibly still running:
+        // teardown waits for idle and runs the action.
+    }
+    EXPECT_EQ(actions_run, 5);
+    vkrc_test::expect_no_validation_messages(*log);
+}
+
+TEST_F(VulkanTest, SubmitAppendsOneTimelineSignal) {
+    const std::uint64_t before = queue.last_submitted_value();
+    VkSubmitInfo2 empty{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    std::array<VkSubmitInfo2, 3> batches{empty, empty, empty};
+    queue.submit(batches);
+    queue.submit({});
+    EXPECT_EQ(queue.last_submitted_value(), before + 2);
+    queue.wait_idle();
+    std::uint64_t reached = 0;
+    ASSERT_EQ(device.fn().vkGetSemaphoreCounterValue(device.vk(), queue.timeline_semaphore(), &reached), VK_SUCCESS);
+    EXPECT_EQ(reached, before + 2);
+}
+
+#if VKRC_IS_MULTI_THREAD
+TEST_F(VulkanTest, SixteenThreadsShareAndDropHandles) {
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 16; ++t) {
+        threads.emplace_back([this, t] {
+            for (int i = 0; i < 2000; ++i) {
+                vkrc::Device d = device;
+                vkrc::Queue q = d.default_queue();
+                vkrc::Instance in = q.device().instance();
+                vkrc::PhysicalDevice p = d.physical_device();
+                if ((i + t) % 500 == 0) q.submit({});
+            }
+        });
+    }
+    for (auto& t : threads) t.join();
+    queue.wait_idle();
+    EXPECT_EQ(device.use_count(), 2u);  // the fixture's device and queue handles
+}
+#endif
+
+}  // namespace

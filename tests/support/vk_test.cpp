@@ -1,0 +1,70 @@
+#include "vk_test.hpp"
+
+#include <cstdlib>
+
+namespace vkrc_test {
+
+std::size_t ValidationLog::take_expected(const std::string& id) {
+    std::lock_guard lock(mutex_);
+    std::size_t before = messages_.size();
+    std::erase_if(messages_, [&](const std::string& m) { return m.find(id) != std::string::npos; });
+    return before - messages_.size();
+}
+
+vkrc::InstanceCreateInfo validated_instance_info(const std::shared_ptr<ValidationLog>& log) {
+    vkrc::InstanceCreateInfo info;
+    info.application_name = "vkrc tests";
+    info.validation = true;
+    info.debug_callback = [log](const vkrc::DebugMessage& m) {
+        vkrc::print_debug_message(m);
+        log->add(m);
+    };
+    return info;
+}
+
+vkrc::DeviceRequirements test_device_requirements() {
+    vkrc::DeviceRequirements req;
+    if (const char* name = std::getenv("VKRC_TEST_DEVICE")) req.name_contains = name;
+    return req;
+}
+
+void VulkanTest::SetUp() {
+    instance = vkrc::Instance::create(validated_instance_info(log));
+    physical_device = vkrc::PhysicalDevice::select(instance, test_device_requirements());
+    device = vkrc::Device::create(physical_device);
+    queue = device.default_queue();
+}
+
+void VulkanTest::release_all() {
+    queue = {};
+    device.reset();
+    physical_device.reset();
+    instance.reset();
+}
+
+void VulkanTest::TearDown() {
+    release_all();
+    expect_no_validation_messages(*log);
+}
+
+void expect_no_validation_messages(ValidationLog& log) {
+    auto messages = log.take();
+    EXPECT_TRUE(messages.empty()) << messages.size() << " validation message(s), first: " << messages.front();
+}
+
+}  // namespace vkrc_test
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <dlfcn.h>
+namespace {
+// The loader unloads the driver and the layer at vkDestroyInstance; leaks
+// inside them would then be reported from "<unknown module>" and could not be
+// told from vkrc's. Pinning them keeps their names for lsan.supp.
+[[maybe_unused]] const bool pinned_driver_modules = [] {
+    for (const char* lib : {"libvulkan_lvp.so", "libVkLayer_khronos_validation.so"}) {
+        dlopen(lib, RTLD_LAZY | RTLD_LOCAL | RTLD_NODELETE);
+    }
+    return true;
+}();
+}  // namespace
+#endif

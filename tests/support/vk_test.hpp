@@ -1,0 +1,61 @@
+// Shared test support: every test that touches Vulkan runs with the Khronos
+// validation layer, and any warning or error it reports fails the test.
+#pragma once
+
+#include <vkrc/vkrc.hpp>
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace vkrc_test {
+
+// Collects validation messages from any thread.
+class ValidationLog {
+public:
+    void add(const vkrc::DebugMessage& m) {
+        std::lock_guard lock(mutex_);
+        messages_.push_back(std::string(m.message_id_name ? m.message_id_name : "-") + ": " + m.message);
+    }
+    std::vector<std::string> take() {
+        std::lock_guard lock(mutex_);
+        return std::exchange(messages_, {});
+    }
+    // Drops messages the test provoked on purpose, all of which must carry id.
+    std::size_t take_expected(const std::string& id);
+
+private:
+    std::mutex mutex_;
+    std::vector<std::string> messages_;
+};
+
+// InstanceCreateInfo with validation on and messages routed into log.
+vkrc::InstanceCreateInfo validated_instance_info(const std::shared_ptr<ValidationLog>& log);
+
+// The device the tests run on: VKRC_TEST_DEVICE (a name substring) or the best.
+vkrc::DeviceRequirements test_device_requirements();
+
+// Fixture: a validated instance, the chosen physical device and a device with
+// one graphics+compute queue. TearDown drops them all and fails the test on
+// any validation message, including those reported at destruction (leaks).
+class VulkanTest : public ::testing::Test {
+protected:
+    void SetUp() override;
+    void TearDown() override;
+    // Drops the fixture's handles (tests that check destruction order call it).
+    void release_all();
+
+    std::shared_ptr<ValidationLog> log = std::make_shared<ValidationLog>();
+    vkrc::Instance instance;
+    vkrc::PhysicalDevice physical_device;
+    vkrc::Device device;
+    vkrc::Queue queue;
+};
+
+// Asserts that log has no messages (prints them otherwise).
+void expect_no_validation_messages(ValidationLog& log);
+
+}  // namespace vkrc_test
