@@ -104,6 +104,31 @@ void DeviceState::collect() noexcept {
     for (auto& a : ready) a.run(*this, a.handle, a.context);
 }
 
+void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) const {
+    out.resize(queues.size());
+    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i]->submitted.load(std::memory_order_acquire);
+}
+
+bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
+    if (lost.load(std::memory_order_relaxed)) return true;
+    for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
+        auto& q = *queues[i];
+        if (q.completed.load(std::memory_order_relaxed) >= snapshot[i]) continue;
+        std::uint64_t value = 0;
+        VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
+        if (r == VK_ERROR_DEVICE_LOST) {
+            mark_lost();
+            return true;
+        }
+        if (r != VK_SUCCESS) return false;
+        std::uint64_t seen = q.completed.load(std::memory_order_relaxed);
+        while (seen < value && !q.completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+        }
+        if (value < snapshot[i]) return false;
+    }
+    return true;
+}
+
 std::size_t DeviceState::deferred_count() const noexcept {
     LockGuard lock(deferred_mutex_);
     return deferred_actions_;
@@ -190,6 +215,8 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     f13.pNext = const_cast<void*>(info.next);
     f13.synchronization2 = VK_TRUE;
     f13.dynamicRendering = VK_TRUE;
+    // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
+    f13.maintenance4 = VK_TRUE;
     auto f12 = info.vulkan12_features;
     f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
     f12.pNext = &f13;

@@ -19,7 +19,8 @@ struct QueueRequest {
 };
 
 // Mirrors VkDeviceCreateInfo. vkrc always turns on timelineSemaphore,
-// synchronization2 and dynamicRendering (it is built on them); set any other
+// synchronization2, dynamicRendering and maintenance4 (it is built on them, and
+// SPIR-V compiled for Vulkan 1.3 needs maintenance4); set any other
 // feature in the structs below. vkrc fills their sType and pNext.
 struct DeviceCreateInfo {
     // Empty: one queue from the first family with graphics and compute.

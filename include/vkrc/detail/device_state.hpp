@@ -48,6 +48,13 @@ public:
     void mark_lost() noexcept { lost.store(true, std::memory_order_relaxed); }
     std::size_t deferred_count() const noexcept;
 
+    // For objects a pool owns (command buffers, descriptor sets), which must
+    // be freed under their pool's lock rather than by a DeferredAction: the
+    // values submitted so far on every queue (out is resized to the queue
+    // count), and whether the GPU has completed the work they stand for.
+    void submitted_snapshot(std::vector<std::uint64_t>& out) const;
+    bool reached(std::span<const std::uint64_t> snapshot) noexcept;
+
     VkDevice device = VK_NULL_HANDLE;
     DeviceFunctions fn;
     PhysicalDevice physical_device;

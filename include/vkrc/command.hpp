@@ -1,0 +1,428 @@
+// Command pools, command buffers, recording and typed submission.
+//
+// Recording methods are inline: each is one call through the device function
+// table with the raw handles read out of the wrappers. No allocation, no
+// atomics, no locks. Anything not wrapped stays callable as
+//     cmd.fn().vkCmdSetLineWidth(cmd.vk(), 2.0f);
+#pragma once
+
+#include "vkrc/pipeline.hpp"
+#include "vkrc/sync.hpp"
+
+#include <span>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class CommandPoolState;
+class CommandBufferState;
+}  // namespace detail
+
+// Mirrors VkCommandPoolCreateInfo.
+struct CommandPoolCreateInfo {
+    VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    std::uint32_t queue_family_index = 0;
+};
+
+class CommandBuffer;
+
+// A command pool, externally synchronised as Vulkan requires: record into the
+// command buffers of one pool from one thread at a time (use a pool per
+// thread). Under the multi-thread policy the pool's lock is taken by
+// allocate, reset, begin and end (never per recorded command), so that the
+// frees vkrc does on its own when a command buffer is dropped (on any thread)
+// never race with them.
+class CommandPool : public Handle<detail::CommandPoolState> {
+public:
+    CommandPool() noexcept = default;
+    static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
+
+    VkCommandPool vk() const noexcept;
+    const Device& device() const noexcept;
+    std::uint32_t queue_family_index() const noexcept;
+
+    CommandBuffer allocate(VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY) const;
+    // vkResetCommandPool: every command buffer of the pool returns to the
+    // initial state. The caller ensures none is pending on the GPU.
+    void reset_commands(VkCommandPoolResetFlags flags = 0) const;
+    // Command buffers dropped while the GPU may use them, not yet freed.
+    std::size_t pending_free_count() const;
+
+private:
+    using Handle::Handle;
+};
+
+// What a secondary command buffer inherits (VkCommandBufferInheritanceInfo,
+// with VkCommandBufferInheritanceRenderingInfo for dynamic rendering). Leave
+// render_pass empty and color_formats empty for secondaries used outside
+// rendering; set either for RENDER_PASS_CONTINUE secondaries.
+struct CommandBufferInheritance {
+    RenderPass render_pass;
+    std::uint32_t subpass = 0;
+    Framebuffer framebuffer;
+    std::span<const VkFormat> color_formats;
+    VkFormat depth_format = VK_FORMAT_UNDEFINED;
+    VkFormat stencil_format = VK_FORMAT_UNDEFINED;
+    VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
+};
+
+// One attachment of dynamic rendering (VkRenderingAttachmentInfo, no resolve).
+struct RenderingAttachment {
+    VkImageView image_view = VK_NULL_HANDLE;
+    VkImageLayout image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    VkAttachmentLoadOp load_op = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    VkAttachmentStoreOp store_op = VK_ATTACHMENT_STORE_OP_STORE;
+    VkClearValue clear_value{};
+};
+
+// VkRenderingInfo. At most max_color_attachments colour attachments.
+struct RenderingInfo {
+    static constexpr std::uint32_t max_color_attachments = 8;
+    VkRect2D render_area{};
+    std::span<const RenderingAttachment> color_attachments;
+    const RenderingAttachment* depth_attachment = nullptr;
+    const RenderingAttachment* stencil_attachment = nullptr;
+    VkRenderingFlags flags = 0;
+    std::uint32_t layer_count = 1;
+};
+
+// A command buffer; keeps its pool alive and returns to it when dropped (once
+// the GPU has finished the work submitted before the drop).
+class CommandBuffer : public Handle<detail::CommandBufferState> {
+public:
+    CommandBuffer() noexcept = default;
+
+    VkCommandBuffer vk() const noexcept;
+    const DeviceFunctions& fn() const noexcept;
+    const CommandPool& pool() const noexcept;
+    VkCommandBufferLevel level() const noexcept;
+
+    // vkBeginCommandBuffer for a primary. flags: ONE_TIME_SUBMIT (default) or
+    // SIMULTANEOUS_USE, or 0 to resubmit without overlap.
+    void begin(VkCommandBufferUsageFlags flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) const;
+    // vkBeginCommandBuffer for a secondary; RENDER_PASS_CONTINUE is added when
+    // inheritance names a render pass or colour formats.
+    void begin_secondary(const CommandBufferInheritance& inheritance = {},
+                         VkCommandBufferUsageFlags flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) const;
+    void end() const;
+    // vkResetCommandBuffer (the pool needs RESET_COMMAND_BUFFER_BIT). Not
+    // reset(), which, as on every handle, drops this reference.
+    void reset_commands(VkCommandBufferResetFlags flags = 0) const;
+
+    // Render passes and dynamic rendering
+    void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
+                           std::span<const VkClearValue> clear_values,
+                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
+    void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
+    void end_render_pass() const noexcept;
+    void begin_rendering(const RenderingInfo& info) const noexcept;
+    void end_rendering() const noexcept;
+
+    // State
+    void bind_pipeline(const Pipeline& pipeline) const noexcept;
+    void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0) const noexcept;
+    void bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
+                             std::span<const VkDeviceSize> offsets) const noexcept;
+    void bind_index_buffer(VkBuffer buffer, VkDeviceSize offset = 0,
+                           VkIndexType type = VK_INDEX_TYPE_UINT32) const noexcept;
+    // Binds one set at index set_index of the pipeline's layout.
+    void bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
+                             std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+    void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+    void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
+                        std::uint32_t size, const void* data) const noexcept;
+    template <class T>
+    void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
+                        std::uint32_t offset = 0) const noexcept {
+        push_constants(layout, stages, offset, sizeof(T), &value);
+    }
+    void set_viewport(const VkViewport& viewport) const noexcept;
+    void set_scissor(const VkRect2D& scissor) const noexcept;
+    // Viewport (depth 0..1) and scissor covering extent.
+    void set_viewport_and_scissor(VkExtent2D extent) const noexcept;
+
+    // Work
+    void draw(std::uint32_t vertex_count, std::uint32_t instance_count = 1, std::uint32_t first_vertex = 0,
+              std::uint32_t first_instance = 0) const noexcept;
+    void draw_indexed(std::uint32_t index_count, std::uint32_t instance_count = 1, std::uint32_t first_index = 0,
+                      std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const noexcept;
+    void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const noexcept;
+    void copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const noexcept;
+    void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
+                              std::span<const VkBufferImageCopy> regions) const noexcept;
+    void copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
+                              std::span<const VkBufferImageCopy> regions) const noexcept;
+    void copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                    std::span<const VkImageCopy> regions) const noexcept;
+    void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, std::uint32_t data) const noexcept;
+
+    // Synchronisation (synchronization2)
+    void pipeline_barrier(const VkDependencyInfo& dependency) const noexcept;
+    void pipeline_barrier(std::span<const VkMemoryBarrier2> memory, std::span<const VkBufferMemoryBarrier2> buffers,
+                          std::span<const VkImageMemoryBarrier2> images, VkDependencyFlags flags = 0) const noexcept;
+    void set_event(const Event& event, const VkDependencyInfo& dependency) const noexcept;
+    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const noexcept;
+
+    // Secondaries: any number, passed to Vulkan in chunks from the stack.
+    void execute_commands(std::span<const CommandBuffer> secondaries) const noexcept;
+
+    // Queries
+    void reset_query_pool(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count) const noexcept;
+    void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool, std::uint32_t query) const noexcept;
+
+private:
+    friend class CommandPool;
+    using Handle::Handle;
+};
+
+// An image barrier over every mip level and layer of one aspect.
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
+                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                    VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
+// A global memory barrier.
+VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept;
+
+// A semaphore to wait on or signal in a submission (VkSemaphoreSubmitInfo);
+// value is ignored for binary semaphores.
+struct SemaphoreSubmit {
+    SemaphoreSubmit(const Semaphore& s, std::uint64_t v = 0,
+                    VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) noexcept
+        : semaphore(s.vk()), value(v), stage_mask(stages) {}
+    VkSemaphore semaphore;
+    std::uint64_t value;
+    VkPipelineStageFlags2 stage_mask;
+};
+
+// One batch of a submission (VkSubmitInfo2).
+struct SubmitBatch {
+    std::span<const SemaphoreSubmit> waits;
+    std::span<const CommandBuffer> command_buffers;
+    std::span<const SemaphoreSubmit> signals;
+};
+
+// Limits of one submit() call, whose Vulkan structures are built on the stack.
+struct SubmitLimits {
+    static constexpr std::size_t batches = 16;
+    static constexpr std::size_t semaphores = 32;       // waits and signals, each, over all batches
+    static constexpr std::size_t command_buffers = 128;  // over all batches
+};
+
+// Queue::submit with typed batches; the fence (if any) signals when all are
+// done. No heap allocation; throws UsageError beyond SubmitLimits.
+void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence = {});
+void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence = {});
+
+namespace detail {
+
+class CommandPoolState final : public RefCounted {
+public:
+    ~CommandPoolState() override;
+    // Under mutex: frees the dropped command buffers the GPU is done with.
+    void free_completed();
+
+    Device device;
+    VkCommandPool pool = VK_NULL_HANDLE;
+    std::uint32_t queue_family_index = 0;
+    mutable Mutex mutex;
+    PoolFreeList<VkCommandBuffer> pending;  // under mutex
+    std::vector<VkCommandBuffer> scratch;   // under mutex
+};
+
+class CommandBufferState final : public RefCounted {
+public:
+    ~CommandBufferState() override;
+    // First, so that recording reads them from the start of the block.
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    const DeviceFunctions* fn = nullptr;
+    CommandPool pool;
+    VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+};
+
+}  // namespace detail
+
+inline VkCommandPool CommandPool::vk() const noexcept { return state_->pool; }
+inline const Device& CommandPool::device() const noexcept { return state_->device; }
+inline std::uint32_t CommandPool::queue_family_index() const noexcept { return state_->queue_family_index; }
+
+inline VkCommandBuffer CommandBuffer::vk() const noexcept { return state_->cmd; }
+inline const DeviceFunctions& CommandBuffer::fn() const noexcept { return *state_->fn; }
+inline const CommandPool& CommandBuffer::pool() const noexcept { return state_->pool; }
+inline VkCommandBufferLevel CommandBuffer::level() const noexcept { return state_->level; }
+
+inline void CommandBuffer::begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer,
+                                             VkRect2D render_area, std::span<const VkClearValue> clear_values,
+                                             VkSubpassContents contents) const noexcept {
+    VkRenderPassBeginInfo info{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    info.renderPass = render_pass.vk();
+    info.framebuffer = framebuffer.vk();
+    info.renderArea = render_area;
+    info.clearValueCount = static_cast<std::uint32_t>(clear_values.size());
+    info.pClearValues = clear_values.data();
+    state_->fn->vkCmdBeginRenderPass(state_->cmd, &info, contents);
+}
+inline void CommandBuffer::next_subpass(VkSubpassContents contents) const noexcept {
+    state_->fn->vkCmdNextSubpass(state_->cmd, contents);
+}
+inline void CommandBuffer::end_render_pass() const noexcept { state_->fn->vkCmdEndRenderPass(state_->cmd); }
+
+inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const noexcept {
+    auto convert = [](const RenderingAttachment& a) {
+        VkRenderingAttachmentInfo r{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        r.imageView = a.image_view;
+        r.imageLayout = a.image_layout;
+        r.loadOp = a.load_op;
+        r.storeOp = a.store_op;
+        r.clearValue = a.clear_value;
+        return r;
+    };
+    VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
+    std::uint32_t count = 0;
+    for (const auto& a : info.color_attachments) {
+        if (count == RenderingInfo::max_color_attachments) break;
+        colors[count++] = convert(a);
+    }
+    VkRenderingAttachmentInfo depth, stencil;
+    VkRenderingInfo r{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    r.flags = info.flags;
+    r.renderArea = info.render_area;
+    r.layerCount = info.layer_count;
+    r.colorAttachmentCount = count;
+    r.pColorAttachments = colors;
+    if (info.depth_attachment) {
+        depth = convert(*info.depth_attachment);
+        r.pDepthAttachment = &depth;
+    }
+    if (info.stencil_attachment) {
+        stencil = convert(*info.stencil_attachment);
+        r.pStencilAttachment = &stencil;
+    }
+    state_->fn->vkCmdBeginRendering(state_->cmd, &r);
+}
+inline void CommandBuffer::end_rendering() const noexcept { state_->fn->vkCmdEndRendering(state_->cmd); }
+
+inline void CommandBuffer::bind_pipeline(const Pipeline& pipeline) const noexcept {
+    state_->fn->vkCmdBindPipeline(state_->cmd, pipeline.bind_point(), pipeline.vk());
+}
+inline void CommandBuffer::bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
+                                              VkDeviceSize offset) const noexcept {
+    state_->fn->vkCmdBindVertexBuffers(state_->cmd, binding, 1, &buffer, &offset);
+}
+inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
+                                               std::span<const VkDeviceSize> offsets) const noexcept {
+    state_->fn->vkCmdBindVertexBuffers(state_->cmd, first_binding, static_cast<std::uint32_t>(buffers.size()),
+                                       buffers.data(), offsets.data());
+}
+inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offset, VkIndexType type) const noexcept {
+    state_->fn->vkCmdBindIndexBuffer(state_->cmd, buffer, offset, type);
+}
+inline void CommandBuffer::bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index,
+                                               const DescriptorSet& set,
+                                               std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+    VkDescriptorSet raw = set.vk();
+    state_->fn->vkCmdBindDescriptorSets(state_->cmd, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
+                                        static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+}
+inline void CommandBuffer::bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set,
+                                                std::span<const VkDescriptorSet> sets,
+                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+    state_->fn->vkCmdBindDescriptorSets(state_->cmd, pipeline.bind_point(), pipeline.layout().vk(), first_set,
+                                        static_cast<std::uint32_t>(sets.size()), sets.data(),
+                                        static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+}
+inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShaderStageFlags stages,
+                                          std::uint32_t offset, std::uint32_t size, const void* data) const noexcept {
+    state_->fn->vkCmdPushConstants(state_->cmd, layout.vk(), stages, offset, size, data);
+}
+inline void CommandBuffer::set_viewport(const VkViewport& viewport) const noexcept {
+    state_->fn->vkCmdSetViewport(state_->cmd, 0, 1, &viewport);
+}
+inline void CommandBuffer::set_scissor(const VkRect2D& scissor) const noexcept {
+    state_->fn->vkCmdSetScissor(state_->cmd, 0, 1, &scissor);
+}
+inline void CommandBuffer::set_viewport_and_scissor(VkExtent2D extent) const noexcept {
+    set_viewport({0.0f, 0.0f, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0f, 1.0f});
+    set_scissor({{0, 0}, extent});
+}
+
+inline void CommandBuffer::draw(std::uint32_t vertex_count, std::uint32_t instance_count, std::uint32_t first_vertex,
+                                std::uint32_t first_instance) const noexcept {
+    state_->fn->vkCmdDraw(state_->cmd, vertex_count, instance_count, first_vertex, first_instance);
+}
+inline void CommandBuffer::draw_indexed(std::uint32_t index_count, std::uint32_t instance_count,
+                                        std::uint32_t first_index, std::int32_t vertex_offset,
+                                        std::uint32_t first_instance) const noexcept {
+    state_->fn->vkCmdDrawIndexed(state_->cmd, index_count, instance_count, first_index, vertex_offset, first_instance);
+}
+inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
+    state_->fn->vkCmdDispatch(state_->cmd, x, y, z);
+}
+inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const noexcept {
+    state_->fn->vkCmdCopyBuffer(state_->cmd, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
+}
+inline void CommandBuffer::copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
+                                                std::span<const VkBufferImageCopy> regions) const noexcept {
+    state_->fn->vkCmdCopyBufferToImage(state_->cmd, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                                       regions.data());
+}
+inline void CommandBuffer::copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
+                                                std::span<const VkBufferImageCopy> regions) const noexcept {
+    state_->fn->vkCmdCopyImageToBuffer(state_->cmd, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()),
+                                       regions.data());
+}
+inline void CommandBuffer::copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                                      std::span<const VkImageCopy> regions) const noexcept {
+    state_->fn->vkCmdCopyImage(state_->cmd, src, src_layout, dst, dst_layout,
+                               static_cast<std::uint32_t>(regions.size()), regions.data());
+}
+inline void CommandBuffer::fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
+                                       std::uint32_t data) const noexcept {
+    state_->fn->vkCmdFillBuffer(state_->cmd, dst, offset, size, data);
+}
+
+inline void CommandBuffer::pipeline_barrier(const VkDependencyInfo& dependency) const noexcept {
+    state_->fn->vkCmdPipelineBarrier2(state_->cmd, &dependency);
+}
+inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> memory,
+                                            std::span<const VkBufferMemoryBarrier2> buffers,
+                                            std::span<const VkImageMemoryBarrier2> images,
+                                            VkDependencyFlags flags) const noexcept {
+    VkDependencyInfo d{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    d.dependencyFlags = flags;
+    d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
+    d.pMemoryBarriers = memory.data();
+    d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+    d.pBufferMemoryBarriers = buffers.data();
+    d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+    d.pImageMemoryBarriers = images.data();
+    state_->fn->vkCmdPipelineBarrier2(state_->cmd, &d);
+}
+inline void CommandBuffer::set_event(const Event& event, const VkDependencyInfo& dependency) const noexcept {
+    state_->fn->vkCmdSetEvent2(state_->cmd, event.vk(), &dependency);
+}
+inline void CommandBuffer::reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const noexcept {
+    state_->fn->vkCmdResetEvent2(state_->cmd, event.vk(), stage_mask);
+}
+
+inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secondaries) const noexcept {
+    constexpr std::size_t chunk = 32;
+    VkCommandBuffer raw[chunk];
+    for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
+        std::uint32_t n = 0;
+        for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
+        state_->fn->vkCmdExecuteCommands(state_->cmd, n, raw);
+    }
+}
+
+inline void CommandBuffer::reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
+                                            std::uint32_t query_count) const noexcept {
+    state_->fn->vkCmdResetQueryPool(state_->cmd, pool.vk(), first_query, query_count);
+}
+inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
+                                           std::uint32_t query) const noexcept {
+    state_->fn->vkCmdWriteTimestamp2(state_->cmd, stage, pool.vk(), query);
+}
+
+VKRC_END_NAMESPACE

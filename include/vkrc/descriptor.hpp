@@ -1,0 +1,131 @@
+// Descriptor set layouts, descriptor pools and the sets they own.
+#pragma once
+
+#include "vkrc/detail/pool_free_list.hpp"
+
+#include <span>
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class DescriptorSetLayoutState;
+class DescriptorPoolState;
+class DescriptorSetState;
+}  // namespace detail
+
+// Mirrors VkDescriptorSetLayoutBinding (without immutable samplers).
+struct DescriptorSetLayoutBinding {
+    std::uint32_t binding = 0;
+    VkDescriptorType descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    std::uint32_t descriptor_count = 1;
+    VkShaderStageFlags stage_flags = VK_SHADER_STAGE_ALL;
+};
+
+// Mirrors VkDescriptorSetLayoutCreateInfo.
+struct DescriptorSetLayoutCreateInfo {
+    VkDescriptorSetLayoutCreateFlags flags = 0;
+    std::vector<DescriptorSetLayoutBinding> bindings;
+};
+
+class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
+public:
+    DescriptorSetLayout() noexcept = default;
+    static DescriptorSetLayout create(const Device& device, const DescriptorSetLayoutCreateInfo& info);
+    VkDescriptorSetLayout vk() const noexcept;
+    const Device& device() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkDescriptorPoolCreateInfo. With VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT
+// a dropped set returns to the pool once the GPU is done with it; without it
+// sets are reclaimed only by reset() or the pool's destruction.
+struct DescriptorPoolCreateInfo {
+    VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+    std::uint32_t max_sets = 0;
+    std::vector<VkDescriptorPoolSize> pool_sizes;
+};
+
+class DescriptorSet;
+
+// Externally synchronised like VkDescriptorPool: allocate() and reset() take
+// the pool's lock under the multi-thread policy.
+class DescriptorPool : public Handle<detail::DescriptorPoolState> {
+public:
+    DescriptorPool() noexcept = default;
+    static DescriptorPool create(const Device& device, const DescriptorPoolCreateInfo& info);
+
+    VkDescriptorPool vk() const noexcept;
+    const Device& device() const noexcept;
+    DescriptorSet allocate(const DescriptorSetLayout& layout) const;
+    // vkResetDescriptorPool: every set allocated from it becomes invalid (its
+    // handle may still be dropped). The caller ensures the GPU no longer uses them.
+    void reset_sets() const;
+    // Sets dropped while the GPU may use them, not yet returned to the pool.
+    std::size_t pending_free_count() const;
+
+private:
+    using Handle::Handle;
+};
+
+// A descriptor set; keeps its pool alive.
+class DescriptorSet : public Handle<detail::DescriptorSetState> {
+public:
+    DescriptorSet() noexcept = default;
+    VkDescriptorSet vk() const noexcept;
+    const DescriptorPool& pool() const noexcept;
+
+    // vkUpdateDescriptorSets with one buffer descriptor.
+    void write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset = 0,
+                      VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const;
+    // vkUpdateDescriptorSets with one image/sampler descriptor.
+    void write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
+                     VkSampler sampler = VK_NULL_HANDLE, std::uint32_t array_element = 0) const;
+
+private:
+    friend class DescriptorPool;
+    using Handle::Handle;
+};
+
+namespace detail {
+
+class DescriptorSetLayoutState final : public RefCounted {
+public:
+    ~DescriptorSetLayoutState() override;
+    Device device;
+    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+};
+
+class DescriptorPoolState final : public RefCounted {
+public:
+    ~DescriptorPoolState() override;
+    Device device;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    bool can_free_sets = false;
+    mutable Mutex mutex;
+    // Under mutex: sets dropped while in use, and how many resets happened
+    // (a set from before a reset is already gone).
+    PoolFreeList<VkDescriptorSet> pending;
+    std::uint64_t generation = 0;
+};
+
+class DescriptorSetState final : public RefCounted {
+public:
+    ~DescriptorSetState() override;
+    DescriptorPool pool;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    std::uint64_t generation = 0;
+};
+
+}  // namespace detail
+
+inline VkDescriptorSetLayout DescriptorSetLayout::vk() const noexcept { return state_->layout; }
+inline const Device& DescriptorSetLayout::device() const noexcept { return state_->device; }
+inline VkDescriptorPool DescriptorPool::vk() const noexcept { return state_->pool; }
+inline const Device& DescriptorPool::device() const noexcept { return state_->device; }
+inline VkDescriptorSet DescriptorSet::vk() const noexcept { return state_->set; }
+inline const DescriptorPool& DescriptorSet::pool() const noexcept { return state_->pool; }
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,59 @@
+// Deferred freeing of pool-owned handles (command buffers, descriptor sets).
+//
+// vkFreeCommandBuffers / vkFreeDescriptorSets need the pool alive and
+// externally synchronised, which a reference-free DeferredAction cannot
+// guarantee. So a dying child's handle goes onto its pool's list, tagged with
+// the values submitted so far on every queue; the pool frees the completed
+// ones under its own lock at its next allocate/reset/begin, and destroying the
+// pool (itself deferred) frees whatever is left.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include <deque>
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+namespace detail {
+
+template <class VkHandle>
+class PoolFreeList {
+public:
+    // Caller holds the pool's lock. Never throws: on allocation failure the
+    // handle is left to the pool's destruction, which frees it anyway.
+    void push(DeviceState& device, VkHandle handle) noexcept {
+        try {
+            device.submitted_snapshot(scratch_);
+            if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
+            batches_.back().handles.push_back(handle);
+        } catch (...) {
+        }
+    }
+    // Caller holds the pool's lock. Moves the handles whose GPU work has
+    // completed into out, in the order they were pushed.
+    void take_ready(DeviceState& device, std::vector<VkHandle>& out) {
+        while (!batches_.empty() && device.reached(batches_.front().wait_values)) {
+            auto& h = batches_.front().handles;
+            out.insert(out.end(), h.begin(), h.end());
+            batches_.pop_front();
+        }
+    }
+    bool empty() const noexcept { return batches_.empty(); }
+    std::size_t size() const noexcept {
+        std::size_t n = 0;
+        for (auto& b : batches_) n += b.handles.size();
+        return n;
+    }
+    void clear() noexcept { batches_.clear(); }
+
+private:
+    struct Batch {
+        std::vector<std::uint64_t> wait_values;
+        std::vector<VkHandle> handles;
+    };
+    std::deque<Batch> batches_;
+    std::vector<std::uint64_t> scratch_;
+};
+
+}  // namespace detail
+VKRC_END_NAMESPACE

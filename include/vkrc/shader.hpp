@@ -1,0 +1,44 @@
+// Shader modules from SPIR-V words (as vkrc_add_shaders embeds them) or files.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include <cstddef>
+#include <filesystem>
+#include <span>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class ShaderModuleState;
+}
+
+class ShaderModule : public Handle<detail::ShaderModuleState> {
+public:
+    ShaderModule() noexcept = default;
+    // Throws UsageError for an empty module or a wrong SPIR-V magic number.
+    static ShaderModule create(const Device& device, std::span<const std::uint32_t> spirv);
+    // Bytes of a .spv file; also rejects a size that is not a multiple of 4.
+    static ShaderModule create(const Device& device, std::span<const std::byte> spirv);
+    static ShaderModule load(const Device& device, const std::filesystem::path& spv_file);
+
+    VkShaderModule vk() const noexcept;
+    const Device& device() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+namespace detail {
+class ShaderModuleState final : public RefCounted {
+public:
+    ~ShaderModuleState() override;
+    Device device;
+    VkShaderModule module = VK_NULL_HANDLE;
+};
+}  // namespace detail
+
+inline VkShaderModule ShaderModule::vk() const noexcept { return state_->module; }
+inline const Device& ShaderModule::device() const noexcept { return state_->device; }
+
+VKRC_END_NAMESPACE

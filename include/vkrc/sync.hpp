@@ -1,0 +1,155 @@
+// Synchronisation objects: Fence, Semaphore (binary and timeline), Event, QueryPool.
+//
+// Waits return a VkResult: VK_TIMEOUT is a status to branch on, not an
+// exception. Every wait runs the device's completed deferred destructions.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include <span>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class FenceState;
+class SemaphoreState;
+class EventState;
+class QueryPoolState;
+}  // namespace detail
+
+inline constexpr std::uint64_t wait_forever = UINT64_MAX;
+
+class Fence : public Handle<detail::FenceState> {
+public:
+    Fence() noexcept = default;
+    // signaled: created in the signalled state (VK_FENCE_CREATE_SIGNALED_BIT).
+    static Fence create(const Device& device, bool signaled = false);
+    static Fence adopt(const Device& device, VkFence fence, Ownership ownership);
+
+    VkFence vk() const noexcept;
+    const Device& device() const noexcept;
+    // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
+    VkResult wait(std::uint64_t timeout_ns = wait_forever) const;
+    // vkGetFenceStatus: VK_SUCCESS (signalled) or VK_NOT_READY.
+    VkResult status() const;
+    // vkResetFences (reset() drops the handle, as on every handle).
+    void unsignal() const;
+
+private:
+    using Handle::Handle;
+};
+
+enum class SemaphoreType : std::uint8_t { binary, timeline };
+
+class Semaphore : public Handle<detail::SemaphoreState> {
+public:
+    Semaphore() noexcept = default;
+    static Semaphore create_binary(const Device& device);
+    static Semaphore create_timeline(const Device& device, std::uint64_t initial_value = 0);
+    static Semaphore adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership);
+
+    VkSemaphore vk() const noexcept;
+    SemaphoreType type() const noexcept;
+    const Device& device() const noexcept;
+
+    // Timeline semaphores only (UsageError otherwise).
+    // vkGetSemaphoreCounterValue.
+    std::uint64_t value() const;
+    // vkSignalSemaphore from the host.
+    void signal(std::uint64_t value) const;
+    // vkWaitSemaphores: VK_SUCCESS once the value is reached, or VK_TIMEOUT.
+    VkResult wait(std::uint64_t value, std::uint64_t timeout_ns = wait_forever) const;
+
+private:
+    using Handle::Handle;
+};
+
+class Event : public Handle<detail::EventState> {
+public:
+    Event() noexcept = default;
+    // device_only: VK_EVENT_CREATE_DEVICE_ONLY_BIT (no host set/reset/status).
+    static Event create(const Device& device, bool device_only = false);
+
+    VkEvent vk() const noexcept;
+    // vkSetEvent / vkResetEvent (reset() drops the handle, as on every handle).
+    void set() const;
+    void unset() const;
+    // VK_EVENT_SET or VK_EVENT_RESET.
+    VkResult status() const;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkQueryPoolCreateInfo.
+struct QueryPoolCreateInfo {
+    VkQueryType query_type = VK_QUERY_TYPE_TIMESTAMP;
+    std::uint32_t query_count = 0;
+    VkQueryPipelineStatisticFlags pipeline_statistics = 0;
+};
+
+class QueryPool : public Handle<detail::QueryPoolState> {
+public:
+    QueryPool() noexcept = default;
+    static QueryPool create(const Device& device, const QueryPoolCreateInfo& info);
+
+    VkQueryPool vk() const noexcept;
+    std::uint32_t query_count() const noexcept;
+    // Reset queries before use with CommandBuffer::reset_query_pool.
+    // vkGetQueryPoolResults as 64-bit values into out (one per query, or
+    // stride_words per query). VK_NOT_READY when flags lack WAIT and some are not ready.
+    VkResult results(std::uint32_t first_query, std::span<std::uint64_t> out,
+                     VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
+    // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
+    double timestamp_period_ns() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+namespace detail {
+
+class FenceState final : public RefCounted {
+public:
+    ~FenceState() override;
+    Device device;
+    VkFence fence = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
+};
+
+class SemaphoreState final : public RefCounted {
+public:
+    ~SemaphoreState() override;
+    Device device;
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    SemaphoreType type = SemaphoreType::binary;
+    Ownership ownership = Ownership::owned;
+};
+
+class EventState final : public RefCounted {
+public:
+    ~EventState() override;
+    Device device;
+    VkEvent event = VK_NULL_HANDLE;
+};
+
+class QueryPoolState final : public RefCounted {
+public:
+    ~QueryPoolState() override;
+    Device device;
+    VkQueryPool pool = VK_NULL_HANDLE;
+    std::uint32_t count = 0;
+};
+
+}  // namespace detail
+
+inline VkFence Fence::vk() const noexcept { return state_->fence; }
+inline const Device& Fence::device() const noexcept { return state_->device; }
+inline VkSemaphore Semaphore::vk() const noexcept { return state_->semaphore; }
+inline SemaphoreType Semaphore::type() const noexcept { return state_->type; }
+inline const Device& Semaphore::device() const noexcept { return state_->device; }
+inline VkEvent Event::vk() const noexcept { return state_->event; }
+inline VkQueryPool QueryPool::vk() const noexcept { return state_->pool; }
+inline std::uint32_t QueryPool::query_count() const noexcept { return state_->count; }
+
+VKRC_END_NAMESPACE

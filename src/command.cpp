@@ -1,0 +1,207 @@
+#include "vkrc/command.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+CommandPoolState::~CommandPoolState() {
+    // Destroying the pool frees its command buffers, the pending ones included;
+    // it is deferred past the work submitted so far like any other object.
+    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool);
+}
+
+void CommandPoolState::free_completed() {
+    if (pending.empty()) return;
+    scratch.clear();
+    pending.take_ready(*device.state(), scratch);
+    if (!scratch.empty()) {
+        device.fn().vkFreeCommandBuffers(device.vk(), pool, static_cast<std::uint32_t>(scratch.size()), scratch.data());
+    }
+}
+
+CommandBufferState::~CommandBufferState() {
+    if (cmd == VK_NULL_HANDLE) return;
+    auto& p = *pool.state();
+    LockGuard lock(p.mutex);
+    p.pending.push(*p.device.state(), cmd);
+}
+
+}  // namespace detail
+
+CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::CommandPool::create: the Device handle is empty");
+    VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    ci.flags = info.flags;
+    ci.queueFamilyIndex = info.queue_family_index;
+    detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);
+    s->device = device;
+    s->queue_family_index = info.queue_family_index;
+    check(device.fn().vkCreateCommandPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateCommandPool");
+    return CommandPool(std::move(s));
+}
+
+CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
+    auto& p = *state_;
+    detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
+    s->fn = &p.device.fn();
+    s->pool = *this;
+    s->level = level;
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = p.pool;
+    ai.level = level;
+    ai.commandBufferCount = 1;
+    LockGuard lock(p.mutex);
+    p.free_completed();
+    check(p.device.fn().vkAllocateCommandBuffers(p.device.vk(), &ai, &s->cmd), "vkAllocateCommandBuffers");
+    return CommandBuffer(std::move(s));
+}
+
+void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
+    auto& p = *state_;
+    LockGuard lock(p.mutex);
+    p.free_completed();
+    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+}
+
+std::size_t CommandPool::pending_free_count() const {
+    LockGuard lock(state_->mutex);
+    return state_->pending.size();
+}
+
+namespace {
+void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& info) {
+    auto& p = *s.pool.state();
+    LockGuard lock(p.mutex);
+    p.free_completed();
+    check(s.fn->vkBeginCommandBuffer(s.cmd, &info), "vkBeginCommandBuffer");
+}
+}  // namespace
+
+void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
+    if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
+        throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
+    }
+    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    info.flags = flags;
+    begin_with(*state_, info);
+}
+
+void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance, VkCommandBufferUsageFlags flags) const {
+    if (state_->level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
+        throw UsageError("vkrc::CommandBuffer::begin_secondary: the command buffer is primary");
+    }
+    VkCommandBufferInheritanceRenderingInfo rendering{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO};
+    VkCommandBufferInheritanceInfo inherit{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
+    if (inheritance.render_pass) {
+        inherit.renderPass = inheritance.render_pass.vk();
+        inherit.subpass = inheritance.subpass;
+        inherit.framebuffer = inheritance.framebuffer ? inheritance.framebuffer.vk() : VK_NULL_HANDLE;
+        flags |= VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT;
+    } else if (!inheritance.color_formats.empty() || inheritance.depth_format != VK_FORMAT_UNDEFINED ||
+               inheritance.stencil_format != VK_FORMAT_UNDEFINED) {
+        rendering.colorAttachmentCount = static_cast<std::uint32_t>(inheritance.color_formats.size());
+        rendering.pColorAttachmentFormats = inheritance.color_formats.data();
+        rendering.depthAttachmentFormat = inheritance.depth_format;
+        rendering.stencilAttachmentFormat = inheritance.stencil_format;
+        rendering.rasterizationSamples = inheritance.rasterization_samples;
+        inherit.pNext = &rendering;
+        flags |= VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT;
+    }
+    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    info.flags = flags;
+    info.pInheritanceInfo = &inherit;
+    begin_with(*state_, info);
+}
+
+void CommandBuffer::end() const {
+    LockGuard lock(state_->pool.state()->mutex);
+    check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
+}
+
+void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
+    LockGuard lock(state_->pool.state()->mutex);
+    check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
+}
+
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
+                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                    VkImageAspectFlags aspect) noexcept {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    b.oldLayout = old_layout;
+    b.newLayout = new_layout;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+    return b;
+}
+
+VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
+    VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    return b;
+}
+
+void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence) {
+    if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
+    VkSubmitInfo2 infos[SubmitLimits::batches];
+    VkSemaphoreSubmitInfo waits[SubmitLimits::semaphores];
+    VkSemaphoreSubmitInfo signals[SubmitLimits::semaphores];
+    VkCommandBufferSubmitInfo cmds[SubmitLimits::command_buffers];
+    std::size_t n_waits = 0, n_signals = 0, n_cmds = 0;
+    if (batches.size() > SubmitLimits::batches) {
+        throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::batches) + " batches");
+    }
+    auto semaphore_info = [](const SemaphoreSubmit& s) {
+        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        i.semaphore = s.semaphore;
+        i.value = s.value;
+        i.stageMask = s.stage_mask;
+        return i;
+    };
+    for (std::size_t b = 0; b < batches.size(); ++b) {
+        const auto& batch = batches[b];
+        if (batch.waits.size() > SubmitLimits::semaphores - n_waits ||
+            batch.signals.size() > SubmitLimits::semaphores - n_signals) {
+            throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::semaphores) +
+                             " wait or signal semaphores");
+        }
+        if (batch.command_buffers.size() > SubmitLimits::command_buffers - n_cmds) {
+            throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::command_buffers) +
+                             " command buffers");
+        }
+        VkSubmitInfo2& info = infos[b];
+        info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
+        info.pWaitSemaphoreInfos = waits + n_waits;
+        for (const auto& w : batch.waits) waits[n_waits++] = semaphore_info(w);
+        info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
+        info.pSignalSemaphoreInfos = signals + n_signals;
+        for (const auto& s : batch.signals) signals[n_signals++] = semaphore_info(s);
+        info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
+        info.pCommandBufferInfos = cmds + n_cmds;
+        for (const auto& c : batch.command_buffers) {
+            if (!c) throw UsageError("vkrc::submit: a CommandBuffer handle is empty");
+            cmds[n_cmds] = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+            cmds[n_cmds++].commandBuffer = c.vk();
+        }
+    }
+    queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
+}
+
+void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
+    submit(queue, std::span<const SubmitBatch>(&batch, 1), fence);
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,126 @@
+#include "vkrc/descriptor.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+DescriptorSetLayoutState::~DescriptorSetLayoutState() {
+    defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout);
+}
+
+DescriptorPoolState::~DescriptorPoolState() {
+    // Destroying the pool frees every set still in it, pending ones included.
+    defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool);
+}
+
+DescriptorSetState::~DescriptorSetState() {
+    auto& p = *pool.state();
+    if (!p.can_free_sets || set == VK_NULL_HANDLE) return;
+    LockGuard lock(p.mutex);
+    if (p.generation == generation) p.pending.push(*p.device.state(), set);
+}
+
+}  // namespace detail
+
+DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::DescriptorSetLayout::create: the Device handle is empty");
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    bindings.reserve(info.bindings.size());
+    for (const auto& b : info.bindings) {
+        bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, nullptr});
+    }
+    VkDescriptorSetLayoutCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    ci.flags = info.flags;
+    ci.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    ci.pBindings = bindings.data();
+    detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
+    s->device = device;
+    check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->layout),
+          "vkCreateDescriptorSetLayout");
+    return DescriptorSetLayout(std::move(s));
+}
+
+DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPoolCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::DescriptorPool::create: the Device handle is empty");
+    if (info.max_sets == 0) throw UsageError("vkrc::DescriptorPool::create: max_sets is 0");
+    if (info.pool_sizes.empty()) throw UsageError("vkrc::DescriptorPool::create: pool_sizes is empty");
+    VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    ci.flags = info.flags;
+    ci.maxSets = info.max_sets;
+    ci.poolSizeCount = static_cast<std::uint32_t>(info.pool_sizes.size());
+    ci.pPoolSizes = info.pool_sizes.data();
+    detail::Ref<detail::DescriptorPoolState> s(new detail::DescriptorPoolState);
+    s->device = device;
+    s->can_free_sets = (info.flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
+    check(device.fn().vkCreateDescriptorPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateDescriptorPool");
+    return DescriptorPool(std::move(s));
+}
+
+DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout) const {
+    if (!layout) throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout handle is empty");
+    auto& p = *state_;
+    auto& d = *p.device.state();
+    detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
+    s->pool = *this;
+    VkDescriptorSetLayout raw_layout = layout.vk();
+    VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    ai.descriptorPool = p.pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &raw_layout;
+    thread_local std::vector<VkDescriptorSet> ready;
+    LockGuard lock(p.mutex);
+    ready.clear();
+    p.pending.take_ready(d, ready);
+    if (!ready.empty()) {
+        check(d.fn.vkFreeDescriptorSets(d.device, p.pool, static_cast<std::uint32_t>(ready.size()), ready.data()),
+              "vkFreeDescriptorSets");
+    }
+    check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->set), "vkAllocateDescriptorSets");
+    s->generation = p.generation;
+    return DescriptorSet(std::move(s));
+}
+
+void DescriptorPool::reset_sets() const {
+    auto& p = *state_;
+    LockGuard lock(p.mutex);
+    check(p.device.fn().vkResetDescriptorPool(p.device.vk(), p.pool, 0), "vkResetDescriptorPool");
+    p.pending.clear();
+    ++p.generation;
+}
+
+std::size_t DescriptorPool::pending_free_count() const {
+    LockGuard lock(state_->mutex);
+    return state_->pending.size();
+}
+
+void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
+                                 VkDeviceSize range, std::uint32_t array_element) const {
+    VkDescriptorBufferInfo bi{buffer, offset, range};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = state_->set;
+    w.dstBinding = binding;
+    w.dstArrayElement = array_element;
+    w.descriptorCount = 1;
+    w.descriptorType = type;
+    w.pBufferInfo = &bi;
+    const auto& d = state_->pool.device();
+    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+}
+
+void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
+                                VkSampler sampler, std::uint32_t array_element) const {
+    VkDescriptorImageInfo ii{sampler, view, layout};
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = state_->set;
+    w.dstBinding = binding;
+    w.dstArrayElement = array_element;
+    w.descriptorCount = 1;
+    w.descriptorType = type;
+    w.pImageInfo = &ii;
+    const auto& d = state_->pool.device();
+    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,357 @@
+#include "vkrc/pipeline.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <system_error>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+PipelineLayoutState::~PipelineLayoutState() {
+    defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout);
+}
+RenderPassState::~RenderPassState() {
+    defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass);
+}
+FramebufferState::~FramebufferState() {
+    defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer);
+}
+PipelineCacheState::~PipelineCacheState() {
+    defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache);
+}
+PipelineState::~PipelineState() {
+    defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline);
+}
+}  // namespace detail
+
+namespace {
+void require(bool ok, const char* who, const char* problem) {
+    if (!ok) throw UsageError(std::string(who) + ": " + problem);
+}
+}  // namespace
+
+PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
+    require(static_cast<bool>(device), "vkrc::PipelineLayout::create", "the Device handle is empty");
+    std::vector<VkDescriptorSetLayout> sets;
+    for (const auto& l : info.set_layouts) {
+        require(static_cast<bool>(l), "vkrc::PipelineLayout::create", "a DescriptorSetLayout handle is empty");
+        sets.push_back(l.vk());
+    }
+    VkPipelineLayoutCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    ci.setLayoutCount = static_cast<std::uint32_t>(sets.size());
+    ci.pSetLayouts = sets.data();
+    ci.pushConstantRangeCount = static_cast<std::uint32_t>(info.push_constant_ranges.size());
+    ci.pPushConstantRanges = info.push_constant_ranges.data();
+    detail::Ref<detail::PipelineLayoutState> s(new detail::PipelineLayoutState);
+    s->device = device;
+    check(device.fn().vkCreatePipelineLayout(device.vk(), &ci, nullptr, &s->layout), "vkCreatePipelineLayout");
+    return PipelineLayout(std::move(s));
+}
+
+RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& info) {
+    const char* who = "vkrc::RenderPass::create";
+    require(static_cast<bool>(device), who, "the Device handle is empty");
+    require(!info.subpasses.empty(), who, "subpasses is empty");
+    std::vector<VkSubpassDescription> subpasses;
+    std::vector<std::uint32_t> color_counts;
+    for (const auto& sp : info.subpasses) {
+        require(sp.resolve_attachments.empty() || sp.resolve_attachments.size() == sp.color_attachments.size(), who,
+                "resolve_attachments must be empty or one per colour attachment");
+        VkSubpassDescription d{};
+        d.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+        d.inputAttachmentCount = static_cast<std::uint32_t>(sp.input_attachments.size());
+        d.pInputAttachments = sp.input_attachments.data();
+        d.colorAttachmentCount = static_cast<std::uint32_t>(sp.color_attachments.size());
+        d.pColorAttachments = sp.color_attachments.data();
+        d.pResolveAttachments = sp.resolve_attachments.empty() ? nullptr : sp.resolve_attachments.data();
+        d.pDepthStencilAttachment = sp.depth_stencil_attachment ? &*sp.depth_stencil_attachment : nullptr;
+        d.preserveAttachmentCount = static_cast<std::uint32_t>(sp.preserve_attachments.size());
+        d.pPreserveAttachments = sp.preserve_attachments.data();
+        subpasses.push_back(d);
+        color_counts.push_back(d.colorAttachmentCount);
+    }
+    VkRenderPassCreateInfo ci{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ci.attachmentCount = static_cast<std::uint32_t>(info.attachments.size());
+    ci.pAttachments = info.attachments.data();
+    ci.subpassCount = static_cast<std::uint32_t>(subpasses.size());
+    ci.pSubpasses = subpasses.data();
+    ci.dependencyCount = static_cast<std::uint32_t>(info.dependencies.size());
+    ci.pDependencies = info.dependencies.data();
+    detail::Ref<detail::RenderPassState> s(new detail::RenderPassState);
+    s->device = device;
+    s->color_counts = std::move(color_counts);
+    check(device.fn().vkCreateRenderPass(device.vk(), &ci, nullptr, &s->render_pass), "vkCreateRenderPass");
+    return RenderPass(std::move(s));
+}
+
+std::uint32_t RenderPass::color_attachment_count(std::uint32_t subpass) const {
+    require(subpass < state_->color_counts.size(), "vkrc::RenderPass::color_attachment_count",
+            "the subpass does not exist");
+    return state_->color_counts[subpass];
+}
+
+Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInfo& info) {
+    const char* who = "vkrc::Framebuffer::create";
+    require(static_cast<bool>(device), who, "the Device handle is empty");
+    require(static_cast<bool>(info.render_pass), who, "render_pass is empty");
+    require(info.width > 0 && info.height > 0 && info.layers > 0, who, "width, height and layers must be non-zero");
+    VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    ci.renderPass = info.render_pass.vk();
+    ci.attachmentCount = static_cast<std::uint32_t>(info.attachments.size());
+    ci.pAttachments = info.attachments.data();
+    ci.width = info.width;
+    ci.height = info.height;
+    ci.layers = info.layers;
+    detail::Ref<detail::FramebufferState> s(new detail::FramebufferState);
+    s->render_pass = info.render_pass;
+    s->extent = {info.width, info.height};
+    check(device.fn().vkCreateFramebuffer(device.vk(), &ci, nullptr, &s->framebuffer), "vkCreateFramebuffer");
+    return Framebuffer(std::move(s));
+}
+
+// Pipeline caches
+
+PipelineCache PipelineCache::create(const Device& device, std::span<const std::byte> initial_data) {
+    require(static_cast<bool>(device), "vkrc::PipelineCache::create", "the Device handle is empty");
+    VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+    ci.initialDataSize = initial_data.size();
+    ci.pInitialData = initial_data.data();
+    detail::Ref<detail::PipelineCacheState> s(new detail::PipelineCacheState);
+    s->device = device;
+    check(device.fn().vkCreatePipelineCache(device.vk(), &ci, nullptr, &s->cache), "vkCreatePipelineCache");
+    s->loaded_from_file = !initial_data.empty();
+    return PipelineCache(std::move(s));
+}
+
+namespace {
+// Why data cannot prime a cache on this device, or nullptr when it can. Drivers
+// are meant to reject foreign data themselves; checking the header first keeps
+// a buggy driver from ever seeing it.
+const char* cache_data_problem(const PhysicalDevice& physical, const std::vector<std::byte>& data) {
+    VkPipelineCacheHeaderVersionOne header{};
+    if (data.size() < sizeof header) return "too short for a pipeline cache header";
+    std::memcpy(&header, data.data(), sizeof header);
+    const auto& p = physical.properties();
+    if (header.headerSize < sizeof header || header.headerSize > data.size()) return "corrupt header";
+    if (header.headerVersion != VK_PIPELINE_CACHE_HEADER_VERSION_ONE) return "unknown header version";
+    if (header.vendorID != p.vendorID || header.deviceID != p.deviceID ||
+        std::memcmp(header.pipelineCacheUUID, p.pipelineCacheUUID, VK_UUID_SIZE) != 0) {
+        return "written by another driver or device";
+    }
+    return nullptr;
+}
+}  // namespace
+
+PipelineCache PipelineCache::load(const Device& device, const std::filesystem::path& file) {
+    require(static_cast<bool>(device), "vkrc::PipelineCache::load", "the Device handle is empty");
+    std::vector<std::byte> data;
+    const char* problem = nullptr;
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+        problem = "cannot be opened";
+    } else {
+        std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        data.resize(bytes.size());
+        if (!bytes.empty()) std::memcpy(data.data(), bytes.data(), bytes.size());
+        problem = cache_data_problem(device.physical_device(), data);
+    }
+    if (problem) {
+        std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n",
+                     file.string().c_str(), problem);
+        return create(device);
+    }
+    return create(device, data);
+}
+
+std::vector<std::byte> PipelineCache::data() const {
+    const auto& d = state_->device;
+    std::size_t size = 0;
+    check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, nullptr), "vkGetPipelineCacheData");
+    std::vector<std::byte> out(size);
+    VkResult r = check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, out.data()), "vkGetPipelineCacheData");
+    out.resize(size);
+    (void)r;  // VK_INCOMPLETE only if the cache grew in between: the prefix is a valid cache
+    return out;
+}
+
+void PipelineCache::save(const std::filesystem::path& file) const {
+    auto bytes = data();
+    // Write beside the target and rename, so a crash never leaves a torn cache.
+    auto tmp = file;
+    tmp += ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+        if (!out) throw std::system_error(errno, std::generic_category(), "vkrc::PipelineCache::save: " + tmp.string());
+    }
+    std::filesystem::rename(tmp, file);
+}
+
+// Pipelines
+
+ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const ShaderModule& module,
+                                        const char* entry_point, const PipelineCache& cache) {
+    const char* who = "vkrc::ComputePipeline::create";
+    require(static_cast<bool>(layout), who, "the PipelineLayout handle is empty");
+    require(static_cast<bool>(module), who, "the ShaderModule handle is empty");
+    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    ci.stage.module = module.vk();
+    ci.stage.pName = entry_point;
+    ci.layout = layout.vk();
+    const auto& d = layout.device();
+    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
+    s->layout = layout;
+    s->bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
+    check(d.fn().vkCreateComputePipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->pipeline),
+          "vkCreateComputePipelines");
+    return ComputePipeline(std::move(s));
+}
+
+GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout) : layout_(std::move(layout)) {}
+
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
+                                                         const char* entry_point) {
+    stages_.push_back({stage, module, entry_point});
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::vertex_binding(std::uint32_t binding, std::uint32_t stride,
+                                                                 VkVertexInputRate input_rate) {
+    bindings_.push_back({binding, stride, input_rate});
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::vertex_attribute(std::uint32_t location, std::uint32_t binding,
+                                                                   VkFormat format, std::uint32_t offset) {
+    attributes_.push_back({location, binding, format, offset});
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::topology(VkPrimitiveTopology t) {
+    topology_ = t;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::polygon_mode(VkPolygonMode m) {
+    polygon_mode_ = m;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::cull_mode(VkCullModeFlags m) {
+    cull_mode_ = m;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::front_face(VkFrontFace f) {
+    front_face_ = f;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::depth_test(bool test, bool write, VkCompareOp compare) {
+    depth_test_ = test;
+    depth_write_ = write;
+    depth_compare_ = compare;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend(const VkPipelineColorBlendAttachmentState& state) {
+    blend_ = state;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::samples(VkSampleCountFlagBits s) {
+    samples_ = s;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_state(VkDynamicState state) {
+    dynamic_states_.push_back(state);
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::render_pass(const RenderPass& rp, std::uint32_t subpass) {
+    render_pass_ = rp;
+    subpass_ = subpass;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(std::span<const VkFormat> color_formats,
+                                                            VkFormat depth_format, VkFormat stencil_format) {
+    color_formats_.assign(color_formats.begin(), color_formats.end());
+    depth_format_ = depth_format;
+    stencil_format_ = stencil_format;
+    return *this;
+}
+
+GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) const {
+    const char* who = "vkrc::GraphicsPipelineBuilder::build";
+    require(static_cast<bool>(layout_), who, "the PipelineLayout handle is empty");
+    require(!stages_.empty(), who, "no shader stages");
+    std::vector<VkPipelineShaderStageCreateInfo> stages;
+    for (const auto& st : stages_) {
+        require(static_cast<bool>(st.module), who, "a ShaderModule handle is empty");
+        VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+        si.stage = st.stage;
+        si.module = st.module.vk();
+        si.pName = st.entry_point;
+        stages.push_back(si);
+    }
+    VkPipelineVertexInputStateCreateInfo vertex{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    vertex.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings_.size());
+    vertex.pVertexBindingDescriptions = bindings_.data();
+    vertex.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attributes_.size());
+    vertex.pVertexAttributeDescriptions = attributes_.data();
+    VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = topology_;
+    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = polygon_mode_;
+    raster.cullMode = cull_mode_;
+    raster.frontFace = front_face_;
+    raster.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    multisample.rasterizationSamples = samples_;
+    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+    depth.depthTestEnable = depth_test_ ? VK_TRUE : VK_FALSE;
+    depth.depthWriteEnable = depth_write_ ? VK_TRUE : VK_FALSE;
+    depth.depthCompareOp = depth_compare_;
+    depth.maxDepthBounds = 1.0f;
+
+    std::uint32_t color_count = 0;
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    if (render_pass_) {
+        color_count = render_pass_.color_attachment_count(subpass_);
+    } else {
+        color_count = static_cast<std::uint32_t>(color_formats_.size());
+        rendering.colorAttachmentCount = color_count;
+        rendering.pColorAttachmentFormats = color_formats_.data();
+        rendering.depthAttachmentFormat = depth_format_;
+        rendering.stencilAttachmentFormat = stencil_format_;
+    }
+    std::vector<VkPipelineColorBlendAttachmentState> blends(color_count, blend_);
+    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    blend.attachmentCount = color_count;
+    blend.pAttachments = blends.data();
+    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states_.size());
+    dynamic.pDynamicStates = dynamic_states_.data();
+
+    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    ci.pNext = render_pass_ ? nullptr : &rendering;
+    ci.stageCount = static_cast<std::uint32_t>(stages.size());
+    ci.pStages = stages.data();
+    ci.pVertexInputState = &vertex;
+    ci.pInputAssemblyState = &assembly;
+    ci.pViewportState = &viewport;
+    ci.pRasterizationState = &raster;
+    ci.pMultisampleState = &multisample;
+    ci.pDepthStencilState = &depth;
+    ci.pColorBlendState = &blend;
+    ci.pDynamicState = &dynamic;
+    ci.layout = layout_.vk();
+    ci.renderPass = render_pass_ ? render_pass_.vk() : VK_NULL_HANDLE;
+    ci.subpass = subpass_;
+    const auto& d = layout_.device();
+    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
+    s->layout = layout_;
+    s->bind_point = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    check(d.fn().vkCreateGraphicsPipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->pipeline),
+          "vkCreateGraphicsPipelines");
+    return GraphicsPipeline(std::move(s));
+}
+
+VKRC_END_NAMESPACE

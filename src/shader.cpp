@@ -1,0 +1,71 @@
+#include "vkrc/shader.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <fstream>
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+ShaderModuleState::~ShaderModuleState() {
+    defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module);
+}
+}  // namespace detail
+
+namespace {
+constexpr std::uint32_t spirv_magic = 0x07230203;
+
+void make(const Device& device, const void* code, std::size_t bytes, const char* who,
+                  detail::Ref<detail::ShaderModuleState>& s) {
+    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    if (bytes == 0) throw UsageError(std::string(who) + ": the SPIR-V module is empty");
+    if (bytes % 4 != 0) {
+        throw UsageError(std::string(who) + ": the SPIR-V size (" + std::to_string(bytes) +
+                         " bytes) is not a multiple of 4");
+    }
+    std::uint32_t magic = 0;
+    std::memcpy(&magic, code, 4);
+    if (magic != spirv_magic) {
+        char hex[16];
+        std::snprintf(hex, sizeof hex, "0x%08x", magic);
+        throw UsageError(std::string(who) + ": not SPIR-V (magic number " + hex + ", expected 0x07230203)");
+    }
+    VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    info.codeSize = bytes;
+    info.pCode = static_cast<const std::uint32_t*>(code);
+    s = detail::Ref<detail::ShaderModuleState>(new detail::ShaderModuleState);
+    s->device = device;
+    check(device.fn().vkCreateShaderModule(device.vk(), &info, nullptr, &s->module), "vkCreateShaderModule");
+
+}
+}  // namespace
+
+ShaderModule ShaderModule::create(const Device& device, std::span<const std::uint32_t> spirv) {
+    detail::Ref<detail::ShaderModuleState> s;
+    make(device, spirv.data(), spirv.size_bytes(), "vkrc::ShaderModule::create", s);
+    return ShaderModule(std::move(s));
+}
+
+ShaderModule ShaderModule::create(const Device& device, std::span<const std::byte> spirv) {
+    // Vulkan wants 4-byte-aligned words; bytes from anywhere are copied into them.
+    std::vector<std::uint32_t> words((spirv.size() + 3) / 4);
+    if (!spirv.empty()) std::memcpy(words.data(), spirv.data(), spirv.size());
+    detail::Ref<detail::ShaderModuleState> s;
+    make(device, words.data(), spirv.size(), "vkrc::ShaderModule::create", s);
+    return ShaderModule(std::move(s));
+}
+
+ShaderModule ShaderModule::load(const Device& device, const std::filesystem::path& spv_file) {
+    std::ifstream in(spv_file, std::ios::binary);
+    if (!in) throw UsageError("vkrc::ShaderModule::load: cannot open " + spv_file.string());
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<std::uint32_t> words((bytes.size() + 3) / 4);
+    if (!bytes.empty()) std::memcpy(words.data(), bytes.data(), bytes.size());
+    detail::Ref<detail::ShaderModuleState> s;
+    make(device, words.data(), bytes.size(), ("vkrc::ShaderModule::load: " + spv_file.string()).c_str(), s);
+    return ShaderModule(std::move(s));
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,192 @@
+#include "vkrc/sync.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace {
+void require_device(const Device& device, const char* who) {
+    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+}
+// Records device loss and runs completed deferred destructions after a wait.
+VkResult after_wait(const Device& device, VkResult r, const char* call) {
+    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
+    device.collect_garbage();
+    return check(r, call);
+}
+}  // namespace
+
+namespace detail {
+FenceState::~FenceState() {
+    if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence);
+}
+SemaphoreState::~SemaphoreState() {
+    if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore);
+}
+EventState::~EventState() { defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event); }
+QueryPoolState::~QueryPoolState() { defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool); }
+}  // namespace detail
+
+Fence Fence::create(const Device& device, bool signaled) {
+    require_device(device, "vkrc::Fence::create");
+    VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    if (signaled) info.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+    detail::Ref<detail::FenceState> s(new detail::FenceState);
+    s->device = device;
+    check(device.fn().vkCreateFence(device.vk(), &info, nullptr, &s->fence), "vkCreateFence");
+    return Fence(std::move(s));
+}
+
+Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
+    require_device(device, "vkrc::Fence::adopt");
+    if (fence == VK_NULL_HANDLE) throw UsageError("vkrc::Fence::adopt: the VkFence is VK_NULL_HANDLE");
+    detail::Ref<detail::FenceState> s(new detail::FenceState);
+    s->device = device;
+    s->fence = fence;
+    s->ownership = ownership;
+    return Fence(std::move(s));
+}
+
+VkResult Fence::wait(std::uint64_t timeout_ns) const {
+    const auto& d = state_->device;
+    VkResult r = d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns);
+    return after_wait(d, r, "vkWaitForFences");
+}
+
+VkResult Fence::status() const {
+    const auto& d = state_->device;
+    return after_wait(d, d.fn().vkGetFenceStatus(d.vk(), state_->fence), "vkGetFenceStatus");
+}
+
+void Fence::unsignal() const {
+    const auto& d = state_->device;
+    check(d.fn().vkResetFences(d.vk(), 1, &state_->fence), "vkResetFences");
+}
+
+namespace {
+void make_semaphore(const Device& device, SemaphoreType type, std::uint64_t initial,
+                         detail::Ref<detail::SemaphoreState>& s) {
+    VkSemaphoreTypeCreateInfo type_info{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
+    type_info.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
+    type_info.initialValue = initial;
+    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    if (type == SemaphoreType::timeline) info.pNext = &type_info;
+    s->device = device;
+    s->type = type;
+    check(device.fn().vkCreateSemaphore(device.vk(), &info, nullptr, &s->semaphore), "vkCreateSemaphore");
+}
+}  // namespace
+
+Semaphore Semaphore::create_binary(const Device& device) {
+    require_device(device, "vkrc::Semaphore::create_binary");
+    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
+    make_semaphore(device, SemaphoreType::binary, 0, s);
+    return Semaphore(std::move(s));
+}
+
+Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial_value) {
+    require_device(device, "vkrc::Semaphore::create_timeline");
+    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
+    make_semaphore(device, SemaphoreType::timeline, initial_value, s);
+    return Semaphore(std::move(s));
+}
+
+Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership) {
+    require_device(device, "vkrc::Semaphore::adopt");
+    if (semaphore == VK_NULL_HANDLE) throw UsageError("vkrc::Semaphore::adopt: the VkSemaphore is VK_NULL_HANDLE");
+    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
+    s->device = device;
+    s->semaphore = semaphore;
+    s->type = type;
+    s->ownership = ownership;
+    return Semaphore(std::move(s));
+}
+
+namespace {
+void require_timeline(const Semaphore& s, const char* who) {
+    if (s.type() != SemaphoreType::timeline) throw UsageError(std::string(who) + ": the semaphore is binary, not timeline");
+}
+}  // namespace
+
+std::uint64_t Semaphore::value() const {
+    require_timeline(*this, "vkrc::Semaphore::value");
+    const auto& d = state_->device;
+    std::uint64_t v = 0;
+    after_wait(d, d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->semaphore, &v), "vkGetSemaphoreCounterValue");
+    return v;
+}
+
+void Semaphore::signal(std::uint64_t value) const {
+    require_timeline(*this, "vkrc::Semaphore::signal");
+    const auto& d = state_->device;
+    VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
+    info.semaphore = state_->semaphore;
+    info.value = value;
+    check(d.fn().vkSignalSemaphore(d.vk(), &info), "vkSignalSemaphore");
+}
+
+VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
+    require_timeline(*this, "vkrc::Semaphore::wait");
+    const auto& d = state_->device;
+    VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    info.semaphoreCount = 1;
+    info.pSemaphores = &state_->semaphore;
+    info.pValues = &value;
+    return after_wait(d, d.fn().vkWaitSemaphores(d.vk(), &info, timeout_ns), "vkWaitSemaphores");
+}
+
+Event Event::create(const Device& device, bool device_only) {
+    require_device(device, "vkrc::Event::create");
+    VkEventCreateInfo info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+    if (device_only) info.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
+    detail::Ref<detail::EventState> s(new detail::EventState);
+    s->device = device;
+    check(device.fn().vkCreateEvent(device.vk(), &info, nullptr, &s->event), "vkCreateEvent");
+    return Event(std::move(s));
+}
+
+void Event::set() const {
+    const auto& d = state_->device;
+    check(d.fn().vkSetEvent(d.vk(), state_->event), "vkSetEvent");
+}
+void Event::unset() const {
+    const auto& d = state_->device;
+    check(d.fn().vkResetEvent(d.vk(), state_->event), "vkResetEvent");
+}
+VkResult Event::status() const {
+    const auto& d = state_->device;
+    return check(d.fn().vkGetEventStatus(d.vk(), state_->event), "vkGetEventStatus");
+}
+
+QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& info) {
+    require_device(device, "vkrc::QueryPool::create");
+    if (info.query_count == 0) throw UsageError("vkrc::QueryPool::create: query_count is 0");
+    VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    ci.queryType = info.query_type;
+    ci.queryCount = info.query_count;
+    ci.pipelineStatistics = info.pipeline_statistics;
+    detail::Ref<detail::QueryPoolState> s(new detail::QueryPoolState);
+    s->device = device;
+    s->count = info.query_count;
+    check(device.fn().vkCreateQueryPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateQueryPool");
+    return QueryPool(std::move(s));
+}
+
+VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> out, VkQueryResultFlags flags,
+                            std::uint32_t stride_words) const {
+    if (stride_words == 0) throw UsageError("vkrc::QueryPool::results: stride_words is 0");
+    const std::size_t count = out.size() / stride_words;
+    if (first_query > state_->count || count > state_->count - first_query) {
+        throw UsageError("vkrc::QueryPool::results: queries " + std::to_string(first_query) + "+" +
+                         std::to_string(count) + " exceed the pool's " + std::to_string(state_->count));
+    }
+    const auto& d = state_->device;
+    VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->pool, first_query, static_cast<std::uint32_t>(count),
+                                              out.size_bytes(), out.data(), stride_words * sizeof(std::uint64_t),
+                                              flags | VK_QUERY_RESULT_64_BIT);
+    return after_wait(d, r, "vkGetQueryPoolResults");
+}
+
+double QueryPool::timestamp_period_ns() const noexcept {
+    return state_->device.physical_device().properties().limits.timestampPeriod;
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,166 @@
+#include "support/vk_test.hpp"
+
+#include "shaders/fill_pattern.comp.h"
+
+#include <thread>
+#include <vector>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+TEST_F(VulkanTest, CommandBufferKeepsItsPoolAlive) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    EXPECT_EQ(cmd.level(), VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    EXPECT_EQ(pool.use_count(), 2u);
+    pool.reset_commands();
+    EXPECT_TRUE(cmd.pool());
+    cmd.begin();
+    cmd.end();
+    cmd.reset_commands();
+    cmd.begin(VK_COMMAND_BUFFER_USAGE_SIMULTANEOUS_USE_BIT);
+    cmd.end();
+    // Nothing was submitted, so the command buffer is freed at the next allocate.
+    cmd.reset();
+    EXPECT_EQ(pool.pending_free_count(), 1u);
+    auto next = pool.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+    EXPECT_THROW(next.begin(), vkrc::UsageError);
+}
+
+// Everything is dropped while the GPU is held back by a timeline wait that
+// only the host can release: nothing may be destroyed before it completes.
+TEST_F(VulkanTest, DroppingEverythingAfterSubmitDefersDestruction) {
+    auto gate = vkrc::Semaphore::create_timeline(device, 0);
+    auto fence = vkrc::Fence::create(device);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    {
+        auto set_layout = vkrc::DescriptorSetLayout::create(
+            device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                   .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+        auto layout = vkrc::PipelineLayout::create(
+            device, {.set_layouts = {set_layout},
+                     .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
+        auto descriptors = vkrc::DescriptorPool::create(
+            device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
+        auto set = descriptors.allocate(set_layout);
+        auto pipeline = vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        auto cmd = pool.allocate();
+        cmd.begin();
+        cmd.bind_pipeline(pipeline);
+        cmd.bind_descriptor_set(pipeline, 0, set);
+        cmd.end();  // nothing dispatched: the set needs no buffer written
+        vkrc::SemaphoreSubmit wait{gate, 1};
+        vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, fence);
+        // Every handle goes out of scope here, right after the submit.
+    }
+    EXPECT_EQ(pool.pending_free_count(), 1u);
+    // Set layout, pipeline layout, descriptor pool, pipeline (the shader module
+    // went before the submit, when nothing was pending).
+    EXPECT_EQ(device.deferred_count(), 4u);
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    gate.signal(1);
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);  // a wait collects what completed
+    EXPECT_EQ(device.deferred_count(), 0u);
+    auto cmd = pool.allocate();  // frees the dropped command buffer
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+}
+
+// A descriptor pool without FREE_DESCRIPTOR_SET_BIT reclaims sets only by reset.
+TEST_F(VulkanTest, DescriptorSetsOfAPoolWithoutFreeBit) {
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+    auto pool = vkrc::DescriptorPool::create(
+        device, {.flags = 0, .max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto set = pool.allocate(set_layout);
+    set.reset();
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+    pool.reset_sets();
+    auto again = pool.allocate(set_layout);
+    EXPECT_TRUE(again.pool() == pool);
+    pool.reset_sets();
+    again.reset();  // a set from before a reset is already gone: nothing to free
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+}
+
+TEST_F(VulkanTest, FreedDescriptorSetsReturnToTheirPool) {
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+    auto pool = vkrc::DescriptorPool::create(
+        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    // A pool of one set serves any number of allocate/drop rounds.
+    for (int i = 0; i < 4; ++i) {
+        auto set = pool.allocate(set_layout);
+        EXPECT_NE(set.vk(), VK_NULL_HANDLE);
+    }
+}
+
+// Secondaries recorded in parallel, one pool per thread, executed by one
+// primary. Under the multi-thread policy they are also dropped on their threads.
+TEST_F(VulkanTest, SecondariesFromFourThreads) {
+    constexpr int threads = 4;
+    constexpr std::uint32_t per_thread = 2;
+    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE) GTEST_SKIP();
+    auto queries = vkrc::QueryPool::create(device, {.query_count = threads * per_thread});
+    std::vector<vkrc::CommandPool> pools;
+    for (int t = 0; t < threads; ++t) {
+        pools.push_back(vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}));
+    }
+    std::vector<vkrc::CommandBuffer> secondaries(threads);
+    auto record = [&](int t) {
+        auto cmd = pools[t].allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        cmd.begin_secondary();
+        std::uint32_t first = static_cast<std::uint32_t>(t) * per_thread;
+        for (std::uint32_t q = first; q < first + per_thread; ++q) {
+            cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries, q);
+        }
+        cmd.end();
+        secondaries[t] = std::move(cmd);
+    };
+#if VKRC_IS_MULTI_THREAD
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) workers.emplace_back(record, t);
+    for (auto& w : workers) w.join();
+#else
+    for (int t = 0; t < threads; ++t) record(t);
+#endif
+    auto primary_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto primary = primary_pool.allocate();
+    primary.begin();
+    primary.reset_query_pool(queries, 0, threads * per_thread);
+    primary.execute_commands(secondaries);
+    primary.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&primary, 1)}, fence);
+#if VKRC_IS_MULTI_THREAD
+    // Each thread drops its secondary while the GPU may still run it.
+    std::vector<std::thread> droppers;
+    for (int t = 0; t < threads; ++t) droppers.emplace_back([&, t] { secondaries[t].reset(); });
+    for (auto& d : droppers) d.join();
+#else
+    secondaries.clear();
+#endif
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    std::vector<std::uint64_t> ticks(threads * per_thread);
+    ASSERT_EQ(queries.results(0, ticks), VK_SUCCESS);
+    for (auto t : ticks) EXPECT_GT(t, 0u);
+    // The next round of recording frees the dropped secondaries.
+    for (auto& p : pools) {
+        auto cmd = p.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        EXPECT_EQ(p.pending_free_count(), 0u);
+    }
+}
+
+TEST_F(VulkanTest, SubmitLimitsAreUsageErrors) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    std::vector<vkrc::CommandBuffer> many(vkrc::SubmitLimits::command_buffers + 1, pool.allocate());
+    try {
+        vkrc::submit(queue, {.command_buffers = many});
+        FAIL() << "no UsageError";
+    } catch (const vkrc::UsageError& e) {
+        EXPECT_STREQ(e.what(), "vkrc::submit: more than 128 command buffers");
+    }
+}
+
+}  // namespace

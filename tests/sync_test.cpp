@@ -1,0 +1,126 @@
+#include "support/vk_test.hpp"
+
+#include <chrono>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+vkrc::CommandBuffer empty_commands(const vkrc::CommandPool& pool) {
+    auto cmd = pool.allocate();
+    cmd.begin();
+    cmd.end();
+    return cmd;
+}
+
+TEST_F(VulkanTest, FenceTimeoutIsAStatusNotAnException) {
+    auto fence = vkrc::Fence::create(device);
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    EXPECT_EQ(fence.wait(1'000'000), VK_TIMEOUT);  // nothing will ever signal it
+    auto signaled = vkrc::Fence::create(device, true);
+    EXPECT_EQ(signaled.wait(0), VK_SUCCESS);
+    signaled.unsignal();
+    EXPECT_EQ(signaled.wait(0), VK_TIMEOUT);
+}
+
+TEST_F(VulkanTest, FenceSignalsWhenSubmittedWorkCompletes) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = empty_commands(pool);
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(fence.status(), VK_SUCCESS);
+}
+
+// The second submission waits on a value only the first one signals, and the
+// first waits on a value only the host signals: neither may complete before.
+TEST_F(VulkanTest, TimelineSemaphoreOrdersTwoSubmissions) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto timeline = vkrc::Semaphore::create_timeline(device, 0);
+    EXPECT_EQ(timeline.type(), vkrc::SemaphoreType::timeline);
+    auto first = empty_commands(pool);
+    auto second = empty_commands(pool);
+    auto second_done = vkrc::Fence::create(device);
+
+    vkrc::SemaphoreSubmit host_go{timeline, 1}, first_done{timeline, 2}, all_done{timeline, 3};
+    vkrc::submit(queue, {.waits = std::span(&host_go, 1), .command_buffers = std::span(&first, 1),
+                         .signals = std::span(&first_done, 1)});
+    vkrc::submit(queue,
+                 {.waits = std::span(&first_done, 1), .command_buffers = std::span(&second, 1),
+                  .signals = std::span(&all_done, 1)},
+                 second_done);
+    EXPECT_EQ(timeline.wait(2, 20'000'000), VK_TIMEOUT);
+    EXPECT_EQ(second_done.wait(1'000'000), VK_TIMEOUT);
+    EXPECT_EQ(timeline.value(), 0u);
+
+    timeline.signal(1);
+    EXPECT_EQ(second_done.wait(), VK_SUCCESS);
+    EXPECT_EQ(timeline.wait(3), VK_SUCCESS);
+    EXPECT_EQ(timeline.value(), 3u);
+}
+
+TEST_F(VulkanTest, TimelineSemaphoreHostSignalAndWait) {
+    auto timeline = vkrc::Semaphore::create_timeline(device, 5);
+    EXPECT_EQ(timeline.value(), 5u);
+    EXPECT_EQ(timeline.wait(6, 0), VK_TIMEOUT);
+    timeline.signal(6);
+    EXPECT_EQ(timeline.wait(6, 0), VK_SUCCESS);
+}
+
+TEST_F(VulkanTest, BinarySemaphoreRejectsTimelineCalls) {
+    auto binary = vkrc::Semaphore::create_binary(device);
+    EXPECT_EQ(binary.type(), vkrc::SemaphoreType::binary);
+    try {
+        binary.signal(1);
+        FAIL() << "signal on a binary semaphore did not throw";
+    } catch (const vkrc::UsageError& e) {
+        EXPECT_STREQ(e.what(), "vkrc::Semaphore::signal: the semaphore is binary, not timeline");
+    }
+    EXPECT_THROW((void)binary.value(), vkrc::UsageError);
+}
+
+TEST_F(VulkanTest, BinarySemaphoreChainsTwoSubmissions) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto binary = vkrc::Semaphore::create_binary(device);
+    auto a = empty_commands(pool);
+    auto b = empty_commands(pool);
+    auto fence = vkrc::Fence::create(device);
+    vkrc::SemaphoreSubmit s{binary};
+    vkrc::submit(queue, {.command_buffers = std::span(&a, 1), .signals = std::span(&s, 1)});
+    vkrc::submit(queue, {.waits = std::span(&s, 1), .command_buffers = std::span(&b, 1)}, fence);
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
+}
+
+TEST_F(VulkanTest, EventIsSetAndResetFromTheHost) {
+    auto event = vkrc::Event::create(device);
+    EXPECT_EQ(event.status(), VK_EVENT_RESET);
+    event.set();
+    EXPECT_EQ(event.status(), VK_EVENT_SET);
+    event.unset();
+    EXPECT_EQ(event.status(), VK_EVENT_RESET);
+}
+
+TEST_F(VulkanTest, TimestampsAreWrittenInOrder) {
+    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE) GTEST_SKIP();
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto queries = vkrc::QueryPool::create(device, {.query_type = VK_QUERY_TYPE_TIMESTAMP, .query_count = 2});
+    EXPECT_EQ(queries.query_count(), 2u);
+    auto cmd = pool.allocate();
+    cmd.begin();
+    cmd.reset_query_pool(queries, 0, 2);
+    cmd.write_timestamp(VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT, queries, 0);
+    cmd.write_timestamp(VK_PIPELINE_STAGE_2_BOTTOM_OF_PIPE_BIT, queries, 1);
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    std::uint64_t ticks[2] = {};
+    ASSERT_EQ(queries.results(0, ticks), VK_SUCCESS);
+    EXPECT_GT(ticks[0], 0u);
+    EXPECT_GE(ticks[1], ticks[0]);
+    EXPECT_GT(queries.timestamp_period_ns(), 0.0);
+    std::uint64_t too_many[3];
+    EXPECT_THROW((void)queries.results(0, too_many), vkrc::UsageError);
+}
+
+}  // namespace
