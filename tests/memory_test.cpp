@@ -2,6 +2,8 @@
 
 #include "../examples/allocator/arena_allocator.hpp"
 
+#include <vkrc/upload.hpp>
+
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -356,6 +358,53 @@ TEST_P(AllocatorTest, StatisticsAndBudget) {
         EXPECT_GE(total.block_count, 1u);
         EXPECT_GE(stats.vk_allocate_calls, total.block_count);
     }
+}
+
+TEST_P(AllocatorTest, BufferUploadAndDownload) {
+    auto buffer = make_buffer(1000, vkrc::MemoryUsage::gpu_only);
+    std::vector<std::byte> data(333);
+    for (std::size_t i = 0; i < data.size(); ++i) data[i] = std::byte(i * 7 + 1);
+    vkrc::upload_buffer(queue, buffer, 5, data);
+    EXPECT_EQ(vkrc::download_buffer(queue, buffer, 5, data.size()), data);
+    auto tail = vkrc::download_buffer(queue, buffer, 5 + 330, 3);
+    EXPECT_EQ(tail, std::vector<std::byte>(data.end() - 3, data.end()));
+    EXPECT_THROW(vkrc::upload_buffer(queue, buffer, 700, data), vkrc::UsageError);
+    EXPECT_THROW(vkrc::download_buffer(queue, buffer, 999, 2), vkrc::UsageError);
+}
+
+// Every mip level and array layer arrives, through the layout transitions.
+TEST_P(AllocatorTest, ImageUploadEveryLevelAndLayer) {
+    vkrc::ImageCreateInfo info;
+    info.format = VK_FORMAT_R8G8B8A8_UINT;
+    info.extent = {37, 20, 1};  // odd sizes: levels 37x20, 18x10, 9x5, 4x2
+    info.mip_levels = 4;
+    info.array_layers = 3;
+    info.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    info.allocator = allocator;
+    auto image = vkrc::Image::create(device, info);
+    const VkDeviceSize size = vkrc::image_data_size(image);
+    EXPECT_EQ(size, (37u * 20 + 18 * 10 + 9 * 5 + 4 * 2) * 4 * 3);
+    std::vector<std::byte> data(size);
+    for (std::size_t i = 0; i < data.size(); ++i) data[i] = std::byte((i * 31) >> 2);
+    EXPECT_THROW(vkrc::upload_image(queue, image, std::span(data).first(size - 1)), vkrc::UsageError);
+    vkrc::upload_image(queue, image, data, {VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+    std::size_t offset = 0;
+    for (std::uint32_t level = 0; level < 4; ++level) {
+        const auto e = image.extent(level);
+        const std::size_t layer_size = std::size_t(e.width) * e.height * 4;
+        for (std::uint32_t layer = 0; layer < 3; ++layer) {
+            auto got = vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, level, layer);
+            ASSERT_EQ(got.size(), layer_size);
+            EXPECT_TRUE(std::equal(got.begin(), got.end(), data.begin() + offset)) << "level " << level << " layer " << layer;
+            offset += layer_size;
+        }
+    }
+    // A second upload from the layout the first left.
+    std::fill(data.begin(), data.end(), std::byte{0x5a});
+    vkrc::upload_image(queue, image, data, {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
+    auto last = vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 3, 2);
+    EXPECT_EQ(last, std::vector<std::byte>(4 * 2 * 4, std::byte{0x5a}));
+    EXPECT_THROW(vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 4, 0), vkrc::UsageError);
 }
 
 INSTANTIATE_TEST_SUITE_P(Allocators, AllocatorTest, ::testing::Values(Kind::pool, Kind::dedicated, Kind::user),

@@ -9,3 +9,4 @@
 #include "vkrc/instance.hpp"
 #include "vkrc/memory.hpp"
 #include "vkrc/resource.hpp"
+#include "vkrc/upload.hpp"
