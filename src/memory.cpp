@@ -3,7 +3,6 @@
 #include "memory_internal.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -59,6 +58,16 @@ bool intent_needs_mapping(const MemoryIntent& intent) noexcept {
            (intent.required_flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
 }
 
+namespace {
+// A few bits at most: cheaper than the library call std::popcount becomes
+// without -mpopcnt.
+int flag_count(VkMemoryPropertyFlags flags) noexcept {
+    int n = 0;
+    for (; flags; flags &= flags - 1) ++n;
+    return n;
+}
+}  // namespace
+
 int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
                      const MemoryIntent& intent) noexcept {
     VkMemoryPropertyFlags required = intent.required_flags;
@@ -90,7 +99,7 @@ int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::ui
         const VkMemoryPropertyFlags flags = properties.memoryTypes[i].propertyFlags;
         if ((flags & required) != required) continue;
         if (flags & special & ~required) continue;
-        const int score = std::popcount(flags & preferred) - std::popcount(flags & avoided);
+        const int score = flag_count(flags & preferred) - flag_count(flags & avoided);
         if (best < 0 || score > best_score) {
             best = static_cast<int>(i);
             best_score = score;

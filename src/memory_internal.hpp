@@ -17,7 +17,10 @@ void check_request(DeviceView device, const AllocationRequest& request, std::uin
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,
                                       VkBuffer dedicated_buffer, VkImage dedicated_image, std::byte** mapped);
 
-constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept { return (v + a - 1) / a * a; }
+// Vulkan's alignments are powers of two; the division is for anything else.
+constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {
+    return (a & (a - 1)) == 0 ? (v + a - 1) & ~(a - 1) : (v + a - 1) / a * a;
+}
 
 }  // namespace detail
 VKRC_END_NAMESPACE

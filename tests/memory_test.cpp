@@ -407,6 +407,97 @@ TEST_P(AllocatorTest, ImageUploadEveryLevelAndLayer) {
     EXPECT_THROW(vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 4, 0), vkrc::UsageError);
 }
 
+// lavapipe's memory is coherent; this test marks every memory type
+// non-coherent in the physical device's cached properties so that vkrc
+// really flushes and invalidates, and records each range it passes to Vulkan.
+std::vector<VkMappedMemoryRange> recorded_ranges;
+PFN_vkFlushMappedMemoryRanges real_flush = nullptr;
+PFN_vkInvalidateMappedMemoryRanges real_invalidate = nullptr;
+
+VKAPI_ATTR VkResult VKAPI_CALL record_flush(VkDevice d, std::uint32_t n, const VkMappedMemoryRange* r) {
+    recorded_ranges.insert(recorded_ranges.end(), r, r + n);
+    return real_flush(d, n, r);
+}
+VKAPI_ATTR VkResult VKAPI_CALL record_invalidate(VkDevice d, std::uint32_t n, const VkMappedMemoryRange* r) {
+    recorded_ranges.insert(recorded_ranges.end(), r, r + n);
+    return real_invalidate(d, n, r);
+}
+
+TEST_P(AllocatorTest, NonCoherentFlushesCoverExactlyTheBytes) {
+    auto& props = physical_device.state()->memory_properties;
+    const auto saved = props;
+    for (std::uint32_t i = 0; i < props.memoryTypeCount; ++i) {
+        props.memoryTypes[i].propertyFlags &= ~VkMemoryPropertyFlags(VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    }
+    auto& fn = device.state()->fn;
+    real_flush = fn.vkFlushMappedMemoryRanges;
+    real_invalidate = fn.vkInvalidateMappedMemoryRanges;
+    fn.vkFlushMappedMemoryRanges = record_flush;
+    fn.vkInvalidateMappedMemoryRanges = record_invalidate;
+    const VkDeviceSize atom = physical_device.properties().limits.nonCoherentAtomSize;
+
+    // Checks the ranges recorded since the last call against the bytes
+    // [offset, offset + size) of allocation a.
+    auto expect_ranges = [&](const vkrc::Allocation& a, VkDeviceSize offset, VkDeviceSize size, const char* what) {
+        ASSERT_EQ(recorded_ranges.size(), 1u) << what;
+        const auto r = recorded_ranges.front();
+        recorded_ranges.clear();
+        const auto& info = a.info();
+        EXPECT_EQ(r.memory, info.memory) << what;
+        EXPECT_EQ(r.offset % atom, 0u) << what;
+        const VkDeviceSize end = r.size == VK_WHOLE_SIZE ? info.memory_size : r.offset + r.size;
+        EXPECT_TRUE(r.size % atom == 0 || end == info.memory_size) << what;
+        EXPECT_LE(r.offset, info.offset + offset) << what;
+        EXPECT_GE(end, info.offset + offset + size) << what;
+        // Nothing beyond the atoms holding the bytes, nor past the memory.
+        EXPECT_LT(info.offset + offset - r.offset, atom) << what;
+        EXPECT_LE(end, std::min(info.memory_size, (info.offset + offset + size + atom - 1) / atom * atom)) << what;
+    };
+    {
+        auto buffer = make_buffer(1000, vkrc::MemoryUsage::upload);
+        const auto& a = buffer.allocation();
+        ASSERT_FALSE(a.host_coherent());
+        const std::array<std::uint8_t, 7> bytes{1, 2, 3, 4, 5, 6, 7};
+        a.write(3, std::span<const std::uint8_t>(bytes).first(5));
+        expect_ranges(a, 3, 5, "unaligned write");
+        a.write(a.size() - 7, std::span<const std::uint8_t>(bytes));
+        expect_ranges(a, a.size() - 7, 7, "write ending at the allocation end");
+        a.flush();
+        expect_ranges(a, 0, a.size(), "VK_WHOLE_SIZE");
+        a.flush(a.size() - 1, VK_WHOLE_SIZE);
+        expect_ranges(a, a.size() - 1, 1, "VK_WHOLE_SIZE from the last byte");
+        a.write_only().write(atom - 1, bytes.data(), 2);
+        expect_ranges(a, atom - 1, 2, "write across an atom boundary");
+        std::array<std::uint8_t, 7> out{};
+        a.read(a.size() - 7, std::span<std::uint8_t>(out));
+        expect_ranges(a, a.size() - 7, 7, "read at the allocation end");
+        EXPECT_EQ(out, bytes);
+        a.write(0, bytes.data(), 0);
+        EXPECT_TRUE(recorded_ranges.empty()) << "a zero-size write flushes nothing";
+    }
+    // Ranges that end exactly at the end of their memory: for the pool a
+    // fresh block of exactly the request, for the dedicated allocator its own
+    // memory, also of a size that is not a multiple of the atom.
+    for (VkDeviceSize size : {1 * MiB, 1 * MiB - 100}) {
+        vkrc::AllocationRequest r;
+        r.requirements = {size, atom, 0xffffffffu};
+        r.intent.usage = vkrc::MemoryUsage::upload;
+        auto a = vkrc::Allocation::create(device, r, allocator);
+        if (GetParam() == Kind::dedicated || (GetParam() == Kind::pool && size == 1 * MiB)) {
+            EXPECT_EQ(a.info().offset + size, a.info().memory_size);
+        }
+        const std::array<std::uint8_t, 3> bytes{9, 8, 7};
+        a.write(a.size() - 3, std::span<const std::uint8_t>(bytes));
+        expect_ranges(a, a.size() - 3, 3, "write at the block end");
+        a.flush(a.size() - 3, VK_WHOLE_SIZE);
+        expect_ranges(a, a.size() - 3, 3, "VK_WHOLE_SIZE at the block end");
+    }
+    queue.wait_idle();
+    fn.vkFlushMappedMemoryRanges = real_flush;
+    fn.vkInvalidateMappedMemoryRanges = real_invalidate;
+    props = saved;
+}
+
 INSTANTIATE_TEST_SUITE_P(Allocators, AllocatorTest, ::testing::Values(Kind::pool, Kind::dedicated, Kind::user),
                          kind_name);
 
