@@ -198,6 +198,11 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         }
     }
     queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
+    if (fence) {
+        // At least this submission's value (a later one under concurrent submits).
+        fence.state()->queue_timeline = queue.timeline_semaphore();
+        fence.state()->queue_value = queue.last_submitted_value();
+    }
 }
 
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {

@@ -97,15 +97,21 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
     require(static_cast<bool>(device), who, "the Device handle is empty");
     require(static_cast<bool>(info.render_pass), who, "render_pass is empty");
     require(info.width > 0 && info.height > 0 && info.layers > 0, who, "width, height and layers must be non-zero");
+    std::vector<VkImageView> views;
+    for (const auto& v : info.attachments) {
+        require(static_cast<bool>(v), who, "an attachment ImageView handle is empty");
+        views.push_back(v.vk());
+    }
     VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
     ci.renderPass = info.render_pass.vk();
-    ci.attachmentCount = static_cast<std::uint32_t>(info.attachments.size());
-    ci.pAttachments = info.attachments.data();
+    ci.attachmentCount = static_cast<std::uint32_t>(views.size());
+    ci.pAttachments = views.data();
     ci.width = info.width;
     ci.height = info.height;
     ci.layers = info.layers;
     detail::Ref<detail::FramebufferState> s(new detail::FramebufferState);
     s->render_pass = info.render_pass;
+    s->attachments = info.attachments;
     s->extent = {info.width, info.height};
     check(device.fn().vkCreateFramebuffer(device.vk(), &ci, nullptr, &s->framebuffer), "vkCreateFramebuffer");
     return Framebuffer(std::move(s));

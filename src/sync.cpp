@@ -15,6 +15,16 @@ VkResult after_wait(const Device& device, VkResult r, const char* call) {
 }  // namespace
 
 namespace detail {
+VkResult FenceState::settle(VkResult fence_result) noexcept {
+    if (fence_result != VK_SUCCESS || queue_timeline == VK_NULL_HANDLE) return fence_result;
+    VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    info.semaphoreCount = 1;
+    info.pSemaphores = &queue_timeline;
+    info.pValues = &queue_value;
+    VkResult r = device.fn().vkWaitSemaphores(device.vk(), &info, UINT64_MAX);
+    return r == VK_SUCCESS ? fence_result : r;
+}
+
 FenceState::~FenceState() {
     if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence);
 }
@@ -48,17 +58,18 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
     VkResult r = d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns);
-    return after_wait(d, r, "vkWaitForFences");
+    return after_wait(d, state_->settle(r), "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
     const auto& d = state_->device;
-    return after_wait(d, d.fn().vkGetFenceStatus(d.vk(), state_->fence), "vkGetFenceStatus");
+    return after_wait(d, state_->settle(d.fn().vkGetFenceStatus(d.vk(), state_->fence)), "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
     const auto& d = state_->device;
     check(d.fn().vkResetFences(d.vk(), 1, &state_->fence), "vkResetFences");
+    state_->queue_timeline = VK_NULL_HANDLE;
 }
 
 namespace {

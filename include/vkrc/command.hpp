@@ -67,6 +67,7 @@ struct CommandBufferInheritance {
 };
 
 // One attachment of dynamic rendering (VkRenderingAttachmentInfo, no resolve).
+// image_view: view.vk() of an ImageView that lives until the work is submitted.
 struct RenderingAttachment {
     VkImageView image_view = VK_NULL_HANDLE;
     VkImageLayout image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
@@ -120,9 +121,16 @@ public:
 
     // State
     void bind_pipeline(const Pipeline& pipeline) const noexcept;
+    void bind_vertex_buffer(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0) const noexcept {
+        bind_vertex_buffer(binding, buffer.vk(), offset);
+    }
     void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0) const noexcept;
     void bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
                              std::span<const VkDeviceSize> offsets) const noexcept;
+    void bind_index_buffer(const Buffer& buffer, VkDeviceSize offset = 0,
+                           VkIndexType type = VK_INDEX_TYPE_UINT32) const noexcept {
+        bind_index_buffer(buffer.vk(), offset, type);
+    }
     void bind_index_buffer(VkBuffer buffer, VkDeviceSize offset = 0,
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const noexcept;
     // Binds one set at index set_index of the pipeline's layout.
@@ -148,6 +156,21 @@ public:
     void draw_indexed(std::uint32_t index_count, std::uint32_t instance_count = 1, std::uint32_t first_index = 0,
                       std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const noexcept;
     void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const noexcept;
+    // Typed overloads read the raw handles; raw ones are the escape hatch.
+    void copy_buffer(const Buffer& src, const Buffer& dst, std::span<const VkBufferCopy> regions) const noexcept {
+        copy_buffer(src.vk(), dst.vk(), regions);
+    }
+    void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
+                              std::span<const VkBufferImageCopy> regions) const noexcept {
+        copy_buffer_to_image(src.vk(), dst.vk(), dst_layout, regions);
+    }
+    void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
+                              std::span<const VkBufferImageCopy> regions) const noexcept {
+        copy_image_to_buffer(src.vk(), src_layout, dst.vk(), regions);
+    }
+    void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size, std::uint32_t data) const noexcept {
+        fill_buffer(dst.vk(), offset, size, data);
+    }
     void copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const noexcept;
     void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
                               std::span<const VkBufferImageCopy> regions) const noexcept;

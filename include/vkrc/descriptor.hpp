@@ -2,6 +2,7 @@
 #pragma once
 
 #include "vkrc/detail/pool_free_list.hpp"
+#include "vkrc/resource.hpp"
 
 #include <span>
 #include <vector>
@@ -77,10 +78,19 @@ public:
     VkDescriptorSet vk() const noexcept;
     const DescriptorPool& pool() const noexcept;
 
-    // vkUpdateDescriptorSets with one buffer descriptor.
+    // vkUpdateDescriptorSets with one buffer descriptor. The set does not keep
+    // what it points to alive: drop it only after the work that uses it is submitted.
+    void write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer, VkDeviceSize offset = 0,
+                      VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const {
+        write_buffer(binding, type, buffer.vk(), offset, range, array_element);
+    }
     void write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset = 0,
                       VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const;
     // vkUpdateDescriptorSets with one image/sampler descriptor.
+    void write_image(std::uint32_t binding, VkDescriptorType type, const ImageView& view, VkImageLayout layout,
+                     const Sampler& sampler = {}, std::uint32_t array_element = 0) const {
+        write_image(binding, type, view.vk(), layout, sampler ? sampler.vk() : VK_NULL_HANDLE, array_element);
+    }
     void write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                      VkSampler sampler = VK_NULL_HANDLE, std::uint32_t array_element = 0) const;
 

@@ -64,16 +64,16 @@ private:
     using Handle::Handle;
 };
 
-// Mirrors VkFramebufferCreateInfo. The views must outlive the framebuffer.
+// Mirrors VkFramebufferCreateInfo.
 struct FramebufferCreateInfo {
     RenderPass render_pass;
-    std::vector<VkImageView> attachments;
+    std::vector<ImageView> attachments;
     std::uint32_t width = 0;
     std::uint32_t height = 0;
     std::uint32_t layers = 1;
 };
 
-// Keeps its render pass alive.
+// Keeps its render pass and attachments alive.
 class Framebuffer : public Handle<detail::FramebufferState> {
 public:
     Framebuffer() noexcept = default;
@@ -228,6 +228,7 @@ class FramebufferState final : public RefCounted {
 public:
     ~FramebufferState() override;
     RenderPass render_pass;
+    std::vector<ImageView> attachments;
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
     VkExtent2D extent{};
 };

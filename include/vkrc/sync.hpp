@@ -29,6 +29,8 @@ public:
     VkFence vk() const noexcept;
     const Device& device() const noexcept;
     // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
+    // After VK_SUCCESS for a fence given to vkrc::submit, every object dropped
+    // before that submission has been destroyed.
     VkResult wait(std::uint64_t timeout_ns = wait_forever) const;
     // vkGetFenceStatus: VK_SUCCESS (signalled) or VK_NOT_READY.
     VkResult status() const;
@@ -115,6 +117,16 @@ public:
     Device device;
     VkFence fence = VK_NULL_HANDLE;
     Ownership ownership = Ownership::owned;
+    // Set by vkrc::submit: the queue timeline value of the fenced submission.
+    // Drivers may signal the fence a moment before the timeline, so a
+    // successful wait also waits for it; then everything dropped before that
+    // submission has been destroyed when wait() returns. Written only by
+    // submit and unsignal, which Vulkan already requires to be externally
+    // synchronised for the fence.
+    VkSemaphore queue_timeline = VK_NULL_HANDLE;
+    std::uint64_t queue_value = 0;
+    // Waits for queue_value once the fence has signalled.
+    VkResult settle(VkResult fence_result) noexcept;
 };
 
 class SemaphoreState final : public RefCounted {

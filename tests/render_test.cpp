@@ -1,0 +1,299 @@
+// End-to-end GPU work through vkrc: compute writes, rendering with a render
+// pass and with dynamic rendering, read back and compared exactly; and
+// dropping every object right after submitting work that uses it.
+#include "support/vk_test.hpp"
+
+#include "shaders/fill_pattern.comp.h"
+#include "shaders/push_color.frag.h"
+#include "shaders/rect.vert.h"
+#include "shaders/triangle.frag.h"
+#include "shaders/triangle.vert.h"
+
+#include <array>
+#include <cstring>
+#include <vector>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+constexpr std::uint32_t size = 64;
+constexpr VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
+constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;
+using Rgba = std::array<std::uint8_t, 4>;
+
+std::uint32_t pattern(std::uint32_t i, std::uint32_t seed) { return (i * 2654435761u) ^ seed; }
+
+struct FillParams {
+    std::uint32_t count;
+    std::uint32_t seed;
+};
+
+struct RectPush {
+    float color[4];
+    float bounds[4];  // x0 y0 x1 y1, NDC
+    float depth;
+};
+
+vkrc::Buffer readback_buffer(const vkrc::Device& device, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+    return vkrc::Buffer::create(device, {.size = bytes, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::readback}});
+}
+
+vkrc::Image attachment_image(const vkrc::Device& device, VkFormat format, VkImageUsageFlags usage) {
+    return vkrc::Image::create(device, {.format = format, .extent = {size, size, 1}, .usage = usage});
+}
+
+// The compute pipeline of fill_pattern.comp and the set that points it at a buffer.
+struct Fill {
+    vkrc::DescriptorSetLayout set_layout;
+    vkrc::ComputePipeline pipeline;
+    vkrc::DescriptorPool pool;
+    vkrc::DescriptorSet set;
+
+    Fill(const vkrc::Device& device, const vkrc::Buffer& target) {
+        set_layout = vkrc::DescriptorSetLayout::create(
+            device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                   .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+        auto layout = vkrc::PipelineLayout::create(
+            device, {.set_layouts = {set_layout},
+                     .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(FillParams)}}});
+        pipeline = vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        pool = vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+        set = pool.allocate(set_layout);
+        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, target);
+    }
+    void record(const vkrc::CommandBuffer& cmd, std::uint32_t count, std::uint32_t seed) const {
+        cmd.bind_pipeline(pipeline);
+        cmd.bind_descriptor_set(pipeline, 0, set);
+        cmd.push_constants(pipeline.layout(), VK_SHADER_STAGE_COMPUTE_BIT, FillParams{count, seed});
+        cmd.dispatch((count + 63) / 64);
+    }
+};
+
+TEST_F(VulkanTest, ComputeWritesAKnownPattern) {
+    constexpr std::uint32_t count = 1000, seed = 0xC0FFEE;
+    auto buffer = readback_buffer(device, count * sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    Fill fill(device, buffer);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    fill.record(cmd, count, seed);
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    std::vector<std::uint32_t> out(count);
+    buffer.allocation().read(0, std::span(out));
+    std::size_t mismatches = 0;
+    for (std::uint32_t i = 0; i < count; ++i) mismatches += out[i] != pattern(i, seed);
+    EXPECT_EQ(mismatches, 0u) << "first value " << out[0] << ", expected " << pattern(0, seed);
+}
+
+// Copies a colour image in TRANSFER_SRC_OPTIMAL to a readback buffer.
+void record_readback(const vkrc::CommandBuffer& cmd, const vkrc::Image& image, const vkrc::Buffer& pixels) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {size, size, 1};
+    cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pixels, std::span(&region, 1));
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+}
+
+Rgba pixel(const vkrc::Buffer& pixels, std::uint32_t x, std::uint32_t y) {
+    return pixels.allocation().read_value<Rgba>((y * size + x) * 4);
+}
+
+void submit_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd) {
+    auto fence = vkrc::Fence::create(queue.device());
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+}
+
+constexpr Rgba red{255, 0, 0, 255}, green{0, 255, 0, 255}, blue{0, 0, 255, 255}, black{0, 0, 0, 255};
+
+// A render pass and framebuffer; the triangle comes from a vertex buffer.
+TEST_F(VulkanTest, TriangleThroughARenderPass) {
+    struct Vertex {
+        float position[2];
+        float color[3];
+    };
+    // Counter-clockwise on screen (y points down in Vulkan's framebuffer).
+    const Vertex vertices[] = {{{0.0f, -0.5f}, {1, 0, 0}}, {{-0.5f, 0.5f}, {1, 0, 0}}, {{0.5f, 0.5f}, {1, 0, 0}}};
+    auto vertex_buffer = vkrc::Buffer::create(
+        device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                 .memory = {.usage = vkrc::MemoryUsage::upload}});
+    vertex_buffer.allocation().write(0, vertices, 3);
+
+    auto image = attachment_image(device, color_format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    VkAttachmentDescription color{0, color_format, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                  VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                  VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    // The copy after the pass waits for the attachment writes.
+    VkSubpassDependency to_copy{0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                                VK_ACCESS_TRANSFER_READ_BIT, 0};
+    auto render_pass = vkrc::RenderPass::create(
+        device, {.attachments = {color},
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
+                 .dependencies = {to_copy}});
+    auto framebuffer = vkrc::Framebuffer::create(
+        device, {.render_pass = render_pass, .attachments = {vkrc::ImageView::create(image)}, .width = size, .height = size});
+    auto pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+                        .vertex_binding(0, sizeof(Vertex))
+                        .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+                        .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+                        .render_pass(render_pass)
+                        .build();
+
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    VkClearValue clear{};
+    clear.color = {{0.0f, 0.0f, 1.0f, 1.0f}};
+    cmd.begin_render_pass(render_pass, framebuffer, {{0, 0}, {size, size}}, std::span(&clear, 1));
+    cmd.bind_pipeline(pipeline);
+    cmd.set_viewport_and_scissor(framebuffer.extent());
+    cmd.bind_vertex_buffer(0, vertex_buffer);
+    cmd.draw(3);
+    cmd.end_render_pass();
+    record_readback(cmd, image, pixels);
+    cmd.end();
+    submit_and_wait(queue, cmd);
+
+    EXPECT_EQ(pixel(pixels, 32, 32), red);  // centre
+    EXPECT_EQ(pixel(pixels, 20, 44), red);  // inside, near the left edge
+    EXPECT_EQ(pixel(pixels, 2, 2), blue);   // corners
+    EXPECT_EQ(pixel(pixels, 61, 61), blue);
+    EXPECT_EQ(pixel(pixels, 32, 12), blue);  // above the apex
+    EXPECT_EQ(pixel(pixels, 12, 44), blue);  // left of the left edge
+}
+
+struct DepthTarget {
+    vkrc::Image color, depth;
+    vkrc::ImageView color_view, depth_view;
+    explicit DepthTarget(const vkrc::Device& device)
+        : color(attachment_image(device, color_format,
+                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT)),
+          depth(attachment_image(device, depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)),
+          color_view(vkrc::ImageView::create(color)),
+          depth_view(vkrc::ImageView::create(depth)) {}
+};
+
+vkrc::GraphicsPipeline rect_pipeline(const vkrc::Device& device) {
+    auto layout = vkrc::PipelineLayout::create(
+        device, {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(RectPush)}}});
+    return vkrc::GraphicsPipelineBuilder(layout)
+        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::rect_vert))
+        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::push_color_frag))
+        .rendering(std::array{color_format}, depth_format)
+        .build();
+}
+
+// Dynamic rendering: layouts in, draw the quads, layout out for the copy.
+void record_quads(const vkrc::CommandBuffer& cmd, const DepthTarget& target, const vkrc::GraphicsPipeline& pipeline,
+                  std::span<const RectPush> quads) {
+    const VkImageMemoryBarrier2 in[] = {
+        vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
+        vkrc::image_barrier(target.depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_NONE, 0,
+                            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                            VK_IMAGE_ASPECT_DEPTH_BIT)};
+    cmd.pipeline_barrier({}, {}, in);
+    vkrc::RenderingAttachment color{.image_view = target.color_view.vk()};
+    color.clear_value.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
+    vkrc::RenderingAttachment depth{.image_view = target.depth_view.vk(),
+                                    .image_layout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                                    .store_op = VK_ATTACHMENT_STORE_OP_DONT_CARE};
+    depth.clear_value.depthStencil = {1.0f, 0};
+    cmd.begin_rendering({.render_area = {{0, 0}, {size, size}},
+                         .color_attachments = std::span(&color, 1),
+                         .depth_attachment = &depth});
+    cmd.bind_pipeline(pipeline);
+    cmd.set_viewport_and_scissor({size, size});
+    for (const auto& q : quads) {
+        cmd.push_constants(pipeline.layout(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, q);
+        cmd.draw(6);
+    }
+    cmd.end_rendering();
+    auto out = vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                                   VK_ACCESS_2_TRANSFER_READ_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&out, 1));
+}
+
+// The near quad is drawn first: the far one must lose where they overlap.
+constexpr RectPush near_green{{0, 1, 0, 1}, {-0.6f, -0.6f, 0.2f, 0.2f}, 0.3f};
+constexpr RectPush far_red{{1, 0, 0, 1}, {-0.2f, -0.2f, 0.6f, 0.6f}, 0.6f};
+
+TEST_F(VulkanTest, DepthTestedQuadsWithDynamicRendering) {
+    DepthTarget target(device);
+    auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto pipeline = rect_pipeline(device);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    const RectPush quads[] = {near_green, far_red};
+    record_quads(cmd, target, pipeline, quads);
+    record_readback(cmd, target.color, pixels);
+    cmd.end();
+    submit_and_wait(queue, cmd);
+
+    EXPECT_EQ(pixel(pixels, 32, 32), green);  // overlap: the near quad wins
+    EXPECT_EQ(pixel(pixels, 36, 36), green);
+    EXPECT_EQ(pixel(pixels, 19, 19), green);  // near quad only
+    EXPECT_EQ(pixel(pixels, 44, 44), red);    // far quad only
+    EXPECT_EQ(pixel(pixels, 2, 2), black);    // background
+    EXPECT_EQ(pixel(pixels, 60, 4), black);
+}
+
+// Everything (buffers, images, views, pipelines, descriptor sets, the command
+// buffer) is dropped right after the submit, while a timeline wait that only
+// the host releases holds the GPU back. Nothing may be destroyed early (the
+// validation layer would report it), and everything is destroyed after.
+TEST_F(VulkanTest, DropEverythingRightAfterSubmit) {
+    auto gate = vkrc::Semaphore::create_timeline(device, 0);
+    auto fence = vkrc::Fence::create(device);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto survivor = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    {
+        auto storage = vkrc::Buffer::create(
+            device, {.size = 4096, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {}});
+        Fill fill(device, storage);
+        DepthTarget target(device);
+        auto pipeline = rect_pipeline(device);
+        auto cmd = pool.allocate();
+        cmd.begin();
+        fill.record(cmd, 1024, 7);
+        const RectPush quads[] = {near_green, far_red};
+        record_quads(cmd, target, pipeline, quads);
+        record_readback(cmd, target.color, survivor);
+        cmd.end();
+        vkrc::SemaphoreSubmit wait{gate, 1};
+        vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, fence);
+    }
+    EXPECT_EQ(pool.pending_free_count(), 1u);
+    EXPECT_GT(device.deferred_count(), 10u);
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    gate.signal(1);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(device.deferred_count(), 0u);
+    // The work ran with every object intact.
+    EXPECT_EQ(pixel(survivor, 32, 32), green);
+    EXPECT_EQ(pixel(survivor, 44, 44), red);
+    auto next = pool.allocate();  // frees the dropped command buffer
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+}
+
+}  // namespace
