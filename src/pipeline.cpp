@@ -1,5 +1,6 @@
 #include "vkrc/pipeline.hpp"
 
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>

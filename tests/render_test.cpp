@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstring>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -197,9 +198,8 @@ vkrc::GraphicsPipeline rect_pipeline(const vkrc::Device& device) {
         .build();
 }
 
-// Dynamic rendering: layouts in, draw the quads, layout out for the copy.
-void record_quads(const vkrc::CommandBuffer& cmd, const DepthTarget& target, const vkrc::GraphicsPipeline& pipeline,
-                  std::span<const RectPush> quads) {
+// Dynamic rendering into the target: layouts in, begin; end, layout out for the copy.
+void begin_target(const vkrc::CommandBuffer& cmd, const DepthTarget& target, VkRenderingFlags flags = 0) {
     const VkImageMemoryBarrier2 in[] = {
         vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
@@ -218,19 +218,33 @@ void record_quads(const vkrc::CommandBuffer& cmd, const DepthTarget& target, con
     depth.clear_value.depthStencil = {1.0f, 0};
     cmd.begin_rendering({.render_area = {{0, 0}, {size, size}},
                          .color_attachments = std::span(&color, 1),
-                         .depth_attachment = &depth});
-    cmd.bind_pipeline(pipeline);
-    cmd.set_viewport_and_scissor({size, size});
-    for (const auto& q : quads) {
-        cmd.push_constants(pipeline.layout(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, q);
-        cmd.draw(6);
-    }
+                         .depth_attachment = &depth,
+                         .flags = flags});
+}
+
+void end_target(const vkrc::CommandBuffer& cmd, const DepthTarget& target) {
     cmd.end_rendering();
     auto out = vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                    VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
                                    VK_ACCESS_2_TRANSFER_READ_BIT);
     cmd.pipeline_barrier({}, {}, std::span(&out, 1));
+}
+
+void draw_quads(const vkrc::CommandBuffer& cmd, const vkrc::GraphicsPipeline& pipeline, std::span<const RectPush> quads) {
+    cmd.bind_pipeline(pipeline);
+    cmd.set_viewport_and_scissor({size, size});
+    for (const auto& q : quads) {
+        cmd.push_constants(pipeline.layout(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, q);
+        cmd.draw(6);
+    }
+}
+
+void record_quads(const vkrc::CommandBuffer& cmd, const DepthTarget& target, const vkrc::GraphicsPipeline& pipeline,
+                  std::span<const RectPush> quads) {
+    begin_target(cmd, target);
+    draw_quads(cmd, pipeline, quads);
+    end_target(cmd, target);
 }
 
 // The near quad is drawn first: the far one must lose where they overlap.
@@ -294,6 +308,66 @@ TEST_F(VulkanTest, DropEverythingRightAfterSubmit) {
     EXPECT_EQ(pixel(survivor, 44, 44), red);
     auto next = pool.allocate();  // frees the dropped command buffer
     EXPECT_EQ(pool.pending_free_count(), 0u);
+}
+
+// Four threads record one secondary each, from four pools, drawing into one
+// quadrant of a dynamic-rendering pass; one primary executes them. Under the
+// multi-thread policy each thread also drops its secondary right after the submit.
+TEST_F(VulkanTest, SecondariesRecordedOnFourThreadsDrawOneImage) {
+    constexpr int threads = 4;
+    DepthTarget target(device);
+    auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto pipeline = rect_pipeline(device);
+    const RectPush quads[threads] = {{{1, 0, 0, 1}, {-1, -1, 0, 0}, 0.5f},
+                                     {{0, 1, 0, 1}, {0, -1, 1, 0}, 0.5f},
+                                     {{0, 0, 1, 1}, {-1, 0, 0, 1}, 0.5f},
+                                     {{1, 1, 1, 1}, {0, 0, 1, 1}, 0.5f}};
+    std::vector<vkrc::CommandPool> pools;
+    for (int t = 0; t < threads; ++t) {
+        pools.push_back(vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}));
+    }
+    std::vector<vkrc::CommandBuffer> secondaries(threads);
+    const VkFormat formats[] = {color_format};
+    auto record = [&](int t) {
+        auto cmd = pools[t].allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        cmd.begin_secondary({.color_formats = formats, .depth_format = depth_format});
+        draw_quads(cmd, pipeline, std::span(&quads[t], 1));
+        cmd.end();
+        secondaries[t] = std::move(cmd);
+    };
+#if VKRC_IS_MULTI_THREAD
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) workers.emplace_back(record, t);
+    for (auto& w : workers) w.join();
+#else
+    for (int t = 0; t < threads; ++t) record(t);
+#endif
+    auto primary_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto primary = primary_pool.allocate();
+    primary.begin();
+    begin_target(primary, target, VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT);
+    primary.execute_commands(secondaries);
+    end_target(primary, target);
+    record_readback(primary, target.color, pixels);
+    primary.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&primary, 1)}, fence);
+#if VKRC_IS_MULTI_THREAD
+    std::vector<std::thread> droppers;
+    for (int t = 0; t < threads; ++t) droppers.emplace_back([&, t] { secondaries[t].reset(); });
+    for (auto& d : droppers) d.join();
+#else
+    secondaries.clear();
+#endif
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(pixel(pixels, 16, 16), red);
+    EXPECT_EQ(pixel(pixels, 48, 16), green);
+    EXPECT_EQ(pixel(pixels, 16, 48), blue);
+    EXPECT_EQ(pixel(pixels, 48, 48), (Rgba{255, 255, 255, 255}));
+    for (auto& p : pools) {
+        auto next = p.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);  // frees the dropped secondary
+        EXPECT_EQ(p.pending_free_count(), 0u);
+    }
 }
 
 }  // namespace
