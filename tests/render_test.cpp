@@ -310,6 +310,62 @@ TEST_F(VulkanTest, DropEverythingRightAfterSubmit) {
     EXPECT_EQ(pool.pending_free_count(), 0u);
 }
 
+// draw_indexed from an index buffer, with vertices that copy_buffer moved
+// from an upload buffer into device-local memory.
+TEST_F(VulkanTest, IndexedQuadFromCopiedVertices) {
+    struct Vertex {
+        float position[2];
+        float color[3];
+    };
+    const Vertex vertices[] = {{{-0.5f, -0.5f}, {0, 1, 0}}, {{-0.5f, 0.5f}, {0, 1, 0}},
+                               {{0.5f, 0.5f}, {0, 1, 0}},   {{0.5f, -0.5f}, {0, 1, 0}}};
+    const std::uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+    auto staging = vkrc::Buffer::create(device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                                 .memory = {.usage = vkrc::MemoryUsage::upload}});
+    staging.allocation().write(0, vertices, 4);
+    auto vertex_buffer = vkrc::Buffer::create(
+        device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+    auto index_buffer = vkrc::Buffer::create(device, {.size = sizeof indices, .usage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                                                      .memory = {.usage = vkrc::MemoryUsage::upload}});
+    index_buffer.allocation().write(0, indices, 6);
+
+    DepthTarget target(device);
+    auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+                        .vertex_binding(0, sizeof(Vertex))
+                        .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+                        .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+                        .rendering(std::array{color_format}, depth_format)
+                        .build();
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    const VkBufferCopy whole{0, 0, sizeof vertices};
+    cmd.copy_buffer(staging, vertex_buffer, std::span(&whole, 1));
+    auto to_vertex_input = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT,
+                                                VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_vertex_input, 1), {}, {});
+    begin_target(cmd, target);
+    cmd.bind_pipeline(pipeline);
+    cmd.set_viewport_and_scissor({size, size});
+    cmd.bind_vertex_buffer(0, vertex_buffer);
+    cmd.bind_index_buffer(index_buffer, 0, VK_INDEX_TYPE_UINT16);
+    cmd.draw_indexed(6);
+    end_target(cmd, target);
+    record_readback(cmd, target.color, pixels);
+    cmd.end();
+    submit_and_wait(queue, cmd);
+
+    EXPECT_EQ(pixel(pixels, 32, 32), green);
+    EXPECT_EQ(pixel(pixels, 20, 20), green);  // first triangle
+    EXPECT_EQ(pixel(pixels, 44, 20), green);  // second triangle
+    EXPECT_EQ(pixel(pixels, 8, 8), black);
+    EXPECT_EQ(pixel(pixels, 56, 32), black);
+}
+
 // Four threads record one secondary each, from four pools, drawing into one
 // quadrant of a dynamic-rendering pass; one primary executes them. Under the
 // multi-thread policy each thread also drops its secondary right after the submit.
