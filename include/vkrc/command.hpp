@@ -278,7 +278,8 @@ inline VkCommandBufferLevel CommandBuffer::level() const noexcept { return state
 inline void CommandBuffer::begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer,
                                              VkRect2D render_area, std::span<const VkClearValue> clear_values,
                                              VkSubpassContents contents) const noexcept {
-    VkRenderPassBeginInfo info{VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+    VkRenderPassBeginInfo info{};
+    info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
     info.renderPass = render_pass.vk();
     info.framebuffer = framebuffer.vk();
     info.renderArea = render_area;
@@ -293,7 +294,8 @@ inline void CommandBuffer::end_render_pass() const noexcept { state_->fn->vkCmdE
 
 inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const noexcept {
     auto convert = [](const RenderingAttachment& a) {
-        VkRenderingAttachmentInfo r{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        VkRenderingAttachmentInfo r{};
+        r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
         r.imageView = a.image_view;
         r.imageLayout = a.image_layout;
         r.loadOp = a.load_op;
@@ -308,7 +310,8 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const noex
         colors[count++] = convert(a);
     }
     VkRenderingAttachmentInfo depth, stencil;
-    VkRenderingInfo r{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    VkRenderingInfo r{};
+    r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
     r.flags = info.flags;
     r.renderArea = info.render_area;
     r.layerCount = info.layer_count;
@@ -412,7 +415,8 @@ inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> me
                                             std::span<const VkBufferMemoryBarrier2> buffers,
                                             std::span<const VkImageMemoryBarrier2> images,
                                             VkDependencyFlags flags) const noexcept {
-    VkDependencyInfo d{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    VkDependencyInfo d{};
+    d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
     d.dependencyFlags = flags;
     d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
     d.pMemoryBarriers = memory.data();
