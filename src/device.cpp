@@ -11,7 +11,20 @@ DeviceState::~DeviceState() {
     if (device == VK_NULL_HANDLE) return;
     // Every handle is gone; whatever the GPU still runs must finish before
     // the queued destructions. A lost device returns at once.
-    if (fn.vkDeviceWaitIdle(device) == VK_ERROR_DEVICE_LOST) mark_lost();
+    VkResult idle = fn.vkDeviceWaitIdle(device);
+    if (idle == VK_ERROR_DEVICE_LOST) mark_lost();
+    if (idle != VK_SUCCESS && !lost.load(std::memory_order_relaxed)) {
+        // Out of memory while waiting: vkrc's own timelines still say when
+        // its submissions are done.
+        for (auto& q : queues) {
+            std::uint64_t value = q->submitted.load(std::memory_order_acquire);
+            VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+            wait.semaphoreCount = 1;
+            wait.pSemaphores = &q->timeline;
+            wait.pValues = &value;
+            fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
+        }
+    }
     for (auto& batch : deferred_) {
         for (auto& action : batch.actions) action.run(*this, action.handle, action.context);
     }
