@@ -30,7 +30,7 @@ DeviceState::~DeviceState() {
     }
     deferred_.clear();
     for (auto& q : queues) {
-        if (q->timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q->timeline, nullptr);
+        if (q.timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.timeline, nullptr);
     }
     if (ownership == Ownership::owned) fn.vkDestroyDevice(device, nullptr);
 }
@@ -38,15 +38,15 @@ DeviceState::~DeviceState() {
 bool DeviceState::idle_now() noexcept {
     bool idle = true;
     for (auto& q : queues) {
-        std::uint64_t submitted = q->submitted.load(std::memory_order_acquire);
-        if (q->completed.load(std::memory_order_relaxed) >= submitted) continue;
+        std::uint64_t submitted = q.submitted.load(std::memory_order_acquire);
+        if (q.completed.load(std::memory_order_relaxed) >= submitted) continue;
         std::uint64_t value = 0;
-        VkResult r = fn.vkGetSemaphoreCounterValue(device, q->timeline, &value);
+        VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
         if (r == VK_ERROR_DEVICE_LOST) mark_lost();
         if (r == VK_SUCCESS) {
             // Keep the cache monotonic when several threads refresh it.
-            std::uint64_t seen = q->completed.load(std::memory_order_relaxed);
-            while (seen < value && !q->completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+            std::uint64_t seen = q.completed.load(std::memory_order_relaxed);
+            while (seen < value && !q.completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
             }
         }
         if (value < submitted) idle = false;
@@ -65,7 +65,7 @@ void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
             // the same work was pending is shared.
             thread_local std::vector<std::uint64_t> values;
             values.clear();
-            for (auto& q : queues) values.push_back(q->submitted.load(std::memory_order_acquire));
+            for (auto& q : queues) values.push_back(q.submitted.load(std::memory_order_acquire));
             try {
                 if (deferred_.empty() || deferred_.back().wait_values != values) {
                     deferred_.push_back(Batch{values, {}});
@@ -93,7 +93,7 @@ void DeviceState::take_ready(std::vector<DeferredAction>& out) noexcept {
         if (!done) {
             done = true;
             for (std::size_t i = 0; i < queues.size(); ++i) {
-                if (queues[i]->completed.load(std::memory_order_relaxed) < batch.wait_values[i]) done = false;
+                if (queues[i].completed.load(std::memory_order_relaxed) < batch.wait_values[i]) done = false;
             }
         }
         if (!done) break;
@@ -138,12 +138,11 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
     VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
     for (const auto& request : requests) {
         for (std::uint32_t i = 0; i < request.queue_priorities.size(); ++i) {
-            auto q = std::make_unique<detail::QueueState>();
-            q->family_index = request.queue_family_index;
-            q->index = i;
-            s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q->queue);
-            s.queues.push_back(std::move(q));
-            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &s.queues.back()->timeline), "vkCreateSemaphore");
+            auto& q = s.queues.emplace_back();
+            q.family_index = request.queue_family_index;
+            q.index = i;
+            s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q.queue);
+            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &q.timeline), "vkCreateSemaphore");
         }
     }
 }
@@ -252,7 +251,7 @@ bool Device::extension_enabled(const char* name) const noexcept {
 
 Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
     for (auto& q : state_->queues) {
-        if (q->family_index == family_index && q->index == index) return Queue(*this, q.get());
+        if (q.family_index == family_index && q.index == index) return Queue(*this, &q);
     }
     throw UsageError("vkrc::Device::queue: queue " + std::to_string(index) + " of family " +
                      std::to_string(family_index) + " was not requested when the device was created");
@@ -260,7 +259,7 @@ Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
 
 Queue Device::default_queue() const {
     if (state_->queues.empty()) throw UsageError("vkrc::Device::default_queue: the device has no queues");
-    return Queue(*this, state_->queues.front().get());
+    return Queue(*this, &state_->queues.front());
 }
 
 void Device::wait_idle() const {

@@ -5,7 +5,6 @@
 #include "vkrc/device.hpp"
 
 #include <deque>
-#include <memory>
 
 VKRC_BEGIN_NAMESPACE
 namespace detail {
@@ -53,7 +52,7 @@ public:
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     std::vector<std::string> enabled_extensions;
-    std::vector<std::unique_ptr<QueueState>> queues;
+    std::deque<QueueState> queues;  // a deque: Queue handles point into it
     std::atomic<bool> lost{false};
 
 private:
