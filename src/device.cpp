@@ -17,10 +17,10 @@ DeviceState::~DeviceState() {
         // Out of memory while waiting: vkrc's own timelines still say when
         // its submissions are done.
         for (auto& q : queues) {
-            std::uint64_t value = q->submitted.load(std::memory_order_acquire);
+            std::uint64_t value = q.submitted.load(std::memory_order_acquire);
             VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
             wait.semaphoreCount = 1;
-            wait.pSemaphores = &q->timeline;
+            wait.pSemaphores = &q.timeline;
             wait.pValues = &value;
             fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
         }
@@ -56,39 +56,46 @@ bool DeviceState::idle_now() noexcept {
 
 void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
     std::vector<DeferredAction> ready;
+    bool run_now = false;
     {
         LockGuard lock(deferred_mutex_);
         if (deferred_.empty() && idle_now()) {
-            ready.push_back(action);
+            run_now = true;
         } else {
-            // Needs the values of work submitted so far; a batch queued while
-            // the same work was pending is shared.
-            thread_local std::vector<std::uint64_t> values;
-            values.clear();
-            for (auto& q : queues) values.push_back(q.submitted.load(std::memory_order_acquire));
+            bool queued = false;
             try {
+                // Needs the values of work submitted so far; a batch queued
+                // while the same work was pending is shared.
+                std::vector<std::uint64_t> values;
+                values.reserve(queues.size());
+                for (auto& q : queues) values.push_back(q.submitted.load(std::memory_order_acquire));
                 if (deferred_.empty() || deferred_.back().wait_values != values) {
-                    deferred_.push_back(Batch{values, {}});
+                    deferred_.push_back(Batch{std::move(values), {}});
                 }
                 deferred_.back().actions.push_back(action);
                 ++deferred_actions_;
+                queued = true;
+                take_ready(ready);
             } catch (...) {
-                // Out of host memory while queueing: waiting is the only safe
-                // way left to destroy the object.
-                fn.vkDeviceWaitIdle(device);
-                ready.push_back(action);
+                // Out of host memory. Unqueued, waiting is the only safe way
+                // left to destroy the object; queued, it runs on a later collect.
+                if (!queued) {
+                    fn.vkDeviceWaitIdle(device);
+                    run_now = true;
+                }
             }
-            take_ready(ready);
         }
     }
+    if (run_now) action.run(*this, action.handle, action.context);
     for (auto& a : ready) a.run(*this, a.handle, a.context);
 }
 
-void DeviceState::take_ready(std::vector<DeferredAction>& out) noexcept {
+void DeviceState::take_ready(std::vector<DeferredAction>& out) {
     if (deferred_.empty()) return;
     bool all = idle_now();
-    while (!deferred_.empty()) {
-        auto& batch = deferred_.front();
+    std::size_t batches = 0;
+    std::size_t actions = 0;
+    for (const auto& batch : deferred_) {
         bool done = all;
         if (!done) {
             done = true;
@@ -97,7 +104,14 @@ void DeviceState::take_ready(std::vector<DeferredAction>& out) noexcept {
             }
         }
         if (!done) break;
-        for (auto& a : batch.actions) out.push_back(a);
+        ++batches;
+        actions += batch.actions.size();
+    }
+    // The only allocation comes first, so a failure leaves the queue as it was.
+    out.reserve(out.size() + actions);
+    for (; batches > 0; --batches) {
+        auto& batch = deferred_.front();
+        out.insert(out.end(), batch.actions.begin(), batch.actions.end());
         deferred_actions_ -= batch.actions.size();
         deferred_.pop_front();
     }

@@ -58,7 +58,8 @@ public:
 private:
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
-    void take_ready(std::vector<DeferredAction>& out) noexcept;
+    // Moves the actions whose work has completed to out; may throw bad_alloc.
+    void take_ready(std::vector<DeferredAction>& out);
 
     // Actions queued while the same work was pending share one batch.
     struct Batch {
