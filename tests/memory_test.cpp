@@ -629,6 +629,37 @@ TEST_F(PoolTest, DriverPreferenceForDedicatedMemoryIsHonoured) {
     pool.release(view());
 }
 
+// lavapipe allows 2^32 - 1 allocations; the test lowers the cached limit.
+TEST_F(PoolTest, MaxMemoryAllocationCountIsRespected) {
+    auto& limits = physical_device.state()->properties.limits;
+    const auto saved = limits.maxMemoryAllocationCount;
+    limits.maxMemoryAllocationCount = 2;
+    vkrc::DedicatedAllocator dedicated;
+    auto a = dedicated.allocate(view(), request(64));
+    auto b = dedicated.allocate(view(), request(64));
+    try {
+        dedicated.allocate(view(), request(64));
+        ADD_FAILURE() << "no throw";
+    } catch (const vkrc::Error& e) {
+        EXPECT_EQ(e.result(), VK_ERROR_TOO_MANY_OBJECTS);
+    }
+    dedicated.free(view(), a);
+    dedicated.free(view(), b);
+
+    vkrc::PoolAllocator pool(small_blocks());
+    auto x = pool.allocate(view(), request(1 * MiB));  // fills a first block
+    auto y = pool.allocate(view(), request(1 * MiB));  // and a second
+    EXPECT_THROW(pool.allocate(view(), request(1 * MiB)), vkrc::Error);
+    pool.free(view(), x);
+    auto z = pool.allocate(view(), request(1000));  // the freed block still serves
+    EXPECT_EQ(z.memory, x.memory);
+    EXPECT_EQ(pool.statistics(view()).total().block_count, 2u);
+    pool.free(view(), y);
+    pool.free(view(), z);
+    pool.release(view());
+    limits.maxMemoryAllocationCount = saved;
+}
+
 TEST_F(PoolTest, AdoptedBuffersAndImages) {
     VkBufferCreateInfo b{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     b.size = 256;

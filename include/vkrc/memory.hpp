@@ -146,6 +146,7 @@ public:
 private:
     mutable Mutex mutex_;
     AllocatorStatistics stats_;
+    std::uint32_t memory_objects_ = 0;
 };
 
 struct PoolAllocatorCreateInfo {
@@ -159,7 +160,8 @@ struct PoolAllocatorCreateInfo {
 
 // Sub-allocates from large blocks per memory type with TLSF (constant-time
 // good fit, freed neighbours merged); host-visible blocks stay mapped;
-// empty blocks are released keeping at most one spare per memory type. The
+// empty blocks are released keeping at most one spare per memory type; its
+// own VkDeviceMemory count stays within maxMemoryAllocationCount. The
 // device's default allocator. Serves one device at a time; used directly
 // (not through Allocation), call release() before that device goes.
 class PoolAllocator final : public DeviceAllocator {
