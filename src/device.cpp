@@ -29,6 +29,7 @@ DeviceState::~DeviceState() {
         for (auto& action : batch.actions) action.run(*this, action.handle, action.context);
     }
     deferred_.clear();
+    release_allocators();
     for (auto& q : queues) {
         if (q.timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.timeline, nullptr);
     }

@@ -7,3 +7,6 @@
 #include "vkrc/functions.hpp"
 #include "vkrc/handle.hpp"
 #include "vkrc/instance.hpp"
+#include "vkrc/memory.hpp"
+#include "vkrc/resource.hpp"
+#include "vkrc/upload.hpp"

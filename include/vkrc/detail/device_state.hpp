@@ -7,6 +7,7 @@
 #include <deque>
 
 VKRC_BEGIN_NAMESPACE
+class DeviceAllocator;
 namespace detail {
 
 struct QueueState {
@@ -55,6 +56,13 @@ public:
     std::deque<QueueState> queues;  // a deque: Queue handles point into it
     std::atomic<bool> lost{false};
 
+    // Memory (memory.cpp). Every allocator used with the device is kept until
+    // teardown, so that deferred frees can still reach it; teardown runs them
+    // all, then calls each allocator's release() before destroying the device.
+    DeviceAllocator& default_allocator();  // a PoolAllocator, made on first use
+    void keep_allocator(const std::shared_ptr<DeviceAllocator>& allocator);
+    void release_allocators() noexcept;
+
 private:
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
@@ -69,6 +77,9 @@ private:
     mutable Mutex deferred_mutex_;
     std::deque<Batch> deferred_;
     std::size_t deferred_actions_ = 0;
+    Mutex allocators_mutex_;
+    std::vector<std::shared_ptr<DeviceAllocator>> allocators_;  // the default one first, once made
+    DeviceAllocator* default_allocator_ = nullptr;
 };
 
 // Converts any Vulkan handle to the word stored in a DeferredAction.

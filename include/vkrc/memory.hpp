@@ -1,0 +1,371 @@
+// Device memory: the allocator interface, the two allocators vkrc ships,
+// allocations and mapped-memory access.
+//
+// An allocator hands out AllocationInfo values (a range of a VkDeviceMemory);
+// an Allocation owns one of them, keeps its Device alive and returns the
+// range to its allocator, after the GPU is done with it, when its last owner
+// goes. Allocation and free are cold paths (virtual calls, locks); mapped
+// reads and writes are inline memcpy.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <span>
+#include <type_traits>
+
+VKRC_BEGIN_NAMESPACE
+
+class DeviceAllocator;
+
+// What the memory of a resource is for; picks the memory type.
+enum class MemoryUsage : std::uint8_t {
+    gpu_only,  // device-local, not mapped
+    upload,    // host-visible, written by the CPU once and read by the GPU (staging, per-frame data)
+    readback,  // host-visible, preferably cached: written by the GPU, read by the CPU
+    custom,    // only required_flags / preferred_flags decide
+};
+
+// The intent of a resource's memory.
+struct MemoryIntent {
+    MemoryUsage usage = MemoryUsage::gpu_only;
+    // Added to what the usage requires / prefers.
+    VkMemoryPropertyFlags required_flags = 0;
+    VkMemoryPropertyFlags preferred_flags = 0;
+    // Always its own VkDeviceMemory (the driver may also ask for it).
+    bool dedicated = false;
+};
+
+// Everything an allocator needs to place one resource.
+struct AllocationRequest {
+    VkMemoryRequirements requirements{};
+    MemoryIntent intent;
+    // From VkMemoryDedicatedRequirements (Vulkan 1.1 core).
+    bool prefers_dedicated = false;
+    bool requires_dedicated = false;
+    // The resource, for VkMemoryDedicatedAllocateInfo when dedicated; at most one set.
+    VkBuffer dedicated_buffer = VK_NULL_HANDLE;
+    VkImage dedicated_image = VK_NULL_HANDLE;
+    // Buffers and linear images are "linear"; optimal-tiling images are not
+    // (bufferImageGranularity separates the two).
+    bool linear = true;
+};
+
+// A range of device memory as an allocator describes it.
+struct AllocationInfo {
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceSize offset = 0;       // of the range in memory
+    VkDeviceSize size = 0;         // usable bytes, at least the requested size
+    VkDeviceSize memory_size = 0;  // of the whole VkDeviceMemory (the block)
+    std::uint32_t memory_type = 0;
+    std::byte* mapped = nullptr;   // host address of offset; null when not host-visible
+    bool dedicated = false;        // the range is the whole of its own VkDeviceMemory
+    // Set by the allocator that made the range; free checks it.
+    const DeviceAllocator* allocator = nullptr;
+    void* allocator_data = nullptr;  // the allocator's own bookkeeping
+};
+
+// A non-owning view of a device for allocator calls: an allocator the device
+// keeps must not hold a Device handle (that would be a reference cycle).
+class DeviceView {
+public:
+    explicit DeviceView(detail::DeviceState& state) noexcept : s_(&state) {}
+    VkDevice vk() const noexcept { return s_->device; }
+    const DeviceFunctions& fn() const noexcept { return s_->fn; }
+    const PhysicalDevice& physical_device() const noexcept { return s_->physical_device; }
+    const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept {
+        return s_->physical_device.memory_properties();
+    }
+    const VkPhysicalDeviceLimits& limits() const noexcept { return s_->physical_device.properties().limits; }
+    bool extension_enabled(const char* name) const noexcept;
+    detail::DeviceState& state() const noexcept { return *s_; }
+    friend bool operator==(DeviceView a, DeviceView b) noexcept { return a.s_ == b.s_; }
+
+private:
+    detail::DeviceState* s_;
+};
+
+// Per heap: what an allocator holds and hands out, and the driver's budget.
+struct HeapStatistics {
+    VkDeviceSize block_bytes = 0;       // reserved with vkAllocateMemory
+    VkDeviceSize allocation_bytes = 0;  // handed out to resources
+    std::uint32_t block_count = 0;      // VkDeviceMemory objects
+    std::uint32_t allocation_count = 0;
+    // VK_EXT_memory_budget when enabled, else the heap size and block_bytes.
+    VkDeviceSize budget = 0;
+    VkDeviceSize usage = 0;
+};
+
+struct AllocatorStatistics {
+    std::array<HeapStatistics, VK_MAX_MEMORY_HEAPS> heaps{};
+    std::uint32_t heap_count = 0;
+    std::uint64_t vk_allocate_calls = 0;  // vkAllocateMemory calls made so far
+    HeapStatistics total() const noexcept;
+};
+
+// The pluggable allocator. Implementations allocate and free ranges; vkrc
+// calls them on cold paths only. The device keeps every allocator used with
+// it until its own teardown (so that deferred frees can run), then calls
+// release(). Thread safety under the multi-thread policy is the allocator's.
+class DeviceAllocator {
+public:
+    virtual ~DeviceAllocator() = default;
+    // Returns a range with info.allocator == this, or throws (vkrc::Error,
+    // vkrc::UsageError). Memory types are chosen with choose_memory_type.
+    virtual AllocationInfo allocate(DeviceView device, const AllocationRequest& request) = 0;
+    // Takes back a range this allocator made. Throws UsageError for a range
+    // from another allocator (and frees nothing).
+    virtual void free(DeviceView device, const AllocationInfo& allocation) = 0;
+    // The device is being destroyed and every range made on it was freed:
+    // give back what is cached.
+    virtual void release(DeviceView device) noexcept { (void)device; }
+    virtual AllocatorStatistics statistics(DeviceView device) const;
+};
+
+// The memory type for type_bits and intent: the lowest index with every
+// required flag and the most preferred (and fewest avoided) flags; -1 if none.
+int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
+                     const MemoryIntent& intent) noexcept;
+// find_memory_type, throwing UsageError naming who asked when there is none.
+std::uint32_t choose_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
+                                 const MemoryIntent& intent, const char* who);
+// Whether a memory type must be mapped (host-visible intent or required flag).
+bool intent_needs_mapping(const MemoryIntent& intent) noexcept;
+
+// One vkAllocateMemory per resource: the baseline.
+class DedicatedAllocator final : public DeviceAllocator {
+public:
+    AllocationInfo allocate(DeviceView device, const AllocationRequest& request) override;
+    void free(DeviceView device, const AllocationInfo& allocation) override;
+    AllocatorStatistics statistics(DeviceView device) const override;
+
+private:
+    mutable Mutex mutex_;
+    AllocatorStatistics stats_;
+    std::uint32_t memory_objects_ = 0;
+};
+
+struct PoolAllocatorCreateInfo {
+    // Blocks start at min_block_size and double up to max_block_size (both
+    // capped at an eighth of small heaps).
+    VkDeviceSize min_block_size = VkDeviceSize{64} << 20;
+    VkDeviceSize max_block_size = VkDeviceSize{256} << 20;
+    // Requests larger than this get their own VkDeviceMemory; 0: max_block_size / 2.
+    VkDeviceSize dedicated_threshold = 0;
+};
+
+// Sub-allocates from large blocks per memory type with TLSF (constant-time
+// good fit, freed neighbours merged); host-visible blocks stay mapped;
+// empty blocks are released keeping at most one spare per memory type; its
+// own VkDeviceMemory count stays within maxMemoryAllocationCount. The
+// device's default allocator. Serves one device at a time; used directly
+// (not through Allocation), call release() before that device goes.
+class PoolAllocator final : public DeviceAllocator {
+public:
+    explicit PoolAllocator(const PoolAllocatorCreateInfo& info = {});
+    ~PoolAllocator() override;
+    PoolAllocator(const PoolAllocator&) = delete;
+    PoolAllocator& operator=(const PoolAllocator&) = delete;
+
+    AllocationInfo allocate(DeviceView device, const AllocationRequest& request) override;
+    void free(DeviceView device, const AllocationInfo& allocation) override;
+    void release(DeviceView device) noexcept override;
+    AllocatorStatistics statistics(DeviceView device) const override;
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+// Adds VK_EXT_memory_budget's budget and usage (or the heap sizes) to stats.
+void fill_budget(DeviceView device, AllocatorStatistics& stats) noexcept;
+
+namespace detail {
+
+// A flush/invalidate range in VkDeviceMemory coordinates.
+struct MemoryRange {
+    VkDeviceSize offset = 0;
+    VkDeviceSize size = 0;
+    friend bool operator==(const MemoryRange&, const MemoryRange&) = default;
+};
+
+// The range to flush or invalidate for bytes [offset, offset + size) of an
+// allocation (size VK_WHOLE_SIZE: to its end) at allocation_offset with
+// allocation_size bytes inside a VkDeviceMemory of memory_size bytes: rounded
+// out to atom (nonCoherentAtomSize), its end clamped to the allocation's end
+// rounded up to atom and to the memory's end. Vulkan's rule holds for the
+// result: offset is a multiple of atom, size is one or reaches the memory's
+// end. The caller has checked that the bytes lie in the allocation.
+constexpr MemoryRange mapped_range(VkDeviceSize allocation_offset, VkDeviceSize allocation_size,
+                                   VkDeviceSize memory_size, VkDeviceSize atom, VkDeviceSize offset,
+                                   VkDeviceSize size) noexcept {
+    const VkDeviceSize begin = allocation_offset + offset;
+    const VkDeviceSize end = size == VK_WHOLE_SIZE ? allocation_offset + allocation_size : begin + size;
+    if (end <= begin) return {begin - begin % atom, 0};
+    const VkDeviceSize first = begin - begin % atom;
+    const VkDeviceSize allocation_end = allocation_offset + allocation_size;
+    VkDeviceSize limit = allocation_end + (atom - allocation_end % atom) % atom;
+    if (limit > memory_size) limit = memory_size;
+    VkDeviceSize last = end + (atom - end % atom) % atom;
+    if (last > limit) last = limit;
+    return {first, last - first};
+}
+
+struct AllocationState final : RefCounted {
+    Ref<DeviceState> device;
+    AllocationInfo info;
+    DeviceAllocator* allocator = nullptr;
+    VkDeviceSize atom = 1;
+    bool coherent = true;
+
+    void flush(VkDeviceSize offset, VkDeviceSize size) const;
+    void invalidate(VkDeviceSize offset, VkDeviceSize size) const;
+
+private:
+    void on_last_release() noexcept override;
+};
+
+[[noreturn]] void throw_not_host_visible(const char* who);
+[[noreturn]] void throw_out_of_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
+                                     VkDeviceSize size);
+
+// Checks that count elements of element bytes at offset fit in size bytes,
+// without overflowing.
+inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
+                               VkDeviceSize size) {
+    if (element != 0 && count > std::numeric_limits<VkDeviceSize>::max() / element) [[unlikely]] {
+        throw_out_of_range(who, offset, count, element, size);
+    }
+    const VkDeviceSize bytes = VkDeviceSize(count) * element;
+    if (offset > size || bytes > size - offset) [[unlikely]] throw_out_of_range(who, offset, count, element, size);
+}
+
+}  // namespace detail
+
+// Writes to upload memory. Reading write-combined memory is slow, so this
+// view has no read; it flushes each write on non-coherent memory. It points
+// into its Allocation's state: use it while the Allocation lives.
+class WriteOnlyView {
+public:
+    template <class T>
+    void write(VkDeviceSize offset, const T* data, std::size_t count) const {
+        static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
+#if VKRC_RUNTIME_CHECKS
+        detail::check_mapped_range("vkrc::WriteOnlyView::write", offset, count, sizeof(T), s_->info.size);
+#endif
+        if (count == 0) return;
+        std::memcpy(s_->info.mapped + offset, data, count * sizeof(T));
+        if (!s_->coherent) [[unlikely]] s_->flush(offset, count * sizeof(T));
+    }
+    template <class T>
+    void write(VkDeviceSize offset, std::span<const T> data) const {
+        write(offset, data.data(), data.size());
+    }
+    template <class T>
+    void write_value(VkDeviceSize offset, const T& value) const {
+        write(offset, &value, 1);
+    }
+    VkDeviceSize size() const noexcept { return s_->info.size; }
+
+private:
+    friend class Allocation;
+    explicit WriteOnlyView(const detail::AllocationState* s) noexcept : s_(s) {}
+    const detail::AllocationState* s_;
+};
+
+// A range of device memory owned by its handles; keeps its Device alive and
+// returns itself to its allocator once the last owner is gone and the GPU
+// work submitted before then has completed.
+class Allocation : public Handle<detail::AllocationState> {
+public:
+    Allocation() noexcept = default;
+    // Allocates for request from allocator (null: the device's default).
+    static Allocation create(const Device& device, const AllocationRequest& request,
+                             const std::shared_ptr<DeviceAllocator>& allocator = nullptr);
+
+    const AllocationInfo& info() const noexcept { return state_->info; }
+    VkDeviceMemory memory() const noexcept { return state_->info.memory; }
+    VkDeviceSize offset() const noexcept { return state_->info.offset; }
+    VkDeviceSize size() const noexcept { return state_->info.size; }
+    std::uint32_t memory_type() const noexcept { return state_->info.memory_type; }
+    bool host_visible() const noexcept { return state_->info.mapped != nullptr; }
+    bool host_coherent() const noexcept { return state_->coherent; }
+    // Host address of the first byte; null when not host-visible.
+    std::byte* mapped() const noexcept { return state_->info.mapped; }
+    DeviceAllocator& allocator() const noexcept { return *state_->allocator; }
+
+    // Copies count elements to offset (bytes) and flushes them on non-coherent
+    // memory. Any alignment of offset is fine. Throws UsageError when the
+    // memory is not host-visible and (with VKRC_RUNTIME_CHECKS) when the bytes
+    // do not fit or count * sizeof(T) overflows.
+    template <class T>
+    void write(VkDeviceSize offset, const T* data, std::size_t count) const {
+        static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
+        auto& s = *state_;
+        if (!s.info.mapped) [[unlikely]] detail::throw_not_host_visible("vkrc::Allocation::write");
+#if VKRC_RUNTIME_CHECKS
+        detail::check_mapped_range("vkrc::Allocation::write", offset, count, sizeof(T), s.info.size);
+#endif
+        if (count == 0) return;
+        std::memcpy(s.info.mapped + offset, data, count * sizeof(T));
+        if (!s.coherent) [[unlikely]] s.flush(offset, count * sizeof(T));
+    }
+    template <class T>
+    void write(VkDeviceSize offset, std::span<const T> data) const {
+        write(offset, data.data(), data.size());
+    }
+    template <class T>
+    void write_value(VkDeviceSize offset, const T& value) const {
+        write(offset, &value, 1);
+    }
+    // Invalidates the bytes on non-coherent memory, then copies them out.
+    template <class T>
+    void read(VkDeviceSize offset, T* out, std::size_t count) const {
+        static_assert(std::is_trivially_copyable_v<T>, "mapped reads copy bytes");
+        auto& s = *state_;
+        if (!s.info.mapped) [[unlikely]] detail::throw_not_host_visible("vkrc::Allocation::read");
+#if VKRC_RUNTIME_CHECKS
+        detail::check_mapped_range("vkrc::Allocation::read", offset, count, sizeof(T), s.info.size);
+#endif
+        if (count == 0) return;
+        if (!s.coherent) [[unlikely]] s.invalidate(offset, count * sizeof(T));
+        std::memcpy(out, s.info.mapped + offset, count * sizeof(T));
+    }
+    template <class T>
+    void read(VkDeviceSize offset, std::span<T> out) const {
+        read(offset, out.data(), out.size());
+    }
+    template <class T>
+    T read_value(VkDeviceSize offset) const {
+        T value;
+        read(offset, &value, 1);
+        return value;
+    }
+    // For upload memory: a view that can only write.
+    WriteOnlyView write_only() const {
+        if (!state_->info.mapped) detail::throw_not_host_visible("vkrc::Allocation::write_only");
+        return WriteOnlyView(state_.get());
+    }
+
+    // For writes through mapped(): size VK_WHOLE_SIZE means to the end.
+    // Both do nothing on coherent memory.
+    void flush(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;
+    void invalidate(VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) const;
+
+private:
+    using Handle::Handle;
+    friend class Buffer;
+    friend class Image;
+};
+
+// The device's default allocator (a PoolAllocator, made on first use).
+DeviceAllocator& default_allocator(const Device& device);
+// Statistics of the device's default allocator, with the budget.
+AllocatorStatistics memory_statistics(const Device& device);
+
+VKRC_END_NAMESPACE

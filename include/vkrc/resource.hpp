@@ -1,0 +1,265 @@
+// Buffers, images, their views, and samplers.
+#pragma once
+
+#include "vkrc/memory.hpp"
+
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+struct BufferState;
+struct ImageState;
+struct ImageViewState;
+struct BufferViewState;
+struct SamplerState;
+}  // namespace detail
+
+// Mirrors VkBufferCreateInfo, plus where its memory comes from.
+struct BufferCreateInfo {
+    VkBufferCreateFlags flags = 0;
+    VkDeviceSize size = 0;
+    VkBufferUsageFlags usage = 0;
+    VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
+    std::vector<std::uint32_t> queue_family_indices;
+    MemoryIntent memory;
+    // Null: the device's default allocator (a PoolAllocator).
+    std::shared_ptr<DeviceAllocator> allocator;
+    const void* next = nullptr;
+};
+
+// A buffer bound to its own Allocation; keeps its Device and memory alive.
+class Buffer : public Handle<detail::BufferState> {
+public:
+    Buffer() noexcept = default;
+    static Buffer create(const Device& device, const BufferCreateInfo& info);
+    // Wraps a buffer made elsewhere, its memory bound by its maker: the
+    // result has no Allocation. With Ownership::owned vkrc destroys it.
+    static Buffer adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
+                        Ownership ownership);
+
+    VkBuffer vk() const noexcept;
+    VkDeviceSize size() const noexcept;
+    VkBufferUsageFlags usage() const noexcept;
+    const Device& device() const noexcept;
+    // Mapped access goes through the allocation: buffer.allocation().write(0, span).
+    // Empty for an adopted buffer.
+    const Allocation& allocation() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkImageCreateInfo, plus where its memory comes from.
+struct ImageCreateInfo {
+    VkImageCreateFlags flags = 0;
+    VkImageType image_type = VK_IMAGE_TYPE_2D;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkExtent3D extent{1, 1, 1};
+    std::uint32_t mip_levels = 1;
+    std::uint32_t array_layers = 1;
+    VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
+    VkImageTiling tiling = VK_IMAGE_TILING_OPTIMAL;
+    VkImageUsageFlags usage = 0;
+    VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
+    std::vector<std::uint32_t> queue_family_indices;
+    VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    MemoryIntent memory;
+    std::shared_ptr<DeviceAllocator> allocator;
+    const void* next = nullptr;
+};
+
+// An image bound to its own Allocation; keeps its Device and memory alive.
+class Image : public Handle<detail::ImageState> {
+public:
+    Image() noexcept = default;
+    static Image create(const Device& device, const ImageCreateInfo& info);
+    // Wraps an image made elsewhere (a swapchain's, with Ownership::borrowed);
+    // info describes it (its memory and allocator fields are ignored). The
+    // result has no Allocation. With Ownership::owned vkrc destroys it.
+    static Image adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership);
+
+    VkImage vk() const noexcept;
+    VkImageType image_type() const noexcept;
+    VkFormat format() const noexcept;
+    VkExtent3D extent() const noexcept;
+    // The extent of a mip level (each dimension halved per level, at least 1).
+    VkExtent3D extent(std::uint32_t mip_level) const noexcept;
+    std::uint32_t mip_levels() const noexcept;
+    std::uint32_t array_layers() const noexcept;
+    VkSampleCountFlagBits samples() const noexcept;
+    VkImageUsageFlags usage() const noexcept;
+    const Device& device() const noexcept;
+    const Allocation& allocation() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkImageViewCreateInfo (the image is the parent).
+struct ImageViewCreateInfo {
+    VkImageViewCreateFlags flags = 0;
+    VkImageViewType view_type = VK_IMAGE_VIEW_TYPE_2D;
+    VkFormat format = VK_FORMAT_UNDEFINED;  // UNDEFINED: the image's format
+    VkComponentMapping components{};
+    // aspectMask 0: colour, or depth for depth formats (and stencil for depth-stencil ones).
+    VkImageSubresourceRange subresource_range{0, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+    const void* next = nullptr;
+};
+
+// Keeps its Image (and so the image's memory and Device) alive.
+class ImageView : public Handle<detail::ImageViewState> {
+public:
+    ImageView() noexcept = default;
+    static ImageView create(const Image& image, const ImageViewCreateInfo& info = {});
+
+    VkImageView vk() const noexcept;
+    const Image& image() const noexcept;
+    VkFormat format() const noexcept;
+    const VkImageSubresourceRange& subresource_range() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkBufferViewCreateInfo (the buffer is the parent).
+struct BufferViewCreateInfo {
+    VkBufferViewCreateFlags flags = 0;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkDeviceSize offset = 0;
+    VkDeviceSize range = VK_WHOLE_SIZE;
+    const void* next = nullptr;
+};
+
+// Keeps its Buffer alive.
+class BufferView : public Handle<detail::BufferViewState> {
+public:
+    BufferView() noexcept = default;
+    static BufferView create(const Buffer& buffer, const BufferViewCreateInfo& info);
+
+    VkBufferView vk() const noexcept;
+    const Buffer& buffer() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors VkSamplerCreateInfo.
+struct SamplerCreateInfo {
+    VkSamplerCreateFlags flags = 0;
+    VkFilter mag_filter = VK_FILTER_LINEAR;
+    VkFilter min_filter = VK_FILTER_LINEAR;
+    VkSamplerMipmapMode mipmap_mode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+    VkSamplerAddressMode address_mode_u = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    VkSamplerAddressMode address_mode_v = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    VkSamplerAddressMode address_mode_w = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    float mip_lod_bias = 0.0f;
+    bool anisotropy_enable = false;
+    float max_anisotropy = 1.0f;
+    bool compare_enable = false;
+    VkCompareOp compare_op = VK_COMPARE_OP_ALWAYS;
+    float min_lod = 0.0f;
+    float max_lod = VK_LOD_CLAMP_NONE;
+    VkBorderColor border_color = VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK;
+    bool unnormalized_coordinates = false;
+    const void* next = nullptr;
+};
+
+class Sampler : public Handle<detail::SamplerState> {
+public:
+    Sampler() noexcept = default;
+    static Sampler create(const Device& device, const SamplerCreateInfo& info = {});
+
+    VkSampler vk() const noexcept;
+    const Device& device() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// The aspects of a format: depth and/or stencil, or colour.
+VkImageAspectFlags format_aspects(VkFormat format) noexcept;
+
+namespace detail {
+
+struct BufferState final : RefCounted {
+    ~BufferState() override;
+    Device device;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceSize size = 0;
+    VkBufferUsageFlags usage = 0;
+    Ownership ownership = Ownership::owned;
+    Allocation allocation;  // released after the buffer's destruction is queued
+};
+
+struct ImageState final : RefCounted {
+    ~ImageState() override;
+    Device device;
+    VkImage image = VK_NULL_HANDLE;
+    VkImageType image_type = VK_IMAGE_TYPE_2D;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkExtent3D extent{};
+    std::uint32_t mip_levels = 1;
+    std::uint32_t array_layers = 1;
+    VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
+    VkImageUsageFlags usage = 0;
+    Ownership ownership = Ownership::owned;
+    Allocation allocation;
+};
+
+struct ImageViewState final : RefCounted {
+    ~ImageViewState() override;
+    Image image;
+    VkImageView view = VK_NULL_HANDLE;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    VkImageSubresourceRange range{};
+};
+
+struct BufferViewState final : RefCounted {
+    ~BufferViewState() override;
+    Buffer buffer;
+    VkBufferView view = VK_NULL_HANDLE;
+};
+
+struct SamplerState final : RefCounted {
+    ~SamplerState() override;
+    Device device;
+    VkSampler sampler = VK_NULL_HANDLE;
+};
+
+}  // namespace detail
+
+inline VkBuffer Buffer::vk() const noexcept { return state_->buffer; }
+inline VkDeviceSize Buffer::size() const noexcept { return state_->size; }
+inline VkBufferUsageFlags Buffer::usage() const noexcept { return state_->usage; }
+inline const Device& Buffer::device() const noexcept { return state_->device; }
+inline const Allocation& Buffer::allocation() const noexcept { return state_->allocation; }
+
+inline VkImage Image::vk() const noexcept { return state_->image; }
+inline VkImageType Image::image_type() const noexcept { return state_->image_type; }
+inline VkFormat Image::format() const noexcept { return state_->format; }
+inline VkExtent3D Image::extent() const noexcept { return state_->extent; }
+inline VkExtent3D Image::extent(std::uint32_t level) const noexcept {
+    auto e = state_->extent;
+    auto half = [level](std::uint32_t v) { return v >> level ? v >> level : 1u; };
+    return {half(e.width), half(e.height), half(e.depth)};
+}
+inline std::uint32_t Image::mip_levels() const noexcept { return state_->mip_levels; }
+inline std::uint32_t Image::array_layers() const noexcept { return state_->array_layers; }
+inline VkSampleCountFlagBits Image::samples() const noexcept { return state_->samples; }
+inline VkImageUsageFlags Image::usage() const noexcept { return state_->usage; }
+inline const Device& Image::device() const noexcept { return state_->device; }
+inline const Allocation& Image::allocation() const noexcept { return state_->allocation; }
+
+inline VkImageView ImageView::vk() const noexcept { return state_->view; }
+inline const Image& ImageView::image() const noexcept { return state_->image; }
+inline VkFormat ImageView::format() const noexcept { return state_->format; }
+inline const VkImageSubresourceRange& ImageView::subresource_range() const noexcept { return state_->range; }
+
+inline VkBufferView BufferView::vk() const noexcept { return state_->view; }
+inline const Buffer& BufferView::buffer() const noexcept { return state_->buffer; }
+
+inline VkSampler Sampler::vk() const noexcept { return state_->sampler; }
+inline const Device& Sampler::device() const noexcept { return state_->device; }
+
+VKRC_END_NAMESPACE

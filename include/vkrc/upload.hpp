@@ -1,0 +1,47 @@
+// Staging transfers: uploads into buffers and images (every mip level and
+// array layer, with the layout transitions) and downloads for reading back.
+// Each call records one command buffer from a transient pool, submits it on
+// the queue and waits for it: for loading and for tests, not per frame.
+#pragma once
+
+#include "vkrc/resource.hpp"
+
+#include <vector>
+
+VKRC_BEGIN_NAMESPACE
+
+// Bytes per texel of an uncompressed colour format; 0 for formats the
+// staging functions do not handle (compressed, depth/stencil, planar).
+std::uint32_t format_texel_size(VkFormat format) noexcept;
+
+// Copies data to buffer at offset through a staging buffer. The buffer needs
+// VK_BUFFER_USAGE_TRANSFER_DST_BIT. Later submits on any queue see the data.
+void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data);
+
+// Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
+std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size);
+
+struct ImageUploadInfo {
+    // The image's layout before the upload; UNDEFINED discards its contents.
+    VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    // The layout the image is left in, for the work that reads it next.
+    VkImageLayout new_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+};
+
+// Bytes upload_image expects: every mip level of every array layer, tightly
+// packed, level by level and within a level layer by layer (level 0 layer 0,
+// level 0 layer 1, ..., level 1 layer 0, ...).
+VkDeviceSize image_data_size(const Image& image);
+
+// Fills every mip level and array layer of a colour image (needs
+// VK_IMAGE_USAGE_TRANSFER_DST_BIT) from data laid out as image_data_size says.
+void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
+                  const ImageUploadInfo& info = {});
+
+// Copies one mip level of one array layer of a colour image (needs
+// VK_IMAGE_USAGE_TRANSFER_SRC_BIT), tightly packed. The image is in layout
+// and is left in it.
+std::vector<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout,
+                                      std::uint32_t mip_level = 0, std::uint32_t array_layer = 0);
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,26 @@
+// Helpers shared by the allocators (not installed).
+#pragma once
+
+#include "vkrc/memory.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+namespace detail {
+
+std::string hex(std::uint64_t v);
+std::string bytes_text(VkDeviceSize n);
+// Throws UsageError for a zero size, two dedicated resources, or a size larger than the heap.
+void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who);
+// vkAllocateMemory (with VkMemoryDedicatedAllocateInfo when a resource is given),
+// mapped whole when host-visible.
+VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,
+                                      VkBuffer dedicated_buffer, VkImage dedicated_image, std::byte** mapped);
+
+// Vulkan's alignments are powers of two; the division is for anything else.
+constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {
+    return (a & (a - 1)) == 0 ? (v + a - 1) & ~(a - 1) : (v + a - 1) / a * a;
+}
+
+}  // namespace detail
+VKRC_END_NAMESPACE

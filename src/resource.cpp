@@ -1,0 +1,230 @@
+#include "vkrc/resource.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+// Each state queues its handle's destruction in its destructor body; its
+// members (the allocation, then the parents) are released after, so FIFO
+// order destroys the handle before its memory returns and before its parent.
+BufferState::~BufferState() {
+    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
+}
+ImageState::~ImageState() {
+    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
+}
+ImageViewState::~ImageViewState() {
+    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view);
+}
+BufferViewState::~BufferViewState() {
+    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view);
+}
+SamplerState::~SamplerState() {
+    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler);
+}
+
+}  // namespace detail
+
+namespace {
+
+AllocationRequest make_request(const VkMemoryRequirements2& requirements, const VkMemoryDedicatedRequirements& dedicated,
+                               const MemoryIntent& intent) {
+    AllocationRequest request;
+    request.requirements = requirements.memoryRequirements;
+    request.intent = intent;
+    request.prefers_dedicated = dedicated.prefersDedicatedAllocation;
+    request.requires_dedicated = dedicated.requiresDedicatedAllocation;
+    return request;
+}
+
+}  // namespace
+
+Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::Buffer::create: the Device handle is empty");
+    if (info.size == 0) throw UsageError("vkrc::Buffer::create: size is 0");
+    if (info.usage == 0) throw UsageError("vkrc::Buffer::create: usage is 0");
+    VkBufferCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, info.next};
+    create.flags = info.flags;
+    create.size = info.size;
+    create.usage = info.usage;
+    create.sharingMode = info.sharing_mode;
+    create.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
+    create.pQueueFamilyIndices = info.queue_family_indices.data();
+
+    // The state owns the buffer from here, so a failure below destroys it.
+    detail::Ref<detail::BufferState> state(new detail::BufferState);
+    check(device.fn().vkCreateBuffer(device.vk(), &create, nullptr, &state->buffer), "vkCreateBuffer");
+    state->device = device;
+    state->size = info.size;
+    state->usage = info.usage;
+
+    VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
+    VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
+    VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->buffer};
+    device.fn().vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
+    AllocationRequest request = make_request(requirements, dedicated, info.memory);
+    request.dedicated_buffer = state->buffer;
+    request.linear = true;
+    state->allocation = Allocation::create(device, request, info.allocator);
+    check(device.fn().vkBindBufferMemory(device.vk(), state->buffer, state->allocation.memory(),
+                                         state->allocation.offset()),
+          "vkBindBufferMemory");
+    return Buffer(std::move(state));
+}
+
+Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
+                     Ownership ownership) {
+    if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
+    if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
+    detail::Ref<detail::BufferState> state(new detail::BufferState);
+    state->ownership = ownership;
+    state->device = device;
+    state->buffer = buffer;
+    state->size = size;
+    state->usage = usage;
+    return Buffer(std::move(state));
+}
+
+VkImageAspectFlags format_aspects(VkFormat format) noexcept {
+    switch (format) {
+        case VK_FORMAT_D16_UNORM:
+        case VK_FORMAT_X8_D24_UNORM_PACK32:
+        case VK_FORMAT_D32_SFLOAT: return VK_IMAGE_ASPECT_DEPTH_BIT;
+        case VK_FORMAT_S8_UINT: return VK_IMAGE_ASPECT_STENCIL_BIT;
+        case VK_FORMAT_D16_UNORM_S8_UINT:
+        case VK_FORMAT_D24_UNORM_S8_UINT:
+        case VK_FORMAT_D32_SFLOAT_S8_UINT: return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
+        default: return VK_IMAGE_ASPECT_COLOR_BIT;
+    }
+}
+
+Image Image::create(const Device& device, const ImageCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::Image::create: the Device handle is empty");
+    if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::Image::create: format is VK_FORMAT_UNDEFINED");
+    if (info.extent.width == 0 || info.extent.height == 0 || info.extent.depth == 0) {
+        throw UsageError("vkrc::Image::create: extent has a zero dimension");
+    }
+    if (info.mip_levels == 0 || info.array_layers == 0) {
+        throw UsageError("vkrc::Image::create: mip_levels and array_layers must be at least 1");
+    }
+    if (info.usage == 0) throw UsageError("vkrc::Image::create: usage is 0");
+    VkImageCreateInfo create{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, info.next};
+    create.flags = info.flags;
+    create.imageType = info.image_type;
+    create.format = info.format;
+    create.extent = info.extent;
+    create.mipLevels = info.mip_levels;
+    create.arrayLayers = info.array_layers;
+    create.samples = info.samples;
+    create.tiling = info.tiling;
+    create.usage = info.usage;
+    create.sharingMode = info.sharing_mode;
+    create.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
+    create.pQueueFamilyIndices = info.queue_family_indices.data();
+    create.initialLayout = info.initial_layout;
+
+    detail::Ref<detail::ImageState> state(new detail::ImageState);
+    check(device.fn().vkCreateImage(device.vk(), &create, nullptr, &state->image), "vkCreateImage");
+    state->device = device;
+    state->image_type = info.image_type;
+    state->format = info.format;
+    state->extent = info.extent;
+    state->mip_levels = info.mip_levels;
+    state->array_layers = info.array_layers;
+    state->samples = info.samples;
+    state->usage = info.usage;
+
+    VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
+    VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
+    VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->image};
+    device.fn().vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
+    AllocationRequest request = make_request(requirements, dedicated, info.memory);
+    request.dedicated_image = state->image;
+    request.linear = info.tiling == VK_IMAGE_TILING_LINEAR;
+    state->allocation = Allocation::create(device, request, info.allocator);
+    check(device.fn().vkBindImageMemory(device.vk(), state->image, state->allocation.memory(),
+                                        state->allocation.offset()),
+          "vkBindImageMemory");
+    return Image(std::move(state));
+}
+
+Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership) {
+    if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
+    if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
+    detail::Ref<detail::ImageState> state(new detail::ImageState);
+    state->ownership = ownership;
+    state->device = device;
+    state->image = image;
+    state->image_type = info.image_type;
+    state->format = info.format;
+    state->extent = info.extent;
+    state->mip_levels = info.mip_levels;
+    state->array_layers = info.array_layers;
+    state->samples = info.samples;
+    state->usage = info.usage;
+    return Image(std::move(state));
+}
+
+ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info) {
+    if (!image) throw UsageError("vkrc::ImageView::create: the Image handle is empty");
+    VkImageViewCreateInfo create{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.next};
+    create.flags = info.flags;
+    create.image = image.vk();
+    create.viewType = info.view_type;
+    create.format = info.format == VK_FORMAT_UNDEFINED ? image.format() : info.format;
+    create.components = info.components;
+    create.subresourceRange = info.subresource_range;
+    if (create.subresourceRange.aspectMask == 0) create.subresourceRange.aspectMask = format_aspects(create.format);
+    detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
+    const auto& device = image.device();
+    check(device.fn().vkCreateImageView(device.vk(), &create, nullptr, &state->view), "vkCreateImageView");
+    state->image = image;
+    state->format = create.format;
+    state->range = create.subresourceRange;
+    return ImageView(std::move(state));
+}
+
+BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& info) {
+    if (!buffer) throw UsageError("vkrc::BufferView::create: the Buffer handle is empty");
+    if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::BufferView::create: format is VK_FORMAT_UNDEFINED");
+    VkBufferViewCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO, info.next};
+    create.flags = info.flags;
+    create.buffer = buffer.vk();
+    create.format = info.format;
+    create.offset = info.offset;
+    create.range = info.range;
+    detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
+    const auto& device = buffer.device();
+    check(device.fn().vkCreateBufferView(device.vk(), &create, nullptr, &state->view), "vkCreateBufferView");
+    state->buffer = buffer;
+    return BufferView(std::move(state));
+}
+
+Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::Sampler::create: the Device handle is empty");
+    VkSamplerCreateInfo create{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.next};
+    create.flags = info.flags;
+    create.magFilter = info.mag_filter;
+    create.minFilter = info.min_filter;
+    create.mipmapMode = info.mipmap_mode;
+    create.addressModeU = info.address_mode_u;
+    create.addressModeV = info.address_mode_v;
+    create.addressModeW = info.address_mode_w;
+    create.mipLodBias = info.mip_lod_bias;
+    create.anisotropyEnable = info.anisotropy_enable ? VK_TRUE : VK_FALSE;
+    create.maxAnisotropy = info.max_anisotropy;
+    create.compareEnable = info.compare_enable ? VK_TRUE : VK_FALSE;
+    create.compareOp = info.compare_op;
+    create.minLod = info.min_lod;
+    create.maxLod = info.max_lod;
+    create.borderColor = info.border_color;
+    create.unnormalizedCoordinates = info.unnormalized_coordinates ? VK_TRUE : VK_FALSE;
+    detail::Ref<detail::SamplerState> state(new detail::SamplerState);
+    check(device.fn().vkCreateSampler(device.vk(), &create, nullptr, &state->sampler), "vkCreateSampler");
+    state->device = device;
+    return Sampler(std::move(state));
+}
+
+VKRC_END_NAMESPACE
