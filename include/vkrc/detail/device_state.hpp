@@ -5,6 +5,7 @@
 #include "vkrc/device.hpp"
 
 #include <deque>
+#include <memory>  // shared_ptr of user allocators
 
 VKRC_BEGIN_NAMESPACE
 class DeviceAllocator;
