@@ -34,6 +34,7 @@ constexpr double frame_step = 1.0 / 60.0;  // simulated seconds per frame
 constexpr double reference_time = 1.25;   // the image check's fixed time
 constexpr int block_frames = 25;           // measured frames per variant per block
 constexpr int warmup_frames = 30;          // per variant, before the first block
+constexpr int preinit_rounds = 5;          // timed inits per variant
 constexpr int finest_tessellation = 32;    // the image error's reference level
 
 struct Options {
@@ -115,7 +116,7 @@ std::string config_tag(const Config& c) {
 
 struct VariantResult {
     std::string name;
-    std::vector<double> stage_us[stage_count];  // preinit holds one sample
+    std::vector<double> stage_us[stage_count];  // preinit holds preinit_rounds samples
     std::vector<std::uint8_t> image;
     std::size_t differing_pixels = 0;
     int max_channel_difference = 0;
@@ -184,18 +185,27 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
     ConfigResult result;
     result.config = config;
     result.frames = frames;
-    std::vector<std::unique_ptr<Variant>> variants;
+    std::vector<std::unique_ptr<Variant>> variants(options.variants.size());
     std::vector<std::uint64_t> frame_counters(options.variants.size(), 0);
     for (const std::string& name : options.variants) {
-        for (const auto& entry : variant_registry())
-            if (entry.name == name) variants.push_back(entry.make());
         VariantResult r;
         r.name = name;
-        auto start = clock::now();
-        variants.back()->init(config, scene);
-        r.stage_us[0].push_back(std::chrono::duration<double, std::micro>(clock::now() - start).count());
         result.variants.push_back(std::move(r));
     }
+    // preinit: an untimed round first (the process's first instance pays for
+    // loading the driver), then preinit_rounds timed ones in rotating order,
+    // tearing down all but the last round's variants.
+    for (int round = 0; round <= preinit_rounds; ++round)
+        for (std::size_t k = 0; k < variants.size(); ++k) {
+            std::size_t v = (k + std::size_t(round)) % variants.size();
+            variants[v].reset();
+            for (const auto& entry : variant_registry())
+                if (entry.name == options.variants[v]) variants[v] = entry.make();
+            auto start = clock::now();
+            variants[v]->init(config, scene);
+            double us = std::chrono::duration<double, std::micro>(clock::now() - start).count();
+            if (round > 0) result.variants[v].stage_us[0].push_back(us);
+        }
 
     // One frame of variant v; records its stages unless discarded.
     auto run_frame = [&](std::size_t v, bool record) {

@@ -66,8 +66,9 @@ void animate(int count, double t, std::span<PushConstants> out) {
 glm::mat4 view_matrix(int count) {
     int side = grid_side(count);
     double extent = side * cell_size;
-    // Far enough that the grid's extent fits a 45 degree view with a margin.
-    double distance = 0.6 * extent / std::tan(pi / 8.0) + 4.0;
+    // Far enough that the grid's extent fits a 45 degree view, with room for
+    // the bobbing and the teapots' depth.
+    double distance = 0.55 * extent / std::tan(pi / 8.0) + 6.0;
     glm::dvec3 eye(0.0, 0.15 * distance, distance), target(0.0), up(0, 1, 0);
     glm::dvec3 f = glm::normalize(target - eye);
     glm::dvec3 s = glm::normalize(glm::cross(f, up));
