@@ -38,7 +38,7 @@ constexpr int preinit_rounds = 5;          // timed inits per variant
 constexpr int finest_tessellation = 32;    // the image error's reference level
 
 struct Options {
-    int frames = 300;
+    int frames = 2500;
     std::vector<std::string> variants;
     Config config;
     bool sweep = false;
@@ -110,8 +110,9 @@ Options parse(int argc, char** argv) {
 }
 
 std::string config_tag(const Config& c) {
-    return "t" + std::to_string(c.teapots) + "_f" + std::to_string(c.frames_in_flight) + "_u" +
-           std::to_string(c.uniform_writes) + "_s" + std::to_string(c.tessellation);
+    char tag[64];
+    std::snprintf(tag, sizeof tag, "t%d_f%d_u%d_s%d", c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation);
+    return tag;
 }
 
 struct VariantResult {
@@ -424,8 +425,14 @@ int run(int argc, char** argv) {
         std::printf("%5s %10s %12s %12s %12s %10s %14s %12s\n", "level", "triangles", "frame_us", "geom_max",
                     "geom_rms", "max_px", "pixels_differ", "max_channel");
         std::optional<int> budget_level;
-        for (const ConfigResult& r : results) {
-            if (!r.geometric) continue;
+        std::vector<const ConfigResult*> levels;
+        for (const ConfigResult& r : results)
+            if (r.geometric) levels.push_back(&r);
+        std::sort(levels.begin(), levels.end(), [](const ConfigResult* a, const ConfigResult* b) {
+            return a->config.tessellation < b->config.tessellation;
+        });
+        for (const ConfigResult* level : levels) {
+            const ConfigResult& r = *level;
             Summary frame = summarize(r.variants[0].stage_us[frame_stage]);
             std::printf("%5d %10d %12.1f %12.3g %12.3g %10.3g %14zu %12d\n", r.config.tessellation,
                         64 * r.config.tessellation * r.config.tessellation, frame.median, r.geometric->max,

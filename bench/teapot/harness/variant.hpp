@@ -57,8 +57,8 @@ struct Config {
     int frames_in_flight = 2;
     int uniform_writes = 1;
     int tessellation = 4;
-    std::uint32_t width = 640;
-    std::uint32_t height = 480;
+    std::uint32_t width = 800;
+    std::uint32_t height = 600;
     bool validation = false;
 };
 
