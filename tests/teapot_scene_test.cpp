@@ -1,6 +1,7 @@
 // The teapot benchmark's scene: patch data, tessellation, error measure and
 // the numerical hard cases of issue 6 (degenerate normals, rotations at large
 // t, projections at extreme aspects and depth ranges).
+#include "harness/stats.hpp"
 #include "scene/teapot_scene.hpp"
 
 #include <gtest/gtest.h>
@@ -127,8 +128,8 @@ TEST(TeapotMesh, SixteenBitIndicesHoldTheFinestLevel) {
     EXPECT_EQ(mesh.triangle_count(), 32u * 2 * 32 * 32);
     EXPECT_LE(mesh.positions.size(), 65536u);
     EXPECT_THROW(teapot::tessellate(teapot::newell_teapot(), 0), std::invalid_argument);
-    // 64 x 64 quads per patch need about 130k vertices: refused, not wrapped.
-    EXPECT_THROW(teapot::tessellate(teapot::newell_teapot(), 64), std::length_error);
+    // 48 x 48 quads per patch need about 74k vertices: refused, not wrapped.
+    EXPECT_THROW(teapot::tessellate(teapot::newell_teapot(), 48), std::length_error);
 }
 
 TEST(TeapotNormals, DegeneratePointsAreFiniteUnitAndOutward) {
@@ -172,7 +173,7 @@ TEST(TeapotError, DecreasesWithTessellationAndIsZeroAtVertices) {
     const auto& patches = teapot::newell_teapot();
     double previous_max = 1e9, previous_rms = 1e9;
     for (int n : {2, 4, 8, 16, 32}) {
-        teapot::GeometricError e = teapot::geometric_error(patches, teapot::tessellate(patches, n));
+        teapot::GeometricError e = teapot::geometric_error(patches, teapot::tessellate(patches, n), 4);
         EXPECT_LT(e.max, previous_max) << n;
         EXPECT_LT(e.rms, previous_rms) << n;
         EXPECT_LE(e.rms, e.max);
@@ -249,4 +250,41 @@ TEST(TeapotCamera, ExtremeAspectsAndDepthRangesStayFinite) {
             EXPECT_LT(clip.z / clip.w, 1.0f);
         }
     }
+}
+
+TEST(TeapotStats, QuantilesInterpolateBetweenSamples) {
+    std::vector<double> samples{4, 1, 3, 2, 5};
+    EXPECT_DOUBLE_EQ(teapot::quantile(samples, 0.5), 3.0);
+    EXPECT_DOUBLE_EQ(teapot::quantile(samples, 0.0), 1.0);
+    EXPECT_DOUBLE_EQ(teapot::quantile(samples, 1.0), 5.0);
+    EXPECT_DOUBLE_EQ(teapot::quantile(samples, 0.125), 1.5);
+    teapot::Summary s = teapot::summarize(samples);
+    EXPECT_DOUBLE_EQ(s.p5, 1.2);
+    EXPECT_DOUBLE_EQ(s.p95, 4.8);
+    EXPECT_EQ(teapot::quantile({}, 0.5), 0.0);
+}
+
+TEST(TeapotStats, BootstrapRatioBracketsTheTrueRatioAndIsReproducible) {
+    std::vector<double> reference, slower;
+    for (int i = 0; i < 400; ++i) {
+        double x = 10.0 + (i * 37 % 101) * 0.05;  // spread 10..15
+        reference.push_back(x);
+        slower.push_back(1.5 * x);
+    }
+    teapot::Ratio r = teapot::bootstrap_ratio(slower, reference);
+    EXPECT_NEAR(r.ratio, 1.5, 1e-12);
+    EXPECT_LT(r.low, 1.5);
+    EXPECT_GT(r.high, 1.5);
+    EXPECT_GT(r.low, 1.3);
+    EXPECT_LT(r.high, 1.7);
+    teapot::Ratio again = teapot::bootstrap_ratio(slower, reference);
+    EXPECT_EQ(r.low, again.low);
+    EXPECT_EQ(r.high, again.high);
+    // Identical constant samples: no spread at all.
+    std::vector<double> constant(50, 2.0);
+    teapot::Ratio flat = teapot::bootstrap_ratio(constant, constant);
+    EXPECT_EQ(flat.ratio, 1.0);
+    EXPECT_EQ(flat.low, 1.0);
+    EXPECT_EQ(flat.high, 1.0);
+    EXPECT_EQ(teapot::bootstrap_ratio(constant, {}).ratio, 0.0);
 }
