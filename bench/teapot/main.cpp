@@ -292,6 +292,9 @@ void print_table(const ConfigResult& r) {
                     r.geometric->max, r.geometric->rms, r.error_pixels);
 }
 
+// The columns first, then the speed-against-error columns (filled
+// for the configurations that vary only the tessellation). frames is the
+// number of samples behind the row: preinit_rounds for preinit.
 void write_csv(const std::string& path, const std::vector<ConfigResult>& results) {
     std::ofstream out(path);
     if (!out) throw std::runtime_error("cannot write " + path);

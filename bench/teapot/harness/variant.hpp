@@ -1,5 +1,10 @@
-// The contract every teapot benchmark variant implements. A new variant is
-// one class deriving from Variant plus one line in variants.cpp.
+// The contract every teapot benchmark variant implements. Adding one (the
+// vkrc-st and vkrc-mt variants, say): a source file under variants/ with a
+// class deriving from Variant that follows the convention below, a factory
+// declared here and listed in variant_registry() (harness/variants.cpp), the
+// file added to the teapot target with vkrc::st or vkrc::mt linked (each
+// translation unit includes vkrc under one policy only). The harness times
+// the stages itself, so a variant only does the work of each stage.
 //
 // Headless presentation convention (every variant follows it exactly, so the
 // stages measure the same work; vkrc's headless presenter must match it):
