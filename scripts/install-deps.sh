@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libvulkan-dev libvulkan1 mesa-vulkan-drivers vulkan-validationlayers
-  glslang-tools libglfw3-dev libglm-dev googletest libgtest-dev xvfb
+  glslang-tools libglfw3-dev libglm-dev googletest libgtest-dev xvfb libstb-dev
 )
 
 missing=()

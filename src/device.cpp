@@ -11,14 +11,27 @@ DeviceState::~DeviceState() {
     if (device == VK_NULL_HANDLE) return;
     // Every handle is gone; whatever the GPU still runs must finish before
     // the queued destructions. A lost device returns at once.
-    if (fn.vkDeviceWaitIdle(device) == VK_ERROR_DEVICE_LOST) mark_lost();
+    VkResult idle = fn.vkDeviceWaitIdle(device);
+    if (idle == VK_ERROR_DEVICE_LOST) mark_lost();
+    if (idle != VK_SUCCESS && !lost.load(std::memory_order_relaxed)) {
+        // Out of memory while waiting: vkrc's own timelines still say when
+        // its submissions are done.
+        for (auto& q : queues) {
+            std::uint64_t value = q.submitted.load(std::memory_order_acquire);
+            VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+            wait.semaphoreCount = 1;
+            wait.pSemaphores = &q.timeline;
+            wait.pValues = &value;
+            fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
+        }
+    }
     for (auto& batch : deferred_) {
         for (auto& action : batch.actions) action.run(*this, action.handle, action.context);
     }
     deferred_.clear();
     release_allocators();
     for (auto& q : queues) {
-        if (q->timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q->timeline, nullptr);
+        if (q.timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.timeline, nullptr);
     }
     if (ownership == Ownership::owned) fn.vkDestroyDevice(device, nullptr);
 }
@@ -26,15 +39,15 @@ DeviceState::~DeviceState() {
 bool DeviceState::idle_now() noexcept {
     bool idle = true;
     for (auto& q : queues) {
-        std::uint64_t submitted = q->submitted.load(std::memory_order_acquire);
-        if (q->completed.load(std::memory_order_relaxed) >= submitted) continue;
+        std::uint64_t submitted = q.submitted.load(std::memory_order_acquire);
+        if (q.completed.load(std::memory_order_relaxed) >= submitted) continue;
         std::uint64_t value = 0;
-        VkResult r = fn.vkGetSemaphoreCounterValue(device, q->timeline, &value);
+        VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
         if (r == VK_ERROR_DEVICE_LOST) mark_lost();
         if (r == VK_SUCCESS) {
             // Keep the cache monotonic when several threads refresh it.
-            std::uint64_t seen = q->completed.load(std::memory_order_relaxed);
-            while (seen < value && !q->completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+            std::uint64_t seen = q.completed.load(std::memory_order_relaxed);
+            while (seen < value && !q.completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
             }
         }
         if (value < submitted) idle = false;
@@ -44,48 +57,62 @@ bool DeviceState::idle_now() noexcept {
 
 void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
     std::vector<DeferredAction> ready;
+    bool run_now = false;
     {
         LockGuard lock(deferred_mutex_);
         if (deferred_.empty() && idle_now()) {
-            ready.push_back(action);
+            run_now = true;
         } else {
-            // Needs the values of work submitted so far; a batch queued while
-            // the same work was pending is shared.
-            thread_local std::vector<std::uint64_t> values;
-            values.clear();
-            for (auto& q : queues) values.push_back(q->submitted.load(std::memory_order_acquire));
+            bool queued = false;
             try {
+                // Needs the values of work submitted so far; a batch queued
+                // while the same work was pending is shared.
+                std::vector<std::uint64_t> values;
+                values.reserve(queues.size());
+                for (auto& q : queues) values.push_back(q.submitted.load(std::memory_order_acquire));
                 if (deferred_.empty() || deferred_.back().wait_values != values) {
-                    deferred_.push_back(Batch{values, {}});
+                    deferred_.push_back(Batch{std::move(values), {}});
                 }
                 deferred_.back().actions.push_back(action);
                 ++deferred_actions_;
+                queued = true;
+                take_ready(ready);
             } catch (...) {
-                // Out of host memory while queueing: waiting is the only safe
-                // way left to destroy the object.
-                fn.vkDeviceWaitIdle(device);
-                ready.push_back(action);
+                // Out of host memory. Unqueued, waiting is the only safe way
+                // left to destroy the object; queued, it runs on a later collect.
+                if (!queued) {
+                    fn.vkDeviceWaitIdle(device);
+                    run_now = true;
+                }
             }
-            take_ready(ready);
         }
     }
+    if (run_now) action.run(*this, action.handle, action.context);
     for (auto& a : ready) a.run(*this, a.handle, a.context);
 }
 
-void DeviceState::take_ready(std::vector<DeferredAction>& out) noexcept {
+void DeviceState::take_ready(std::vector<DeferredAction>& out) {
     if (deferred_.empty()) return;
     bool all = idle_now();
-    while (!deferred_.empty()) {
-        auto& batch = deferred_.front();
+    std::size_t batches = 0;
+    std::size_t actions = 0;
+    for (const auto& batch : deferred_) {
         bool done = all;
         if (!done) {
             done = true;
             for (std::size_t i = 0; i < queues.size(); ++i) {
-                if (queues[i]->completed.load(std::memory_order_relaxed) < batch.wait_values[i]) done = false;
+                if (queues[i].completed.load(std::memory_order_relaxed) < batch.wait_values[i]) done = false;
             }
         }
         if (!done) break;
-        for (auto& a : batch.actions) out.push_back(a);
+        ++batches;
+        actions += batch.actions.size();
+    }
+    // The only allocation comes first, so a failure leaves the queue as it was.
+    out.reserve(out.size() + actions);
+    for (; batches > 0; --batches) {
+        auto& batch = deferred_.front();
+        out.insert(out.end(), batch.actions.begin(), batch.actions.end());
         deferred_actions_ -= batch.actions.size();
         deferred_.pop_front();
     }
@@ -151,12 +178,11 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
     VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
     for (const auto& request : requests) {
         for (std::uint32_t i = 0; i < request.queue_priorities.size(); ++i) {
-            auto q = std::make_unique<detail::QueueState>();
-            q->family_index = request.queue_family_index;
-            q->index = i;
-            s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q->queue);
-            s.queues.push_back(std::move(q));
-            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &s.queues.back()->timeline), "vkCreateSemaphore");
+            auto& q = s.queues.emplace_back();
+            q.family_index = request.queue_family_index;
+            q.index = i;
+            s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q.queue);
+            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &q.timeline), "vkCreateSemaphore");
         }
     }
 }
@@ -267,7 +293,7 @@ bool Device::extension_enabled(const char* name) const noexcept {
 
 Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
     for (auto& q : state_->queues) {
-        if (q->family_index == family_index && q->index == index) return Queue(*this, q.get());
+        if (q.family_index == family_index && q.index == index) return Queue(*this, &q);
     }
     throw UsageError("vkrc::Device::queue: queue " + std::to_string(index) + " of family " +
                      std::to_string(family_index) + " was not requested when the device was created");
@@ -275,7 +301,7 @@ Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
 
 Queue Device::default_queue() const {
     if (state_->queues.empty()) throw UsageError("vkrc::Device::default_queue: the device has no queues");
-    return Queue(*this, state_->queues.front().get());
+    return Queue(*this, &state_->queues.front());
 }
 
 void Device::wait_idle() const {

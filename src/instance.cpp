@@ -64,11 +64,14 @@ Instance Instance::create(const InstanceCreateInfo& info) {
         add_unique(layers, validation_layer);
         add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
-    std::unique_ptr<DebugCallback> callback;
-    if (info.debug_callback || info.validation) {
+    // The state exists before the instance: its callback's address is the
+    // messenger's user data from vkCreateInstance to vkDestroyInstance.
+    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
+    auto& s = *instance.state_;
+    const bool messenger = info.debug_callback || info.validation;
+    if (messenger) {
         add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        callback = std::make_unique<DebugCallback>(info.debug_callback ? info.debug_callback
-                                                                       : DebugCallback(print_debug_message));
+        s.debug_callback = info.debug_callback ? info.debug_callback : DebugCallback(print_debug_message);
     }
 
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
@@ -85,11 +88,11 @@ Instance Instance::create(const InstanceCreateInfo& info) {
                                  VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                                  VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     messenger_info.pfnUserCallback = debug_trampoline;
-    messenger_info.pUserData = callback.get();
+    messenger_info.pUserData = &s.debug_callback;
     messenger_info.pNext = info.next;
 
     VkInstanceCreateInfo create{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    create.pNext = callback ? &messenger_info : info.next;
+    create.pNext = messenger ? &messenger_info : info.next;
     create.pApplicationInfo = &app;
     create.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
     create.ppEnabledLayerNames = layers.data();
@@ -100,19 +103,16 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     check(global.vkCreateInstance(&create, nullptr, &raw), "vkCreateInstance");
 
     // From here the state owns the instance: an exception below destroys it.
-    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
-    auto& s = *instance.state_;
     s.instance = raw;
     s.api_version = info.api_version;
     s.global_fn = global;
     s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
     s.enabled_extensions.assign(extensions.begin(), extensions.end());
-    if (callback) {
+    if (messenger) {
         messenger_info.pNext = nullptr;
         check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
               "vkCreateDebugUtilsMessengerEXT");
     }
-    s.debug_callback = std::move(callback);
     return instance;
 }
 

@@ -295,16 +295,24 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
     detail::check_request(device, request, type, who);
     const bool dedicated_info = request.requires_dedicated || request.prefers_dedicated || request.intent.dedicated;
     {
+        // Reserved now, so that concurrent calls cannot pass the limit together.
         LockGuard lock(mutex_);
-        const auto total = stats_.total();
-        if (total.block_count >= device.limits().maxMemoryAllocationCount) {
+        if (memory_objects_ >= device.limits().maxMemoryAllocationCount) {
             throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
         }
+        ++memory_objects_;
     }
     AllocationInfo info;
-    info.memory = detail::allocate_device_memory(device, request.requirements.size, type,
-                                                 dedicated_info ? request.dedicated_buffer : VK_NULL_HANDLE,
-                                                 dedicated_info ? request.dedicated_image : VK_NULL_HANDLE, &info.mapped);
+    try {
+        info.memory = detail::allocate_device_memory(device, request.requirements.size, type,
+                                                     dedicated_info ? request.dedicated_buffer : VK_NULL_HANDLE,
+                                                     dedicated_info ? request.dedicated_image : VK_NULL_HANDLE,
+                                                     &info.mapped);
+    } catch (...) {
+        LockGuard lock(mutex_);
+        --memory_objects_;
+        throw;
+    }
     info.size = request.requirements.size;
     info.memory_size = request.requirements.size;
     info.memory_type = type;
@@ -331,6 +339,7 @@ void DedicatedAllocator::free(DeviceView device, const AllocationInfo& allocatio
     heap.allocation_bytes -= allocation.size;
     heap.block_count -= 1;
     heap.allocation_count -= 1;
+    memory_objects_ -= 1;
 }
 
 AllocatorStatistics DedicatedAllocator::statistics(DeviceView device) const {

@@ -10,10 +10,10 @@ namespace detail {
 // members (the allocation, then the parents) are released after, so FIFO
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
+    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
 }
 ImageState::~ImageState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
+    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
 }
 ImageViewState::~ImageViewState() {
     if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view);
@@ -71,6 +71,19 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     check(device.fn().vkBindBufferMemory(device.vk(), state->buffer, state->allocation.memory(),
                                          state->allocation.offset()),
           "vkBindBufferMemory");
+    return Buffer(std::move(state));
+}
+
+Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
+                     Ownership ownership) {
+    if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
+    if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
+    detail::Ref<detail::BufferState> state(new detail::BufferState);
+    state->ownership = ownership;
+    state->device = device;
+    state->buffer = buffer;
+    state->size = size;
+    state->usage = usage;
     return Buffer(std::move(state));
 }
 
@@ -134,6 +147,23 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
     check(device.fn().vkBindImageMemory(device.vk(), state->image, state->allocation.memory(),
                                         state->allocation.offset()),
           "vkBindImageMemory");
+    return Image(std::move(state));
+}
+
+Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership) {
+    if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
+    if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
+    detail::Ref<detail::ImageState> state(new detail::ImageState);
+    state->ownership = ownership;
+    state->device = device;
+    state->image = image;
+    state->image_type = info.image_type;
+    state->format = info.format;
+    state->extent = info.extent;
+    state->mip_levels = info.mip_levels;
+    state->array_layers = info.array_layers;
+    state->samples = info.samples;
+    state->usage = info.usage;
     return Image(std::move(state));
 }
 

@@ -609,6 +609,87 @@ TEST_F(PoolTest, DefaultAllocatorIsAPool) {
     EXPECT_EQ(total.block_count, 1u);
 }
 
+TEST_F(PoolTest, DriverPreferenceForDedicatedMemoryIsHonoured) {
+    vkrc::PoolAllocator pool(small_blocks());
+    auto r = request(4096);
+    r.prefers_dedicated = true;
+    auto a = pool.allocate(view(), r);
+    EXPECT_TRUE(a.dedicated);
+    r.prefers_dedicated = false;
+    r.requires_dedicated = true;
+    auto b = pool.allocate(view(), r);
+    EXPECT_TRUE(b.dedicated);
+    r.requires_dedicated = false;
+    r.intent.dedicated = true;
+    auto c = pool.allocate(view(), r);
+    EXPECT_TRUE(c.dedicated);
+    EXPECT_EQ(pool.statistics(view()).vk_allocate_calls, 3u);
+    for (auto* x : {&a, &b, &c}) pool.free(view(), *x);
+    EXPECT_EQ(pool.statistics(view()).total().block_count, 0u);
+    pool.release(view());
+}
+
+// lavapipe allows 2^32 - 1 allocations; the test lowers the cached limit.
+TEST_F(PoolTest, MaxMemoryAllocationCountIsRespected) {
+    auto& limits = physical_device.state()->properties.limits;
+    const auto saved = limits.maxMemoryAllocationCount;
+    limits.maxMemoryAllocationCount = 2;
+    vkrc::DedicatedAllocator dedicated;
+    auto a = dedicated.allocate(view(), request(64));
+    auto b = dedicated.allocate(view(), request(64));
+    try {
+        dedicated.allocate(view(), request(64));
+        ADD_FAILURE() << "no throw";
+    } catch (const vkrc::Error& e) {
+        EXPECT_EQ(e.result(), VK_ERROR_TOO_MANY_OBJECTS);
+    }
+    dedicated.free(view(), a);
+    dedicated.free(view(), b);
+
+    vkrc::PoolAllocator pool(small_blocks());
+    auto x = pool.allocate(view(), request(1 * MiB));  // fills a first block
+    auto y = pool.allocate(view(), request(1 * MiB));  // and a second
+    EXPECT_THROW(pool.allocate(view(), request(1 * MiB)), vkrc::Error);
+    pool.free(view(), x);
+    auto z = pool.allocate(view(), request(1000));  // the freed block still serves
+    EXPECT_EQ(z.memory, x.memory);
+    EXPECT_EQ(pool.statistics(view()).total().block_count, 2u);
+    pool.free(view(), y);
+    pool.free(view(), z);
+    pool.release(view());
+    limits.maxMemoryAllocationCount = saved;
+}
+
+TEST_F(PoolTest, AdoptedBuffersAndImages) {
+    VkBufferCreateInfo b{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    b.size = 256;
+    b.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    VkBuffer raw_buffer = VK_NULL_HANDLE;
+    ASSERT_EQ(device.fn().vkCreateBuffer(device.vk(), &b, nullptr, &raw_buffer), VK_SUCCESS);
+    {
+        auto buffer = vkrc::Buffer::adopt(device, raw_buffer, 256, b.usage, vkrc::Ownership::borrowed);
+        EXPECT_EQ(buffer.vk(), raw_buffer);
+        EXPECT_FALSE(buffer.allocation());
+    }
+    // Borrowed: still ours to destroy; owned: vkrc destroys it (validation
+    // reports a leak or a double destruction otherwise).
+    auto owned = vkrc::Buffer::adopt(device, raw_buffer, 256, b.usage, vkrc::Ownership::owned);
+    owned.reset();
+
+    vkrc::ImageCreateInfo info;
+    info.format = VK_FORMAT_R8G8B8A8_UNORM;
+    info.extent = {16, 16, 1};
+    info.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+    auto made = vkrc::Image::create(device, info);
+    {
+        // A second, borrowed wrapper of the same VkImage (as for swapchain images).
+        auto borrowed = vkrc::Image::adopt(device, made.vk(), info, vkrc::Ownership::borrowed);
+        auto view = vkrc::ImageView::create(borrowed);
+        EXPECT_EQ(view.image().extent().width, 16u);
+    }
+    EXPECT_THROW(vkrc::Image::adopt(device, VK_NULL_HANDLE, info, vkrc::Ownership::borrowed), vkrc::UsageError);
+}
+
 #if VKRC_IS_MULTI_THREAD
 // Eight threads allocate and free at once through one pool (run under TSan).
 TEST_F(PoolTest, ConcurrentAllocateAndFree) {

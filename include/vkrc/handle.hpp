@@ -7,10 +7,10 @@
 #pragma once
 
 #include "vkrc/config.hpp"
+#include "vkrc/detail/light_std.hpp"  // std::mutex, std::lock_guard
 
 #include <atomic>
 #include <cstdint>
-#include <mutex>
 #include <utility>
 
 VKRC_BEGIN_NAMESPACE

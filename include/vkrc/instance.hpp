@@ -4,8 +4,8 @@
 #include "vkrc/error.hpp"
 #include "vkrc/functions.hpp"
 #include "vkrc/handle.hpp"
+#include "vkrc/detail/light_std.hpp"  // std::function
 
-#include <functional>
 #include <string>
 #include <vector>
 

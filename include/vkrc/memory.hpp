@@ -146,6 +146,7 @@ public:
 private:
     mutable Mutex mutex_;
     AllocatorStatistics stats_;
+    std::uint32_t memory_objects_ = 0;
 };
 
 struct PoolAllocatorCreateInfo {
@@ -157,10 +158,12 @@ struct PoolAllocatorCreateInfo {
     VkDeviceSize dedicated_threshold = 0;
 };
 
-// Sub-allocates from large blocks per memory type: best-fit over free ranges
-// ordered by size, merging freed neighbours; host-visible blocks stay mapped;
-// empty blocks are released keeping at most one spare per memory type. The
-// device's default allocator. Serves one device at a time.
+// Sub-allocates from large blocks per memory type with TLSF (constant-time
+// good fit, freed neighbours merged); host-visible blocks stay mapped;
+// empty blocks are released keeping at most one spare per memory type; its
+// own VkDeviceMemory count stays within maxMemoryAllocationCount. The
+// device's default allocator. Serves one device at a time; used directly
+// (not through Allocation), call release() before that device goes.
 class PoolAllocator final : public DeviceAllocator {
 public:
     explicit PoolAllocator(const PoolAllocatorCreateInfo& info = {});
@@ -245,7 +248,8 @@ inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t
 }  // namespace detail
 
 // Writes to upload memory. Reading write-combined memory is slow, so this
-// view has no read; it flushes each write on non-coherent memory.
+// view has no read; it flushes each write on non-coherent memory. It points
+// into its Allocation's state: use it while the Allocation lives.
 class WriteOnlyView {
 public:
     template <class T>

@@ -33,12 +33,17 @@ class Buffer : public Handle<detail::BufferState> {
 public:
     Buffer() noexcept = default;
     static Buffer create(const Device& device, const BufferCreateInfo& info);
+    // Wraps a buffer made elsewhere, its memory bound by its maker: the
+    // result has no Allocation. With Ownership::owned vkrc destroys it.
+    static Buffer adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
+                        Ownership ownership);
 
     VkBuffer vk() const noexcept;
     VkDeviceSize size() const noexcept;
     VkBufferUsageFlags usage() const noexcept;
     const Device& device() const noexcept;
     // Mapped access goes through the allocation: buffer.allocation().write(0, span).
+    // Empty for an adopted buffer.
     const Allocation& allocation() const noexcept;
 
 private:
@@ -69,6 +74,10 @@ class Image : public Handle<detail::ImageState> {
 public:
     Image() noexcept = default;
     static Image create(const Device& device, const ImageCreateInfo& info);
+    // Wraps an image made elsewhere (a swapchain's, with Ownership::borrowed);
+    // info describes it (its memory and allocator fields are ignored). The
+    // result has no Allocation. With Ownership::owned vkrc destroys it.
+    static Image adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership);
 
     VkImage vk() const noexcept;
     VkImageType image_type() const noexcept;
@@ -179,6 +188,7 @@ struct BufferState final : RefCounted {
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
+    Ownership ownership = Ownership::owned;
     Allocation allocation;  // released after the buffer's destruction is queued
 };
 
@@ -193,6 +203,7 @@ struct ImageState final : RefCounted {
     std::uint32_t array_layers = 1;
     VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
     VkImageUsageFlags usage = 0;
+    Ownership ownership = Ownership::owned;
     Allocation allocation;
 };
 

@@ -5,7 +5,7 @@
 #include "vkrc/device.hpp"
 
 #include <deque>
-#include <memory>
+#include <memory>  // shared_ptr of user allocators
 
 VKRC_BEGIN_NAMESPACE
 class DeviceAllocator;
@@ -61,7 +61,7 @@ public:
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     std::vector<std::string> enabled_extensions;
-    std::vector<std::unique_ptr<QueueState>> queues;
+    std::deque<QueueState> queues;  // a deque: Queue handles point into it
     std::atomic<bool> lost{false};
 
     // Memory (memory.cpp). Every allocator used with the device is kept until
@@ -74,7 +74,8 @@ public:
 private:
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
-    void take_ready(std::vector<DeferredAction>& out) noexcept;
+    // Moves the actions whose work has completed to out; may throw bad_alloc.
+    void take_ready(std::vector<DeferredAction>& out);
 
     // Actions queued while the same work was pending share one batch.
     struct Batch {

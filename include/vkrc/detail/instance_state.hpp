@@ -3,8 +3,6 @@
 
 #include "vkrc/instance.hpp"
 
-#include <memory>
-
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
@@ -19,7 +17,7 @@ public:
     InstanceFunctions fn;
     std::vector<std::string> enabled_extensions;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-    std::unique_ptr<DebugCallback> debug_callback;  // stable address: the messenger's user data
+    DebugCallback debug_callback;  // the messengers' user data: the state never moves
 };
 
 class PhysicalDeviceState final : public RefCounted {

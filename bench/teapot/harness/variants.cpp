@@ -1,0 +1,27 @@
+#include "harness/variant.hpp"
+
+#include <cstdio>
+
+namespace teapot {
+
+const std::vector<VariantEntry>& variant_registry() {
+    // The first entry is the reference the ratios and image checks use.
+    static const std::vector<VariantEntry> registry = {
+        {"raw", make_raw_variant},
+        {"raw-direct", make_raw_direct_variant},
+        {"vkhpp", make_vkhpp_variant},
+    };
+    return registry;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL validation_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                   VkDebugUtilsMessageTypeFlagsEXT,
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+    ++validation_messages;
+    std::fprintf(stderr, "validation %s: %s\n",
+                 severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+                 data && data->pMessage ? data->pMessage : "(no message)");
+    return VK_FALSE;
+}
+
+}  // namespace teapot

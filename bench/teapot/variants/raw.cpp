@@ -1,0 +1,656 @@
+// The raw C API variants: `raw` calls the loader's exported functions, as a
+// careful C programmer would; `raw-direct` makes the same device-level calls
+// through pointers from vkGetDeviceProcAddr, skipping the loader's
+// trampolines (the floor for any wrapper). One template, Direct selects the
+// dispatch at compile time so `raw` keeps plain direct calls.
+#include "harness/variant.hpp"
+
+#include "shaders/teapot.frag.h"
+#include "shaders/teapot.vert.h"
+
+#include <array>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace teapot {
+namespace {
+
+void check(VkResult result, const char* call) {
+    if (result != VK_SUCCESS) throw std::runtime_error(std::string(call) + " failed: VkResult " + std::to_string(result));
+}
+
+// Device-level functions the variant calls.
+#define TEAPOT_DEVICE_FUNCTIONS(X)                                                                               \
+    X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) X(vkCreateBuffer) X(vkDestroyBuffer)               \
+    X(vkGetBufferMemoryRequirements) X(vkAllocateMemory) X(vkFreeMemory) X(vkBindBufferMemory) X(vkMapMemory)     \
+    X(vkCreateImage) X(vkDestroyImage) X(vkGetImageMemoryRequirements) X(vkBindImageMemory) X(vkCreateImageView)  \
+    X(vkDestroyImageView) X(vkCreateShaderModule) X(vkDestroyShaderModule) X(vkCreateDescriptorSetLayout)         \
+    X(vkDestroyDescriptorSetLayout) X(vkCreatePipelineLayout) X(vkDestroyPipelineLayout)                          \
+    X(vkCreateGraphicsPipelines) X(vkDestroyPipeline) X(vkCreateDescriptorPool) X(vkDestroyDescriptorPool)        \
+    X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets) X(vkCreateCommandPool) X(vkDestroyCommandPool)          \
+    X(vkAllocateCommandBuffers) X(vkResetCommandPool) X(vkBeginCommandBuffer) X(vkEndCommandBuffer)               \
+    X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) X(vkQueueSubmit2)                      \
+    X(vkCmdPipelineBarrier2) X(vkCmdBeginRendering) X(vkCmdEndRendering) X(vkCmdBindPipeline)                     \
+    X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdBindDescriptorSets) X(vkCmdBindVertexBuffers)                   \
+    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)
+
+struct DeviceFunctions {
+#define TEAPOT_MEMBER(name) PFN_##name name = nullptr;
+    TEAPOT_DEVICE_FUNCTIONS(TEAPOT_MEMBER)
+#undef TEAPOT_MEMBER
+};
+
+// A buffer or image with its own allocation.
+struct Allocation {
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+};
+
+template <bool Direct>
+class RawVariant final : public Variant {
+public:
+    ~RawVariant() override { destroy(); }
+
+    void init(const Config& config, const SceneData& scene) override {
+        config_ = config;
+        camera_ = scene.camera;
+        draws_.resize(config.teapots);
+        index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        create_instance();
+        create_device();
+        create_geometry(*scene.mesh);
+        create_images();
+        create_pipeline();
+        create_frames();
+    }
+
+    void acquire() override {
+        slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
+        image_ = static_cast<std::uint32_t>(frame_ % (config_.frames_in_flight + 1));
+    }
+
+    void uniform() override {
+        write_camera_uniforms(static_cast<char*>(uniform_.mapped) + slot_ * uniform_stride_, camera_,
+                              config_.uniform_writes);
+    }
+
+    void command() override {
+        Frame& f = frames_[slot_];
+        check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.pool, 0), "vkResetCommandPool");
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        VkCommandBuffer cmd = f.cmd;
+        check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin), "vkBeginCommandBuffer");
+
+        VkImageMemoryBarrier2 to_render[2]{};
+        to_render[0].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
+        to_render[0].srcStageMask = VK_PIPELINE_STAGE_2_NONE;
+        to_render[0].dstStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        to_render[0].dstAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+        to_render[0].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        to_render[0].newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        to_render[0].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_render[0].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_render[0].image = ring_[image_].image;
+        to_render[0].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        to_render[1].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
+        to_render[1].srcStageMask =
+            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+        to_render[1].srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        to_render[1].dstStageMask =
+            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+        to_render[1].dstAccessMask =
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+        to_render[1].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+        to_render[1].newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        to_render[1].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_render[1].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_render[1].image = depth_.image;
+        to_render[1].subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dependency.imageMemoryBarrierCount = 2;
+        dependency.pImageMemoryBarriers = to_render;
+        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &dependency);
+
+        VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        colour.imageView = ring_[image_].view;
+        colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        colour.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        std::memcpy(colour.clearValue.color.float32, clear_colour, sizeof clear_colour);
+        VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        depth.imageView = depth_.view;
+        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
+        depth.clearValue.depthStencil = {1.0f, 0};
+        VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        rendering.renderArea = {{0, 0}, {config_.width, config_.height}};
+        rendering.layerCount = 1;
+        rendering.colorAttachmentCount = 1;
+        rendering.pColorAttachments = &colour;
+        rendering.pDepthAttachment = &depth;
+        call(&DeviceFunctions::vkCmdBeginRendering, ::vkCmdBeginRendering)(cmd, &rendering);
+
+        call(&DeviceFunctions::vkCmdBindPipeline, ::vkCmdBindPipeline)(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+        VkViewport viewport{0, 0, float(config_.width), float(config_.height), 0, 1};
+        call(&DeviceFunctions::vkCmdSetViewport, ::vkCmdSetViewport)(cmd, 0, 1, &viewport);
+        VkRect2D scissor{{0, 0}, {config_.width, config_.height}};
+        call(&DeviceFunctions::vkCmdSetScissor, ::vkCmdSetScissor)(cmd, 0, 1, &scissor);
+        call(&DeviceFunctions::vkCmdBindDescriptorSets, ::vkCmdBindDescriptorSets)(
+            cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_layout_, 0, 1, &f.descriptor_set, 0, nullptr);
+        VkBuffer vertex_buffers[2] = {positions_, normals_};
+        VkDeviceSize offsets[2] = {0, 0};
+        call(&DeviceFunctions::vkCmdBindVertexBuffers, ::vkCmdBindVertexBuffers)(cmd, 0, 2, vertex_buffers, offsets);
+        call(&DeviceFunctions::vkCmdBindIndexBuffer, ::vkCmdBindIndexBuffer)(cmd, indices_, 0, VK_INDEX_TYPE_UINT16);
+        auto push = call(&DeviceFunctions::vkCmdPushConstants, ::vkCmdPushConstants);
+        auto draw = call(&DeviceFunctions::vkCmdDrawIndexed, ::vkCmdDrawIndexed);
+        for (const PushConstants& d : draws_) {
+            push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof d, &d);
+            draw(cmd, index_count_, 1, 0, 0, 0);
+        }
+        call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
+
+        VkImageMemoryBarrier2 to_present{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        to_present.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        to_present.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+        to_present.dstStageMask = VK_PIPELINE_STAGE_2_NONE;
+        to_present.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        to_present.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        to_present.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_present.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_present.image = ring_[image_].image;
+        to_present.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkDependencyInfo present_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        present_dependency.imageMemoryBarrierCount = 1;
+        present_dependency.pImageMemoryBarriers = &to_present;
+        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &present_dependency);
+        check(call(&DeviceFunctions::vkEndCommandBuffer, ::vkEndCommandBuffer)(cmd), "vkEndCommandBuffer");
+    }
+
+    void submit() override {
+        Frame& f = frames_[slot_];
+        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmd_info.commandBuffer = f.cmd;
+        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit.commandBufferInfoCount = 1;
+        submit.pCommandBufferInfos = &cmd_info;
+        check(call(&DeviceFunctions::vkQueueSubmit2, ::vkQueueSubmit2)(queue_, 1, &submit, f.fence), "vkQueueSubmit2");
+        f.submitted = true;
+    }
+
+    void present() override {
+        presented_image_ = image_;
+        ++frame_;
+    }
+
+    void wait() override {
+        Frame& next = frames_[frame_ % config_.frames_in_flight];
+        if (!next.submitted) return;
+        check(call(&DeviceFunctions::vkWaitForFences, ::vkWaitForFences)(device_, 1, &next.fence, VK_TRUE, UINT64_MAX),
+              "vkWaitForFences");
+        check(call(&DeviceFunctions::vkResetFences, ::vkResetFences)(device_, 1, &next.fence), "vkResetFences");
+        next.submitted = false;
+    }
+
+    void update(double t) override { animate(config_.teapots, t, draws_); }
+
+    void drain() override { check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
+
+    std::vector<std::uint8_t> render_reference_frame(double t) override {
+        drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        submit();
+        present();
+        drain();
+        // Copy the presented image to the readback buffer with a one-off
+        // command buffer from the slot's pool (idle after the drain).
+        Frame& f = frames_[slot_];
+        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+        f.submitted = false;
+        check(fn_.vkResetCommandPool(device_, f.pool, 0), "vkResetCommandPool");
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        check(fn_.vkBeginCommandBuffer(f.cmd, &begin), "vkBeginCommandBuffer");
+        VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+        to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+        to_copy.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        to_copy.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_copy.image = ring_[presented_image_].image;
+        to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dependency.imageMemoryBarrierCount = 1;
+        dependency.pImageMemoryBarriers = &to_copy;
+        fn_.vkCmdPipelineBarrier2(f.cmd, &dependency);
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {config_.width, config_.height, 1};
+        fn_.vkCmdCopyImageToBuffer(f.cmd, ring_[presented_image_].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   readback_buffer_, 1, &region);
+        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = readback_buffer_;
+        to_host.size = VK_WHOLE_SIZE;
+        VkDependencyInfo host_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        host_dependency.bufferMemoryBarrierCount = 1;
+        host_dependency.pBufferMemoryBarriers = &to_host;
+        fn_.vkCmdPipelineBarrier2(f.cmd, &host_dependency);
+        check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
+        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmd_info.commandBuffer = f.cmd;
+        VkSubmitInfo2 submit_info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit_info.commandBufferInfoCount = 1;
+        submit_info.pCommandBufferInfos = &cmd_info;
+        check(fn_.vkQueueSubmit2(queue_, 1, &submit_info, f.fence), "vkQueueSubmit2");
+        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        return {pixels, pixels + std::size_t(config_.width) * config_.height * 4};
+    }
+
+    std::string device_name() const override { return device_name_; }
+
+private:
+    struct Image {
+        VkImage image = VK_NULL_HANDLE;
+        VkImageView view = VK_NULL_HANDLE;
+        VkDeviceMemory memory = VK_NULL_HANDLE;
+    };
+    struct Frame {
+        VkCommandPool pool = VK_NULL_HANDLE;
+        VkCommandBuffer cmd = VK_NULL_HANDLE;
+        VkFence fence = VK_NULL_HANDLE;
+        VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+        bool submitted = false;
+    };
+
+    // The device-level function: the loader's export for raw, the device's
+    // own pointer for raw-direct. Resolved at compile time.
+    template <typename Pfn>
+    Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
+        if constexpr (Direct)
+            return fn_.*member;
+        else
+            return exported;
+    }
+
+    void create_instance() {
+        VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+        app.pApplicationName = "teapot";
+        app.apiVersion = VK_API_VERSION_1_3;
+        VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+        messenger.messageSeverity = validation_severities;
+        messenger.messageType = validation_types;
+        messenger.pfnUserCallback = validation_callback;
+        const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+        VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+        info.pApplicationInfo = &app;
+        if (config_.validation) {
+            info.pNext = &messenger;
+            info.enabledLayerCount = 1;
+            info.ppEnabledLayerNames = &validation_layer;
+            info.enabledExtensionCount = 1;
+            info.ppEnabledExtensionNames = &extension;
+        }
+        check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
+        if (config_.validation) {
+            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+            check(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+        }
+    }
+
+    void create_device() {
+        // The first device with a graphics queue and Vulkan 1.3.
+        std::uint32_t count = 0;
+        check(vkEnumeratePhysicalDevices(instance_, &count, nullptr), "vkEnumeratePhysicalDevices");
+        std::vector<VkPhysicalDevice> devices(count);
+        check(vkEnumeratePhysicalDevices(instance_, &count, devices.data()), "vkEnumeratePhysicalDevices");
+        for (VkPhysicalDevice candidate : devices) {
+            VkPhysicalDeviceProperties properties;
+            vkGetPhysicalDeviceProperties(candidate, &properties);
+            if (properties.apiVersion < VK_API_VERSION_1_3) continue;
+            std::uint32_t family_count = 0;
+            vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, nullptr);
+            std::vector<VkQueueFamilyProperties> families(family_count);
+            vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, families.data());
+            for (std::uint32_t i = 0; i < family_count; ++i)
+                if (families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
+                    physical_device_ = candidate;
+                    queue_family_ = i;
+                    device_name_ = properties.deviceName;
+                    uniform_alignment_ = properties.limits.minUniformBufferOffsetAlignment;
+                    break;
+                }
+            if (physical_device_) break;
+        }
+        if (!physical_device_) throw std::runtime_error("no Vulkan 1.3 device with a graphics queue");
+        vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
+
+        float priority = 1.0f;
+        VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        queue_info.queueFamilyIndex = queue_family_;
+        queue_info.queueCount = 1;
+        queue_info.pQueuePriorities = &priority;
+        VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        features13.synchronization2 = VK_TRUE;
+        features13.dynamicRendering = VK_TRUE;
+        VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        info.pNext = &features13;
+        info.queueCreateInfoCount = 1;
+        info.pQueueCreateInfos = &queue_info;
+        check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
+        // The pointers for raw-direct's hot path and for the untimed helpers.
+#define TEAPOT_LOAD(name) fn_.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device_, #name));
+        TEAPOT_DEVICE_FUNCTIONS(TEAPOT_LOAD)
+#undef TEAPOT_LOAD
+        fn_.vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    }
+
+    std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted) const {
+        for (std::uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i)
+            if ((bits & (1u << i)) && (memory_properties_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+        return UINT32_MAX;
+    }
+
+    // A buffer in memory the host writes directly: device-local as well where
+    // the device offers that (integrated GPUs, lavapipe, resizable BAR).
+    VkBuffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage, Allocation& allocation) {
+        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        info.size = size;
+        info.usage = usage;
+        VkBuffer buffer;
+        check(fn_.vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
+        VkMemoryRequirements requirements;
+        fn_.vkGetBufferMemoryRequirements(device_, buffer, &requirements);
+        const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, host);
+        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = type;
+        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &allocation.memory), "vkAllocateMemory");
+        check(fn_.vkBindBufferMemory(device_, buffer, allocation.memory, 0), "vkBindBufferMemory");
+        check(fn_.vkMapMemory(device_, allocation.memory, 0, VK_WHOLE_SIZE, 0, &allocation.mapped), "vkMapMemory");
+        return buffer;
+    }
+
+    template <typename T>
+    VkBuffer create_filled_buffer(const std::vector<T>& data, VkBufferUsageFlags usage, Allocation& allocation) {
+        VkBuffer buffer = create_buffer(data.size() * sizeof(T), usage, allocation);
+        std::memcpy(allocation.mapped, data.data(), data.size() * sizeof(T));
+        return buffer;
+    }
+
+    void create_geometry(const Mesh& mesh) {
+        positions_ = create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, positions_memory_);
+        normals_ = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, normals_memory_);
+        indices_ = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, indices_memory_);
+        uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
+        uniform_buffer_ = create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                        uniform_);
+        readback_buffer_ = create_buffer(VkDeviceSize(config_.width) * config_.height * 4,
+                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback_);
+    }
+
+    Image create_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
+        Image image;
+        VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+        info.imageType = VK_IMAGE_TYPE_2D;
+        info.format = format;
+        info.extent = {config_.width, config_.height, 1};
+        info.mipLevels = 1;
+        info.arrayLayers = 1;
+        info.samples = VK_SAMPLE_COUNT_1_BIT;
+        info.tiling = VK_IMAGE_TILING_OPTIMAL;
+        info.usage = usage;
+        check(fn_.vkCreateImage(device_, &info, nullptr, &image.image), "vkCreateImage");
+        VkMemoryRequirements requirements;
+        fn_.vkGetImageMemoryRequirements(device_, image.image, &requirements);
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, 0);
+        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = type;
+        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &image.memory), "vkAllocateMemory");
+        check(fn_.vkBindImageMemory(device_, image.image, image.memory, 0), "vkBindImageMemory");
+        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+        view.image = image.image;
+        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+        view.format = format;
+        view.subresourceRange = {aspect, 0, 1, 0, 1};
+        check(fn_.vkCreateImageView(device_, &view, nullptr, &image.view), "vkCreateImageView");
+        return image;
+    }
+
+    void create_images() {
+        ring_.resize(config_.frames_in_flight + 1);
+        for (Image& image : ring_)
+            image = create_image(colour_format,
+                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                 VK_IMAGE_ASPECT_COLOR_BIT);
+        depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+    }
+
+    VkShaderModule create_shader(std::span<const std::uint32_t> code) {
+        VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+        info.codeSize = code.size_bytes();
+        info.pCode = code.data();
+        VkShaderModule module;
+        check(fn_.vkCreateShaderModule(device_, &info, nullptr, &module), "vkCreateShaderModule");
+        return module;
+    }
+
+    void create_pipeline() {
+        VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT,
+                                             nullptr};
+        VkDescriptorSetLayoutCreateInfo set_layout{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+        set_layout.bindingCount = 1;
+        set_layout.pBindings = &binding;
+        check(fn_.vkCreateDescriptorSetLayout(device_, &set_layout, nullptr, &set_layout_),
+              "vkCreateDescriptorSetLayout");
+        VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)};
+        VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+        layout.setLayoutCount = 1;
+        layout.pSetLayouts = &set_layout_;
+        layout.pushConstantRangeCount = 1;
+        layout.pPushConstantRanges = &push;
+        check(fn_.vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
+
+        VkShaderModule vert = create_shader(vkrc_shaders::teapot_vert);
+        VkShaderModule frag = create_shader(vkrc_shaders::teapot_frag);
+        VkPipelineShaderStageCreateInfo stages[2]{};
+        stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
+                     vert, "main", nullptr};
+        stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
+                     frag, "main", nullptr};
+        VkVertexInputBindingDescription bindings[2] = {{0, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX},
+                                                       {1, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX}};
+        VkVertexInputAttributeDescription attributes[2] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                                                           {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+        VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+        vertex_input.vertexBindingDescriptionCount = 2;
+        vertex_input.pVertexBindingDescriptions = bindings;
+        vertex_input.vertexAttributeDescriptionCount = 2;
+        vertex_input.pVertexAttributeDescriptions = attributes;
+        VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+        assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+        VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+        viewport.viewportCount = 1;
+        viewport.scissorCount = 1;
+        VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+        raster.polygonMode = VK_POLYGON_MODE_FILL;
+        raster.cullMode = VK_CULL_MODE_NONE;  // the spout and lid openings show inner faces
+        raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+        raster.lineWidth = 1.0f;
+        VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+        multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+        VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+        depth.depthTestEnable = VK_TRUE;
+        depth.depthWriteEnable = VK_TRUE;
+        depth.depthCompareOp = VK_COMPARE_OP_LESS;
+        VkPipelineColorBlendAttachmentState blend_attachment{};
+        blend_attachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+        VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+        blend.attachmentCount = 1;
+        blend.pAttachments = &blend_attachment;
+        VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+        VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+        dynamic.dynamicStateCount = 2;
+        dynamic.pDynamicStates = dynamic_states;
+        VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+        rendering.colorAttachmentCount = 1;
+        rendering.pColorAttachmentFormats = &colour_format;
+        rendering.depthAttachmentFormat = depth_format;
+        VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+        info.pNext = &rendering;
+        info.stageCount = 2;
+        info.pStages = stages;
+        info.pVertexInputState = &vertex_input;
+        info.pInputAssemblyState = &assembly;
+        info.pViewportState = &viewport;
+        info.pRasterizationState = &raster;
+        info.pMultisampleState = &multisample;
+        info.pDepthStencilState = &depth;
+        info.pColorBlendState = &blend;
+        info.pDynamicState = &dynamic;
+        info.layout = pipeline_layout_;
+        VkResult result = fn_.vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
+        fn_.vkDestroyShaderModule(device_, vert, nullptr);
+        fn_.vkDestroyShaderModule(device_, frag, nullptr);
+        check(result, "vkCreateGraphicsPipelines");
+    }
+
+    void create_frames() {
+        auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
+        VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
+        VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pool.maxSets = slots;
+        pool.poolSizeCount = 1;
+        pool.pPoolSizes = &pool_size;
+        check(fn_.vkCreateDescriptorPool(device_, &pool, nullptr, &descriptor_pool_), "vkCreateDescriptorPool");
+        frames_.resize(slots);
+        for (std::uint32_t i = 0; i < slots; ++i) {
+            Frame& f = frames_[i];
+            VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+            pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+            pool_info.queueFamilyIndex = queue_family_;
+            check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &f.pool), "vkCreateCommandPool");
+            VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+            allocate.commandPool = f.pool;
+            allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+            allocate.commandBufferCount = 1;
+            check(fn_.vkAllocateCommandBuffers(device_, &allocate, &f.cmd), "vkAllocateCommandBuffers");
+            VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+            check(fn_.vkCreateFence(device_, &fence, nullptr, &f.fence), "vkCreateFence");
+            VkDescriptorSetAllocateInfo set{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+            set.descriptorPool = descriptor_pool_;
+            set.descriptorSetCount = 1;
+            set.pSetLayouts = &set_layout_;
+            check(fn_.vkAllocateDescriptorSets(device_, &set, &f.descriptor_set), "vkAllocateDescriptorSets");
+            VkDescriptorBufferInfo buffer{uniform_buffer_, i * uniform_stride_, sizeof(CameraUniforms)};
+            VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            write.dstSet = f.descriptor_set;
+            write.descriptorCount = 1;
+            write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+            write.pBufferInfo = &buffer;
+            fn_.vkUpdateDescriptorSets(device_, 1, &write, 0, nullptr);
+        }
+    }
+
+    void destroy() {
+        if (device_) {
+            fn_.vkDeviceWaitIdle(device_);
+            for (Frame& f : frames_) {
+                fn_.vkDestroyFence(device_, f.fence, nullptr);
+                fn_.vkDestroyCommandPool(device_, f.pool, nullptr);
+            }
+            fn_.vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
+            fn_.vkDestroyPipeline(device_, pipeline_, nullptr);
+            fn_.vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+            fn_.vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+            auto destroy_image = [&](Image& image) {
+                fn_.vkDestroyImageView(device_, image.view, nullptr);
+                fn_.vkDestroyImage(device_, image.image, nullptr);
+                fn_.vkFreeMemory(device_, image.memory, nullptr);
+            };
+            for (Image& image : ring_) destroy_image(image);
+            destroy_image(depth_);
+            auto destroy_buffer = [&](VkBuffer buffer, Allocation& allocation) {
+                fn_.vkDestroyBuffer(device_, buffer, nullptr);
+                fn_.vkFreeMemory(device_, allocation.memory, nullptr);  // unmaps implicitly
+            };
+            destroy_buffer(positions_, positions_memory_);
+            destroy_buffer(normals_, normals_memory_);
+            destroy_buffer(indices_, indices_memory_);
+            destroy_buffer(uniform_buffer_, uniform_);
+            destroy_buffer(readback_buffer_, readback_);
+            fn_.vkDestroyDevice(device_, nullptr);
+        }
+        if (messenger_) {
+            auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+                vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+            destroy_messenger(instance_, messenger_, nullptr);
+        }
+        if (instance_) vkDestroyInstance(instance_, nullptr);
+    }
+
+    Config config_;
+    CameraUniforms camera_{};
+    std::vector<PushConstants> draws_;
+    std::uint32_t index_count_ = 0;
+
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+    VkPhysicalDeviceMemoryProperties memory_properties_{};
+    std::string device_name_;
+    VkDeviceSize uniform_alignment_ = 1;
+    std::uint32_t queue_family_ = 0;
+    VkDevice device_ = VK_NULL_HANDLE;
+    DeviceFunctions fn_;
+    VkQueue queue_ = VK_NULL_HANDLE;
+
+    VkBuffer positions_ = VK_NULL_HANDLE, normals_ = VK_NULL_HANDLE, indices_ = VK_NULL_HANDLE;
+    Allocation positions_memory_, normals_memory_, indices_memory_;
+    VkBuffer uniform_buffer_ = VK_NULL_HANDLE;
+    Allocation uniform_;
+    VkDeviceSize uniform_stride_ = 0;
+    VkBuffer readback_buffer_ = VK_NULL_HANDLE;
+    Allocation readback_;
+    std::vector<Image> ring_;
+    Image depth_;
+    VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+    VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+    VkPipeline pipeline_ = VK_NULL_HANDLE;
+    VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+    std::vector<Frame> frames_;
+
+    std::uint64_t frame_ = 0;
+    std::uint32_t slot_ = 0;
+    std::uint32_t image_ = 0;
+    std::uint32_t presented_image_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Variant> make_raw_variant() { return std::make_unique<RawVariant<false>>(); }
+std::unique_ptr<Variant> make_raw_direct_variant() { return std::make_unique<RawVariant<true>>(); }
+
+}  // namespace teapot

@@ -1,0 +1,390 @@
+// The Vulkan-Hpp variant: vk::raii from Debian's headers, written the way
+// its samples do (its own translation unit: the header compiles slowly).
+#include "harness/variant.hpp"
+
+#include "shaders/teapot.frag.h"
+#include "shaders/teapot.vert.h"
+
+#include <vulkan/vulkan_raii.hpp>
+
+#include <optional>
+#include <stdexcept>
+
+namespace teapot {
+namespace {
+
+class VkhppVariant final : public Variant {
+public:
+    ~VkhppVariant() override {
+        if (device_) device_->waitIdle();
+    }
+
+    void init(const Config& config, const SceneData& scene) override {
+        config_ = config;
+        camera_ = scene.camera;
+        draws_.resize(config.teapots);
+        index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        create_instance();
+        create_device();
+        create_geometry(*scene.mesh);
+        create_images();
+        create_pipeline();
+        create_frames();
+    }
+
+    void acquire() override {
+        slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
+        image_ = static_cast<std::uint32_t>(frame_ % (config_.frames_in_flight + 1));
+    }
+
+    void uniform() override {
+        write_camera_uniforms(static_cast<char*>(uniform_mapped_) + slot_ * uniform_stride_, camera_,
+                              config_.uniform_writes);
+    }
+
+    void command() override {
+        Frame& f = frames_[slot_];
+        f.pool.reset();
+        const vk::raii::CommandBuffer& cmd = f.cmd;
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        std::array<vk::ImageMemoryBarrier2, 2> to_render{
+            vk::ImageMemoryBarrier2(vk::PipelineStageFlagBits2::eNone, {},
+                                    vk::PipelineStageFlagBits2::eColorAttachmentOutput,
+                                    vk::AccessFlagBits2::eColorAttachmentWrite, vk::ImageLayout::eUndefined,
+                                    vk::ImageLayout::eColorAttachmentOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                    VK_QUEUE_FAMILY_IGNORED, *ring_[image_].image,
+                                    {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}),
+            vk::ImageMemoryBarrier2(
+                vk::PipelineStageFlagBits2::eEarlyFragmentTests | vk::PipelineStageFlagBits2::eLateFragmentTests,
+                vk::AccessFlagBits2::eDepthStencilAttachmentWrite,
+                vk::PipelineStageFlagBits2::eEarlyFragmentTests | vk::PipelineStageFlagBits2::eLateFragmentTests,
+                vk::AccessFlagBits2::eDepthStencilAttachmentRead | vk::AccessFlagBits2::eDepthStencilAttachmentWrite,
+                vk::ImageLayout::eUndefined, vk::ImageLayout::eDepthAttachmentOptimal, VK_QUEUE_FAMILY_IGNORED,
+                VK_QUEUE_FAMILY_IGNORED, *depth_.image, {vk::ImageAspectFlagBits::eDepth, 0, 1, 0, 1})};
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_render));
+
+        vk::RenderingAttachmentInfo colour(*ring_[image_].view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
+                                           vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eStore,
+                                           vk::ClearColorValue(std::array<float, 4>{clear_colour[0], clear_colour[1],
+                                                                                    clear_colour[2], clear_colour[3]}));
+        vk::RenderingAttachmentInfo depth(*depth_.view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
+                                          vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
+                                          vk::ClearDepthStencilValue(1.0f, 0));
+        cmd.beginRendering(
+            vk::RenderingInfo({}, {{0, 0}, {config_.width, config_.height}}, 1, 0, colour, &depth));
+        cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline_);
+        cmd.setViewport(0, vk::Viewport(0, 0, float(config_.width), float(config_.height), 0, 1));
+        cmd.setScissor(0, vk::Rect2D({0, 0}, {config_.width, config_.height}));
+        cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout_, 0, *f.descriptor_set, {});
+        cmd.bindVertexBuffers(0, {*positions_.buffer, *normals_.buffer}, {0, 0});
+        cmd.bindIndexBuffer(*indices_.buffer, 0, vk::IndexType::eUint16);
+        for (const PushConstants& d : draws_) {
+            cmd.pushConstants<PushConstants>(*pipeline_layout_, vk::ShaderStageFlagBits::eVertex, 0, d);
+            cmd.drawIndexed(index_count_, 1, 0, 0, 0);
+        }
+        cmd.endRendering();
+        vk::ImageMemoryBarrier2 to_present(
+            vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
+            vk::PipelineStageFlagBits2::eNone, {}, vk::ImageLayout::eColorAttachmentOptimal,
+            vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
+            *ring_[image_].image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_present));
+        cmd.end();
+    }
+
+    void submit() override {
+        Frame& f = frames_[slot_];
+        vk::CommandBufferSubmitInfo cmd_info(*f.cmd);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *f.fence);
+        f.submitted = true;
+    }
+
+    void present() override {
+        presented_image_ = image_;
+        ++frame_;
+    }
+
+    void wait() override {
+        Frame& next = frames_[frame_ % config_.frames_in_flight];
+        if (!next.submitted) return;
+        if (device_->waitForFences(*next.fence, VK_TRUE, UINT64_MAX) != vk::Result::eSuccess)
+            throw std::runtime_error("vkWaitForFences timed out");
+        device_->resetFences(*next.fence);
+        next.submitted = false;
+    }
+
+    void update(double t) override { animate(config_.teapots, t, draws_); }
+
+    void drain() override { device_->waitIdle(); }
+
+    std::vector<std::uint8_t> render_reference_frame(double t) override {
+        drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        submit();
+        present();
+        drain();
+        Frame& f = frames_[slot_];
+        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+        device_->resetFences(*f.fence);
+        f.submitted = false;
+        f.pool.reset();
+        const vk::raii::CommandBuffer& cmd = f.cmd;
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        vk::ImageMemoryBarrier2 to_copy(
+            vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
+            vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferRead,
+            vk::ImageLayout::eTransferSrcOptimal, vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED,
+            VK_QUEUE_FAMILY_IGNORED, *ring_[presented_image_].image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_copy));
+        vk::BufferImageCopy region(0, 0, 0, {vk::ImageAspectFlagBits::eColor, 0, 0, 1}, {0, 0, 0},
+                                   {config_.width, config_.height, 1});
+        cmd.copyImageToBuffer(*ring_[presented_image_].image, vk::ImageLayout::eTransferSrcOptimal,
+                              *readback_.buffer, region);
+        vk::BufferMemoryBarrier2 to_host(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                         vk::PipelineStageFlagBits2::eHost, vk::AccessFlagBits2::eHostRead,
+                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *readback_.buffer, 0,
+                                         VK_WHOLE_SIZE);
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, to_host, {}));
+        cmd.end();
+        vk::CommandBufferSubmitInfo cmd_info(*cmd);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *f.fence);
+        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+        device_->resetFences(*f.fence);
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        return {pixels, pixels + std::size_t(config_.width) * config_.height * 4};
+    }
+
+    std::string device_name() const override { return device_name_; }
+
+private:
+    struct Buffer {
+        vk::raii::Buffer buffer = nullptr;
+        vk::raii::DeviceMemory memory = nullptr;
+        void* mapped = nullptr;
+    };
+    struct Image {
+        vk::raii::Image image = nullptr;
+        vk::raii::DeviceMemory memory = nullptr;
+        vk::raii::ImageView view = nullptr;
+    };
+    struct Frame {
+        vk::raii::CommandPool pool = nullptr;
+        vk::raii::CommandBuffer cmd = nullptr;
+        vk::raii::Fence fence = nullptr;
+        vk::raii::DescriptorSet descriptor_set = nullptr;
+        bool submitted = false;
+    };
+
+    void create_instance() {
+        vk::ApplicationInfo app("teapot", 1, nullptr, 0, VK_API_VERSION_1_3);
+        vk::DebugUtilsMessengerCreateInfoEXT messenger(
+            {}, vk::DebugUtilsMessageSeverityFlagsEXT(validation_severities),
+            vk::DebugUtilsMessageTypeFlagsEXT(validation_types),
+            reinterpret_cast<PFN_vkDebugUtilsMessengerCallbackEXT>(&validation_callback));
+        std::vector<const char*> layers, extensions;
+        if (config_.validation) {
+            layers.push_back(validation_layer);
+            extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        }
+        vk::InstanceCreateInfo info({}, &app, layers, extensions);
+        if (config_.validation) info.pNext = &messenger;
+        instance_.emplace(context_, info);
+        if (config_.validation) messenger_.emplace(*instance_, messenger);
+    }
+
+    void create_device() {
+        vk::raii::PhysicalDevices devices(*instance_);
+        for (auto& candidate : devices) {
+            vk::PhysicalDeviceProperties properties = candidate.getProperties();
+            if (properties.apiVersion < VK_API_VERSION_1_3) continue;
+            auto families = candidate.getQueueFamilyProperties();
+            for (std::uint32_t i = 0; i < families.size(); ++i)
+                if (families[i].queueFlags & vk::QueueFlagBits::eGraphics) {
+                    physical_device_.emplace(std::move(candidate));
+                    queue_family_ = i;
+                    device_name_ = properties.deviceName.data();
+                    uniform_alignment_ = properties.limits.minUniformBufferOffsetAlignment;
+                    break;
+                }
+            if (physical_device_) break;
+        }
+        if (!physical_device_) throw std::runtime_error("no Vulkan 1.3 device with a graphics queue");
+        memory_properties_ = physical_device_->getMemoryProperties();
+        float priority = 1.0f;
+        vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
+        vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> chain(
+            vk::DeviceCreateInfo({}, queue_info), vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
+        device_.emplace(*physical_device_, chain.get<vk::DeviceCreateInfo>());
+        queue_.emplace(*device_, queue_family_, 0);
+    }
+
+    std::uint32_t memory_type(std::uint32_t bits, vk::MemoryPropertyFlags wanted) const {
+        for (std::uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i)
+            if ((bits & (1u << i)) && (memory_properties_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+        return UINT32_MAX;
+    }
+
+    // Same memory choice as the raw variants: host-written, device-local too
+    // where offered.
+    Buffer create_buffer(vk::DeviceSize size, vk::BufferUsageFlags usage) {
+        Buffer b;
+        b.buffer = vk::raii::Buffer(*device_, vk::BufferCreateInfo({}, size, usage));
+        vk::MemoryRequirements requirements = b.buffer.getMemoryRequirements();
+        const vk::MemoryPropertyFlags host =
+            vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent;
+        std::uint32_t type =
+            memory_type(requirements.memoryTypeBits, host | vk::MemoryPropertyFlagBits::eDeviceLocal);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, host);
+        b.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
+        b.buffer.bindMemory(*b.memory, 0);
+        b.mapped = b.memory.mapMemory(0, VK_WHOLE_SIZE);
+        return b;
+    }
+
+    template <typename T>
+    Buffer create_filled_buffer(const std::vector<T>& data, vk::BufferUsageFlags usage) {
+        Buffer b = create_buffer(data.size() * sizeof(T), usage);
+        std::memcpy(b.mapped, data.data(), data.size() * sizeof(T));
+        return b;
+    }
+
+    void create_geometry(const Mesh& mesh) {
+        positions_ = create_filled_buffer(mesh.positions, vk::BufferUsageFlagBits::eVertexBuffer);
+        normals_ = create_filled_buffer(mesh.normals, vk::BufferUsageFlagBits::eVertexBuffer);
+        indices_ = create_filled_buffer(mesh.indices, vk::BufferUsageFlagBits::eIndexBuffer);
+        uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
+        uniform_ = create_buffer(uniform_stride_ * config_.frames_in_flight, vk::BufferUsageFlagBits::eUniformBuffer);
+        uniform_mapped_ = uniform_.mapped;
+        readback_ = create_buffer(vk::DeviceSize(config_.width) * config_.height * 4,
+                                  vk::BufferUsageFlagBits::eTransferDst);
+    }
+
+    Image create_image(vk::Format format, vk::ImageUsageFlags usage, vk::ImageAspectFlags aspect) {
+        Image image;
+        image.image = vk::raii::Image(
+            *device_, vk::ImageCreateInfo({}, vk::ImageType::e2D, format, {config_.width, config_.height, 1}, 1, 1,
+                                          vk::SampleCountFlagBits::e1, vk::ImageTiling::eOptimal, usage));
+        vk::MemoryRequirements requirements = image.image.getMemoryRequirements();
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, {});
+        image.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
+        image.image.bindMemory(*image.memory, 0);
+        image.view = vk::raii::ImageView(
+            *device_, vk::ImageViewCreateInfo({}, *image.image, vk::ImageViewType::e2D, format, {}, {aspect, 0, 1, 0, 1}));
+        return image;
+    }
+
+    void create_images() {
+        for (int i = 0; i < config_.frames_in_flight + 1; ++i)
+            ring_.push_back(create_image(vk::Format(colour_format),
+                                         vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+                                         vk::ImageAspectFlagBits::eColor));
+        depth_ = create_image(vk::Format(depth_format), vk::ImageUsageFlagBits::eDepthStencilAttachment,
+                              vk::ImageAspectFlagBits::eDepth);
+    }
+
+    void create_pipeline() {
+        vk::DescriptorSetLayoutBinding binding(0, vk::DescriptorType::eUniformBuffer, 1,
+                                               vk::ShaderStageFlagBits::eVertex);
+        set_layout_ = vk::raii::DescriptorSetLayout(*device_, vk::DescriptorSetLayoutCreateInfo({}, binding));
+        vk::PushConstantRange push(vk::ShaderStageFlagBits::eVertex, 0, sizeof(PushConstants));
+        pipeline_layout_ = vk::raii::PipelineLayout(*device_, vk::PipelineLayoutCreateInfo({}, *set_layout_, push));
+        vk::raii::ShaderModule vert(*device_, vk::ShaderModuleCreateInfo({}, vkrc_shaders::teapot_vert.size_bytes(),
+                                                                         vkrc_shaders::teapot_vert.data()));
+        vk::raii::ShaderModule frag(*device_, vk::ShaderModuleCreateInfo({}, vkrc_shaders::teapot_frag.size_bytes(),
+                                                                         vkrc_shaders::teapot_frag.data()));
+        std::array<vk::PipelineShaderStageCreateInfo, 2> stages{
+            vk::PipelineShaderStageCreateInfo({}, vk::ShaderStageFlagBits::eVertex, *vert, "main"),
+            vk::PipelineShaderStageCreateInfo({}, vk::ShaderStageFlagBits::eFragment, *frag, "main")};
+        std::array<vk::VertexInputBindingDescription, 2> bindings{
+            vk::VertexInputBindingDescription(0, sizeof(glm::vec3), vk::VertexInputRate::eVertex),
+            vk::VertexInputBindingDescription(1, sizeof(glm::vec3), vk::VertexInputRate::eVertex)};
+        std::array<vk::VertexInputAttributeDescription, 2> attributes{
+            vk::VertexInputAttributeDescription(0, 0, vk::Format::eR32G32B32Sfloat, 0),
+            vk::VertexInputAttributeDescription(1, 1, vk::Format::eR32G32B32Sfloat, 0)};
+        vk::PipelineVertexInputStateCreateInfo vertex_input({}, bindings, attributes);
+        vk::PipelineInputAssemblyStateCreateInfo assembly({}, vk::PrimitiveTopology::eTriangleList);
+        vk::PipelineViewportStateCreateInfo viewport({}, 1, nullptr, 1, nullptr);
+        vk::PipelineRasterizationStateCreateInfo raster({}, false, false, vk::PolygonMode::eFill,
+                                                        vk::CullModeFlagBits::eNone, vk::FrontFace::eCounterClockwise,
+                                                        false, 0, 0, 0, 1.0f);
+        vk::PipelineMultisampleStateCreateInfo multisample({}, vk::SampleCountFlagBits::e1);
+        vk::PipelineDepthStencilStateCreateInfo depth({}, true, true, vk::CompareOp::eLess);
+        vk::PipelineColorBlendAttachmentState blend_attachment;
+        blend_attachment.colorWriteMask = vk::ColorComponentFlagBits::eR | vk::ColorComponentFlagBits::eG |
+                                          vk::ColorComponentFlagBits::eB | vk::ColorComponentFlagBits::eA;
+        vk::PipelineColorBlendStateCreateInfo blend({}, false, vk::LogicOp::eClear, blend_attachment);
+        std::array<vk::DynamicState, 2> dynamic_states{vk::DynamicState::eViewport, vk::DynamicState::eScissor};
+        vk::PipelineDynamicStateCreateInfo dynamic({}, dynamic_states);
+        vk::Format colour = vk::Format(colour_format);
+        vk::StructureChain<vk::GraphicsPipelineCreateInfo, vk::PipelineRenderingCreateInfo> chain(
+            vk::GraphicsPipelineCreateInfo({}, stages, &vertex_input, &assembly, nullptr, &viewport, &raster,
+                                           &multisample, &depth, &blend, &dynamic, *pipeline_layout_),
+            vk::PipelineRenderingCreateInfo(0, colour, vk::Format(depth_format)));
+        pipeline_ = vk::raii::Pipeline(*device_, nullptr, chain.get<vk::GraphicsPipelineCreateInfo>());
+    }
+
+    void create_frames() {
+        auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
+        vk::DescriptorPoolSize pool_size(vk::DescriptorType::eUniformBuffer, slots);
+        // vk::raii::DescriptorSet frees its set on destruction, which needs the flag.
+        descriptor_pool_ = vk::raii::DescriptorPool(
+            *device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, slots,
+                                                   pool_size));
+        for (std::uint32_t i = 0; i < slots; ++i) {
+            Frame f;
+            f.pool = vk::raii::CommandPool(
+                *device_, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eTransient, queue_family_));
+            f.cmd = std::move(vk::raii::CommandBuffers(
+                *device_, vk::CommandBufferAllocateInfo(*f.pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
+            f.fence = vk::raii::Fence(*device_, vk::FenceCreateInfo());
+            f.descriptor_set = std::move(
+                vk::raii::DescriptorSets(*device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *set_layout_))[0]);
+            vk::DescriptorBufferInfo buffer(*uniform_.buffer, i * uniform_stride_, sizeof(CameraUniforms));
+            device_->updateDescriptorSets(
+                vk::WriteDescriptorSet(*f.descriptor_set, 0, 0, vk::DescriptorType::eUniformBuffer, {}, buffer), {});
+            frames_.push_back(std::move(f));
+        }
+    }
+
+    Config config_;
+    CameraUniforms camera_{};
+    std::vector<PushConstants> draws_;
+    std::uint32_t index_count_ = 0;
+    std::string device_name_;
+    vk::DeviceSize uniform_alignment_ = 1;
+    std::uint32_t queue_family_ = 0;
+    vk::PhysicalDeviceMemoryProperties memory_properties_;
+
+    // Declaration order is destruction order reversed: parents first.
+    vk::raii::Context context_;
+    std::optional<vk::raii::Instance> instance_;
+    std::optional<vk::raii::DebugUtilsMessengerEXT> messenger_;
+    std::optional<vk::raii::PhysicalDevice> physical_device_;
+    std::optional<vk::raii::Device> device_;
+    std::optional<vk::raii::Queue> queue_;
+    Buffer positions_, normals_, indices_, uniform_, readback_;
+    void* uniform_mapped_ = nullptr;
+    vk::DeviceSize uniform_stride_ = 0;
+    std::vector<Image> ring_;
+    Image depth_;
+    vk::raii::DescriptorSetLayout set_layout_ = nullptr;
+    vk::raii::PipelineLayout pipeline_layout_ = nullptr;
+    vk::raii::Pipeline pipeline_ = nullptr;
+    vk::raii::DescriptorPool descriptor_pool_ = nullptr;
+    std::vector<Frame> frames_;
+
+    std::uint64_t frame_ = 0;
+    std::uint32_t slot_ = 0;
+    std::uint32_t image_ = 0;
+    std::uint32_t presented_image_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Variant> make_vkhpp_variant() { return std::make_unique<VkhppVariant>(); }
+
+}  // namespace teapot

@@ -1,0 +1,25 @@
+// Fault injection: wraps every Vulkan entry point vkrc loads, so that the k-th
+// call returning VkResult fails with a chosen error. Lives in the tests only:
+// vkrc takes the wrapper through InstanceCreateInfo::get_instance_proc_addr,
+// the same hook any application has, and its hot path is untouched.
+#pragma once
+
+#include <vulkan/vulkan_core.h>
+
+#include <cstdint>
+
+namespace vkrc_test::faults {
+
+// Pass as InstanceCreateInfo::get_instance_proc_addr. Device-level functions
+// are wrapped too, through the vkGetDeviceProcAddr it hands out.
+PFN_vkGetInstanceProcAddr get_instance_proc_addr();
+
+// From now on, the call-th failable call (1-based) returns error; 0 disarms.
+void arm(std::uint64_t call, VkResult error);
+// Failable calls made since the last arm().
+std::uint64_t failable_calls();
+// Whether the armed failure has been returned, and by which function.
+bool fired();
+const char* fired_in();
+
+}  // namespace vkrc_test::faults
