@@ -134,13 +134,13 @@ void DeviceState::collect() noexcept {
 
 void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) const {
     out.resize(queues.size());
-    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i]->submitted.load(std::memory_order_acquire);
+    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].submitted.load(std::memory_order_acquire);
 }
 
 bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
     if (lost.load(std::memory_order_relaxed)) return true;
     for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
-        auto& q = *queues[i];
+        auto& q = queues[i];
         if (q.completed.load(std::memory_order_relaxed) >= snapshot[i]) continue;
         std::uint64_t value = 0;
         VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
