@@ -8,6 +8,7 @@
 #include "shaders/triangle.vert.h"
 #include "support/png.hpp"
 
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <exception>
