@@ -68,8 +68,12 @@ int flag_count(VkMemoryPropertyFlags flags) noexcept {
 }
 }  // namespace
 
-int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
-                     const MemoryIntent& intent) noexcept {
+namespace {
+struct FlagChoice {
+    VkMemoryPropertyFlags required, preferred, avoided;
+};
+// The intent's own flags plus what its usage implies.
+FlagChoice flags_of(const MemoryIntent& intent) noexcept {
     VkMemoryPropertyFlags required = intent.required_flags;
     VkMemoryPropertyFlags preferred = intent.preferred_flags;
     VkMemoryPropertyFlags avoided = 0;
@@ -88,6 +92,13 @@ int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::ui
             break;
         case MemoryUsage::custom: break;
     }
+    return {required, preferred, avoided};
+}
+}  // namespace
+
+int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
+                     const MemoryIntent& intent) noexcept {
+    const auto [required, preferred, avoided] = flags_of(intent);
     // Memory only special resources may use is never chosen unless required.
     const VkMemoryPropertyFlags special = VK_MEMORY_PROPERTY_PROTECTED_BIT |
                                           VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT |
@@ -113,7 +124,7 @@ std::uint32_t choose_memory_type(const VkPhysicalDeviceMemoryProperties& propert
     int type = find_memory_type(properties, type_bits, intent);
     if (type < 0) {
         throw UsageError(std::string(who) + ": no memory type of the device has the required property flags 0x" +
-                         detail::hex(intent.required_flags) + " among the resource's allowed types 0x" +
+                         detail::hex(flags_of(intent).required) + " among the resource's allowed types 0x" +
                          detail::hex(type_bits));
     }
     return static_cast<std::uint32_t>(type);

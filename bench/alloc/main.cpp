@@ -75,6 +75,8 @@ Pattern make_pattern(const vkrc::Device& device, std::size_t operations, std::si
                 VkDeviceImageMemoryRequirements q{VK_STRUCTURE_TYPE_DEVICE_IMAGE_MEMORY_REQUIREMENTS, nullptr, &i};
                 device.fn().vkGetDeviceImageMemoryRequirements(device.vk(), &q, &req);
                 r.linear = false;
+                // Discrete GPUs offer no host-visible type for optimal-tiling images.
+                r.intent.usage = vkrc::MemoryUsage::gpu_only;
             }
             r.requirements = req.memoryRequirements;
             const std::size_t slot = free_slots.back();
