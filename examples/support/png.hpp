@@ -1,6 +1,5 @@
-// A minimal PNG writer and reader for the examples: 8-bit RGBA, zlib "stored"
-// (uncompressed) deflate blocks, no dependencies. The reader only reads what
-// the writer writes (it is for checking the examples' output in tests).
+// PNG files for the examples: 8-bit RGBA, written and read with stb
+// (stb_image_write.h and stb_image.h from Debian's libstb-dev).
 #pragma once
 
 #include <cstdint>
@@ -18,10 +17,10 @@ struct RgbaImage {
     const std::uint8_t* at(std::uint32_t x, std::uint32_t y) const { return &pixels[(std::size_t(y) * width + x) * 4]; }
 };
 
-// Throws std::runtime_error on I/O failure.
+// Throws std::runtime_error on I/O failure or when rgba is not width * height * 4 bytes.
 void write_png(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                std::span<const std::uint8_t> rgba);
-// Throws std::runtime_error for files write_png did not write.
+// Any PNG, converted to RGBA. Throws std::runtime_error when it cannot be read.
 RgbaImage read_png(const std::filesystem::path& file);
 
 }  // namespace vkrc_examples

@@ -1,0 +1,22 @@
+#include <vkrc/vkrc.hpp>
+#include <cstdio>
+int main() {
+    auto instance = vkrc::Instance::create({.validation = true});
+    auto device = vkrc::Device::create(vkrc::PhysicalDevice::select(instance));
+    auto queue = device.default_queue();
+    instance.reset();  // fine: the device keeps its instance alive
+    auto buffer = vkrc::Buffer::create(device, {.size = 1024, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto cmd = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}).allocate();
+    cmd.begin();
+    cmd.fill_buffer(buffer, 0, buffer.size(), 42);
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    auto done = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, done);
+    done.wait();
+    std::printf("%s filled the buffer with %u\n", device.physical_device().name(),
+                buffer.allocation().read_value<std::uint32_t>(512));
+}  // handles go in any order; vkrc destroys children before parents
