@@ -97,8 +97,10 @@ void choose_format_and_mode(detail::SwapchainState& s) {
             }
         }
     }
+    const bool srgb = s.surface_format.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR;
     log(s, "format " + format_name(s.surface_format.format) + ", colour space " +
-               std::to_string(s.surface_format.colorSpace) + " (" + reason + ")");
+               (srgb ? std::string("SRGB_NONLINEAR") : std::to_string(s.surface_format.colorSpace)) + " (" + reason +
+               ")");
 
     auto modes = s.surface.present_modes(physical);
     const VkPresentModeKHR requested = s.info.present_mode;
