@@ -29,17 +29,35 @@ SwapchainChainState::~SwapchainChainState() {
     // so no cycle): the surface must outlive the swapchain's destruction.
     SurfaceState* s = surface.state();
     s->add_ref();
-    device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
-                                  d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
-                                  static_cast<SurfaceState*>(context)->release();
-                              },
-                              handle_bits(swapchain), s});
+    if (last) {
+        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      auto* surface_state = static_cast<SurfaceState*>(context);
+                                      {
+                                          LockGuard lock(surface_state->mutex);
+                                          surface_state->releasing = false;
+                                      }
+                                      surface_state->release();
+                                  },
+                                  handle_bits(swapchain), s});
+    } else {
+        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      static_cast<SurfaceState*>(context)->release();
+                                  },
+                                  handle_bits(swapchain), s});
+    }
 }
 
 SwapchainState::~SwapchainState() {
     if (!surface) return;
     LockGuard lock(surface.state()->mutex);
     surface.state()->taken = false;
+    if (chain) {
+        // Set before the chain member is released (after this body).
+        chain->last = true;
+        surface.state()->releasing = true;
+    }
 }
 
 }  // namespace detail
@@ -267,12 +285,25 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const Sw
                          " cannot present to the surface");
     }
     detail::Ref<detail::SwapchainState> state(new detail::SwapchainState);
-    {
-        LockGuard lock(surface.state()->mutex);
-        if (surface.state()->taken) {
-            throw UsageError("vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
+    auto& surface_state = *surface.state();
+    for (bool waited = false;; waited = true) {
+        {
+            LockGuard lock(surface_state.mutex);
+            if (surface_state.taken) {
+                throw UsageError("vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
+            }
+            if (!surface_state.releasing) {
+                surface_state.taken = true;
+                break;
+            }
         }
-        surface.state()->taken = true;
+        if (waited) {
+            throw UsageError("vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
+                             "Image holds one of its images, or another device has not destroyed it)");
+        }
+        // The previous Swapchain's Vulkan swapchain is not retired: its
+        // destruction must run before a new one can be made for the surface.
+        device.wait_idle();
     }
     state->surface = surface;  // from here the state's destructor gives the surface back
     state->queue = queue;

@@ -240,9 +240,31 @@ TEST_F(PresentationTest, MinimisedAndRestored) {
 TEST_F(PresentationTest, OneLiveSwapchainPerSurface) {
     auto swapchain = make_swapchain();
     EXPECT_THROW(make_swapchain(), vkrc::UsageError);
+    {
+        Renderer renderer(queue, swapchain.format());
+        for (int i = 0; i < 3; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+        // Dropped with frames in flight: the next create waits for its destruction.
+        swapchain.reset();
+        swapchain = make_swapchain();
+        EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+        renderer.wait();
+    }
+    // A frame that outlives its Swapchain keeps the Vulkan swapchain, so the
+    // surface is not free until the frame goes.
+    auto frame = swapchain.acquire();
+    ASSERT_TRUE(frame);
+    Renderer renderer(queue, swapchain.format());
+    renderer.record(renderer.slots[0].cmd, frame, nullptr);
+    renderer.slots[0].fence.unsignal();
+    vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1),
+                         .signals = frame.signals()},
+                 renderer.slots[0].fence);
+    EXPECT_EQ(swapchain.present(frame), vkrc::PresentStatus::success);
     swapchain.reset();
-    auto second = make_swapchain();
-    EXPECT_TRUE(second);
+    EXPECT_THROW(make_swapchain(), vkrc::UsageError);
+    frame = {};
+    EXPECT_TRUE(make_swapchain());
+    renderer.wait();
 }
 
 TEST_F(PresentationTest, RetiredSwapchainLivesWhileAFrameHoldsItsImage) {

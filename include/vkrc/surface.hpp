@@ -43,9 +43,12 @@ public:
     Instance instance;
     VkSurfaceKHR surface = VK_NULL_HANDLE;
     Ownership ownership = Ownership::owned;
-    // Whether a live Swapchain holds the surface (Vulkan allows one
-    // non-retired swapchain per surface). Set and cleared under mutex.
+    // Vulkan allows one non-retired swapchain per surface. taken: a live
+    // Swapchain holds the surface. releasing: the last one is gone but its
+    // current Vulkan swapchain is not destroyed yet (frames hold its images,
+    // or the GPU is not done). Both under mutex.
     bool taken = false;
+    bool releasing = false;
     Mutex mutex;
 };
 

@@ -128,7 +128,10 @@ class Swapchain : public Handle<detail::SwapchainState>, public Presenter {
 public:
     Swapchain() noexcept = default;
     // Creates the swapchain and takes the surface: a second live Swapchain
-    // for the same surface is a UsageError. The device needs
+    // for the same surface is a UsageError. After a previous Swapchain of the
+    // surface was dropped, waits for the device to be idle so that its Vulkan
+    // swapchain is destroyed (UsageError if frames still hold its images).
+    // The device needs
     // VK_KHR_swapchain, and the queue's family must present to the surface.
     // A surface with zero extent (minimised) gets its swapchain at the first
     // acquire after it has an area again.
@@ -136,6 +139,8 @@ public:
 
     Frame acquire() override;
     PresentStatus present(const Frame& frame) override;
+    // As of the last (re)creation; under the multi-thread policy read them on
+    // the thread that acquires, or use the Frame's.
     VkExtent2D extent() const noexcept override;
     VkFormat format() const noexcept override;
     std::uint32_t image_count() const noexcept override;
@@ -216,6 +221,9 @@ public:
     // only when image i is acquired again.
     std::vector<Semaphore> render_done;
     bool presented = false;  // under the owning SwapchainState's mutex
+    // Not retired when its Swapchain went: its destruction ends the surface's
+    // SurfaceState::releasing.
+    bool last = false;
 };
 
 class SwapchainState final : public RefCounted {
