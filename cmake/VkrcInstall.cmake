@@ -19,11 +19,13 @@ foreach(policy IN LISTS VKRC_POLICIES)
   list(APPEND vkrc_install_targets vkrc_${policy})
 endforeach()
 # Add-on libraries join the same export set when they are built; each one's
-# EXPORT_NAME gives its imported name (vkrc_glfw -> vkrc::glfw). Their
+# EXPORT_NAME gives its imported name (vkrc_glfw_st -> vkrc::glfw_st). Their
 # dependencies are found in vkrcConfig.cmake.in, next to Vulkan's.
-foreach(addon IN ITEMS vkrc_glfw)
-  if(TARGET ${addon})
-    list(APPEND vkrc_install_targets ${addon})
+set(VKRC_INSTALLED_GLFW OFF)
+foreach(policy IN LISTS VKRC_POLICIES)
+  if(TARGET vkrc_glfw_${policy})
+    list(APPEND vkrc_install_targets vkrc_glfw_${policy})
+    set(VKRC_INSTALLED_GLFW ON)
   endif()
 endforeach()
 
@@ -40,10 +42,6 @@ install(EXPORT vkrcTargets
 
 # The policies and add-ons this installation holds, for vkrcConfig.cmake.
 set(VKRC_INSTALLED_POLICIES "${VKRC_POLICIES}")
-set(VKRC_INSTALLED_GLFW OFF)
-if(TARGET vkrc_glfw)
-  set(VKRC_INSTALLED_GLFW ON)
-endif()
 configure_package_config_file(
   ${CMAKE_CURRENT_LIST_DIR}/vkrcConfig.cmake.in
   ${PROJECT_BINARY_DIR}/vkrcConfig.cmake

@@ -211,12 +211,13 @@ VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 
 // A semaphore to wait on or signal in a submission (VkSemaphoreSubmitInfo);
 // value is ignored for binary semaphores.
 struct SemaphoreSubmit {
+    SemaphoreSubmit() noexcept = default;
     SemaphoreSubmit(const Semaphore& s, std::uint64_t v = 0,
                     VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) noexcept
         : semaphore(s.vk()), value(v), stage_mask(stages) {}
-    VkSemaphore semaphore;
-    std::uint64_t value;
-    VkPipelineStageFlags2 stage_mask;
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    std::uint64_t value = 0;
+    VkPipelineStageFlags2 stage_mask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 };
 
 // One batch of a submission (VkSubmitInfo2).

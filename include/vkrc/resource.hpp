@@ -205,6 +205,9 @@ struct ImageState final : RefCounted {
     VkImageUsageFlags usage = 0;
     Ownership ownership = Ownership::owned;
     Allocation allocation;
+    // What a borrowed image belongs to and keeps alive (a swapchain's images
+    // keep their swapchain); released first, after the image's own teardown.
+    Ref<RefCounted> owner;
 };
 
 struct ImageViewState final : RefCounted {

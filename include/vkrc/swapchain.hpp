@@ -1,0 +1,278 @@
+// Presentation: the Presenter interface, Swapchain (VK_KHR_swapchain) and
+// HeadlessPresenter (a ring of offscreen images), so that one frame loop
+// serves a window and a machine without a display:
+//
+//     vkrc::Frame frame = presenter.acquire();
+//     if (!frame) continue;  // minimised, or re-created next time: no image this time
+//     ... record: barrier UNDEFINED -> attachment (src stage frame.acquire_stage),
+//         render into frame.view (frame.extent), barrier -> frame.present_layout
+//     vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = ...,
+//                          .signals = frame.signals()}, fence);
+//     presenter.present(frame);
+//
+// Every acquired frame must be submitted (waiting on frame.waits()) and
+// presented: its semaphores are reused on that condition.
+#pragma once
+
+#include "vkrc/command.hpp"
+#include "vkrc/resource.hpp"
+#include "vkrc/surface.hpp"
+#include "vkrc/sync.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class SwapchainState;
+class SwapchainChainState;
+class HeadlessPresenterState;
+}  // namespace detail
+
+// What acquire() and present() report; none of them is an exception.
+enum class PresentStatus : std::uint8_t {
+    success,
+    // The image is usable (acquire) or was presented (present), but no longer
+    // matches the surface: the presenter re-creates its images before the
+    // next acquire.
+    suboptimal,
+    // No image (acquire) / not presented (present): the surface changed. The
+    // next acquire re-creates the images first.
+    out_of_date,
+    // The surface has no area (a minimised window): no image and nothing to
+    // render. Acquire again later (after waiting for window events).
+    zero_extent,
+};
+
+// One acquired image and what its submission waits on and signals.
+class Frame {
+public:
+    PresentStatus status = PresentStatus::out_of_date;
+    std::uint32_t image_index = 0;
+    Image image;  // borrowed from the presenter; keeps it (its swapchain) alive
+    ImageView view;
+    VkExtent2D extent{};
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    // The layout the image must be in when present() is called:
+    // PRESENT_SRC_KHR for a swapchain, TRANSFER_SRC_OPTIMAL headless.
+    VkImageLayout present_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    // The stage at which the submission waits for the image: the source
+    // stage of the first barrier on the image.
+    static constexpr VkPipelineStageFlags2 acquire_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+
+    // True when there is an image to render.
+    explicit operator bool() const noexcept { return static_cast<bool>(image); }
+    // For the submission that renders the image: it waits until the image is
+    // free and signals when rendering is done. Empty spans headless.
+    std::span<const SemaphoreSubmit> waits() const noexcept { return {&wait_, sync_count_}; }
+    std::span<const SemaphoreSubmit> signals() const noexcept { return {&signal_, sync_count_}; }
+
+private:
+    friend class Swapchain;
+    friend class HeadlessPresenter;
+    SemaphoreSubmit wait_;
+    SemaphoreSubmit signal_;
+    std::uint32_t sync_count_ = 0;
+    std::uint32_t acquire_slot_ = 0;
+    detail::SwapchainChainState* chain_ = nullptr;  // kept alive by image
+};
+
+// The interface the frame loop uses; Swapchain and HeadlessPresenter
+// implement it. acquire and present take the presenter's lock (and present
+// the queue's), so under the multi-thread policy any thread may call them.
+class Presenter {
+public:
+    virtual ~Presenter() = default;
+    // The next image to render; see PresentStatus for an empty frame.
+    virtual Frame acquire() = 0;
+    // Hands the rendered image over (after the submission that renders it).
+    virtual PresentStatus present(const Frame& frame) = 0;
+    virtual VkExtent2D extent() const noexcept = 0;
+    virtual VkFormat format() const noexcept = 0;
+    virtual std::uint32_t image_count() const noexcept = 0;
+
+protected:
+    Presenter() = default;
+    Presenter(const Presenter&) = default;
+    Presenter& operator=(const Presenter&) = default;
+};
+
+// Mirrors what vkrc chooses for VkSwapchainCreateInfoKHR.
+struct SwapchainCreateInfo {
+    // Tried in order; the first the surface supports wins, otherwise the
+    // surface's first format.
+    std::vector<VkSurfaceFormatKHR> preferred_formats = {
+        {VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
+        {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
+    // IMMEDIATE falls back to MAILBOX, MAILBOX to IMMEDIATE, both then to
+    // FIFO (which every surface supports).
+    VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+    // Clamped to the surface's minimum and maximum.
+    std::uint32_t min_image_count = 3;
+    VkImageUsageFlags image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+    // Falls back to the first alpha mode the surface supports.
+    VkCompositeAlphaFlagBitsKHR composite_alpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+    bool clipped = true;
+    // Only for surfaces that leave the extent to the swapchain (currentExtent
+    // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
+    VkExtent2D extent{};
+    // Receives the choices made and why, at creation and every re-creation.
+    std::function<void(const std::string&)> log;
+};
+
+// A swapchain for one Surface, re-created in place. Keeps its Surface,
+// Queue and Device alive. Its images are borrowed Image handles that keep
+// the Vulkan swapchain they belong to alive, so a retired swapchain stays
+// until every frame that used it is dropped and its work has completed.
+class Swapchain : public Handle<detail::SwapchainState>, public Presenter {
+public:
+    Swapchain() noexcept = default;
+    // Creates the swapchain and takes the surface: a second live Swapchain
+    // for the same surface is a UsageError. After a previous Swapchain of the
+    // surface was dropped, waits for the device to be idle so that its Vulkan
+    // swapchain is destroyed (UsageError if frames still hold its images).
+    // The device needs
+    // VK_KHR_swapchain, and the queue's family must present to the surface.
+    // A surface with zero extent (minimised) gets its swapchain at the first
+    // acquire after it has an area again.
+    static Swapchain create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info = {});
+
+    Frame acquire() override;
+    PresentStatus present(const Frame& frame) override;
+    // As of the last (re)creation; under the multi-thread policy read them on
+    // the thread that acquires, or use the Frame's.
+    VkExtent2D extent() const noexcept override;
+    VkFormat format() const noexcept override;
+    std::uint32_t image_count() const noexcept override;
+
+    // Re-creates for the surface's current extent now (oldSwapchain set to
+    // the current one, which is retired). zero_extent when the surface has
+    // no area (the old swapchain stays until it has); success otherwise.
+    // acquire() does this itself after out_of_date or suboptimal.
+    PresentStatus recreate();
+    // The extent for surfaces that leave it to the swapchain (see
+    // SwapchainCreateInfo::extent); takes effect at the next re-creation.
+    void set_extent(VkExtent2D extent);
+
+    // The current Vulkan swapchain (VK_NULL_HANDLE while the surface has no area).
+    VkSwapchainKHR vk() const noexcept;
+    const Surface& surface() const noexcept;
+    const Queue& queue() const noexcept;
+    VkColorSpaceKHR color_space() const noexcept;
+    VkPresentModeKHR present_mode() const noexcept;
+
+private:
+    using Handle::Handle;
+};
+
+// Mirrors what a swapchain would be made of, for rendering offscreen.
+struct HeadlessPresenterCreateInfo {
+    VkExtent2D extent{};
+    VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
+    // The ring's size: frames in flight + 1, as a swapchain would have.
+    std::uint32_t image_count = 3;
+    // TRANSFER_SRC is always added (for read_back).
+    VkImageUsageFlags image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+};
+
+// The Presenter for machines without a display: frame n renders into ring
+// image n % image_count; acquire and present are bookkeeping only (no
+// semaphores, no Vulkan call), as in the teapot benchmark's convention
+// (bench/teapot/harness/variant.hpp). Like a swapchain image, a ring image
+// is reused image_count frames later: the frame loop's fences keep it from
+// being rewritten while the GPU still renders into it.
+class HeadlessPresenter : public Handle<detail::HeadlessPresenterState>, public Presenter {
+public:
+    HeadlessPresenter() noexcept = default;
+    static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
+
+    Frame acquire() override;
+    PresentStatus present(const Frame& frame) override;
+    VkExtent2D extent() const noexcept override;
+    VkFormat format() const noexcept override;
+    std::uint32_t image_count() const noexcept override;
+
+    // The ring image last presented; UINT32_MAX before the first present.
+    std::uint32_t last_presented() const noexcept;
+    // Waits for the image's rendering (the queue's submitted work) and copies
+    // it out: extent.width * extent.height texels, top row first.
+    std::vector<std::byte> read_back(std::uint32_t image_index) const;
+    // New images of this extent from the next acquire (frames holding the
+    // old ones keep them alive).
+    void resize(VkExtent2D extent);
+
+private:
+    using Handle::Handle;
+};
+
+namespace detail {
+
+// One Vulkan swapchain (current or retired) and its per-image semaphores.
+class SwapchainChainState final : public RefCounted {
+public:
+    // Queues the swapchain's destruction after everything submitted on the
+    // queue so far, including (by an empty submission) its last present;
+    // see the Presentation section of docs/design.md.
+    ~SwapchainChainState() override;
+    Queue queue;
+    Surface surface;
+    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+    // Signalled by the rendering of image i, waited by its present; reused
+    // only when image i is acquired again.
+    std::vector<Semaphore> render_done;
+    bool presented = false;  // under the owning SwapchainState's mutex
+    // Not retired when its Swapchain went: its destruction ends the surface's
+    // SurfaceState::releasing.
+    bool last = false;
+};
+
+class SwapchainState final : public RefCounted {
+public:
+    ~SwapchainState() override;  // gives the surface back
+    Queue queue;
+    Surface surface;
+    SwapchainCreateInfo info;
+    Ref<SwapchainChainState> chain;  // null until the surface has an area
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    // Ring of acquire semaphores, each reused once the queue has reached the
+    // value recorded when the frame that waited on it was presented.
+    std::vector<Semaphore> acquire_semaphores;
+    std::vector<std::uint64_t> acquire_done_values;
+    std::uint32_t next_acquire = 0;
+    VkSurfaceFormatKHR surface_format{};
+    VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+    VkExtent2D extent{};
+    bool needs_recreate = false;
+    Mutex mutex;
+};
+
+class HeadlessPresenterState final : public RefCounted {
+public:
+    Queue queue;
+    HeadlessPresenterCreateInfo info;
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    std::uint64_t frame = 0;
+    std::uint32_t last_presented = UINT32_MAX;
+    bool needs_resize = false;
+    mutable Mutex mutex;
+};
+
+}  // namespace detail
+
+inline VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
+inline VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
+inline std::uint32_t Swapchain::image_count() const noexcept { return static_cast<std::uint32_t>(state_->images.size()); }
+inline VkSwapchainKHR Swapchain::vk() const noexcept { return state_->chain ? state_->chain->swapchain : VK_NULL_HANDLE; }
+inline const Surface& Swapchain::surface() const noexcept { return state_->surface; }
+inline const Queue& Swapchain::queue() const noexcept { return state_->queue; }
+inline VkColorSpaceKHR Swapchain::color_space() const noexcept { return state_->surface_format.colorSpace; }
+inline VkPresentModeKHR Swapchain::present_mode() const noexcept { return state_->present_mode; }
+
+inline VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }
+inline VkFormat HeadlessPresenter::format() const noexcept { return state_->info.format; }
+inline std::uint32_t HeadlessPresenter::image_count() const noexcept { return state_->info.image_count; }
+inline std::uint32_t HeadlessPresenter::last_presented() const noexcept { return state_->last_presented; }
+
+VKRC_END_NAMESPACE

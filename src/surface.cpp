@@ -1,0 +1,67 @@
+#include "vkrc/surface.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+SurfaceState::~SurfaceState() {
+    // Swapchains hold the surface until their deferred destruction has run,
+    // so none is left when this runs.
+    if (ownership == Ownership::owned && surface != VK_NULL_HANDLE) {
+        instance.fn().vkDestroySurfaceKHR(instance.vk(), surface, nullptr);
+    }
+}
+}  // namespace detail
+
+Surface Surface::adopt(const Instance& instance, VkSurfaceKHR surface, Ownership ownership) {
+    if (!instance) throw UsageError("vkrc::Surface::adopt: the Instance handle is empty");
+    if (surface == VK_NULL_HANDLE) throw UsageError("vkrc::Surface::adopt: the VkSurfaceKHR is VK_NULL_HANDLE");
+    if (!instance.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME)) {
+        throw UsageError("vkrc::Surface::adopt: the instance was created without VK_KHR_surface");
+    }
+    detail::Ref<detail::SurfaceState> state(new detail::SurfaceState);
+    state->instance = instance;
+    state->surface = surface;
+    state->ownership = ownership;
+    return Surface(std::move(state));
+}
+
+VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_device) const {
+    VkSurfaceCapabilitiesKHR caps{};
+    check(instance().fn().vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device.vk(), vk(), &caps),
+          "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+    return caps;
+}
+
+std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
+    const auto& fn = instance().fn();
+    std::vector<VkSurfaceFormatKHR> out;
+    VkResult r;
+    do {
+        std::uint32_t count = 0;
+        check(fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), &count, nullptr),
+              "vkGetPhysicalDeviceSurfaceFormatsKHR");
+        out.resize(count);
+        r = check(fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), &count, out.data()),
+                  "vkGetPhysicalDeviceSurfaceFormatsKHR");
+        out.resize(count);
+    } while (r == VK_INCOMPLETE);
+    return out;
+}
+
+std::vector<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
+    const auto& fn = instance().fn();
+    std::vector<VkPresentModeKHR> out;
+    VkResult r;
+    do {
+        std::uint32_t count = 0;
+        check(fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), &count, nullptr),
+              "vkGetPhysicalDeviceSurfacePresentModesKHR");
+        out.resize(count);
+        r = check(fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), &count, out.data()),
+                  "vkGetPhysicalDeviceSurfacePresentModesKHR");
+        out.resize(count);
+    } while (r == VK_INCOMPLETE);
+    return out;
+}
+
+VKRC_END_NAMESPACE

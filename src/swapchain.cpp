@@ -1,0 +1,491 @@
+#include "vkrc/swapchain.hpp"
+
+#include "vkrc/upload.hpp"
+
+#include <algorithm>
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+SwapchainChainState::~SwapchainChainState() {
+    if (swapchain == VK_NULL_HANDLE) return;
+    auto& device = *queue.device().state();
+    if (presented) {
+        // Without VK_EXT_swapchain_maintenance1 nothing says when a present
+        // is done. An empty submission after the last present puts a value
+        // of the queue's timeline after it in queue order; destroy_after_gpu
+        // below waits for that value (docs/design.md, Presentation).
+        try {
+            queue.submit({});
+        } catch (...) {
+            LockGuard lock(queue.mutex());
+            device.fn.vkQueueWaitIdle(queue.vk());
+        }
+    }
+    render_done.clear();  // queued before the swapchain, after the presents that wait on them
+    // The action carries a reference to the surface (not a device ancestor,
+    // so no cycle): the surface must outlive the swapchain's destruction.
+    SurfaceState* s = surface.state();
+    s->add_ref();
+    if (last) {
+        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      auto* surface_state = static_cast<SurfaceState*>(context);
+                                      {
+                                          LockGuard lock(surface_state->mutex);
+                                          surface_state->releasing = false;
+                                      }
+                                      surface_state->release();
+                                  },
+                                  handle_bits(swapchain), s});
+    } else {
+        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      static_cast<SurfaceState*>(context)->release();
+                                  },
+                                  handle_bits(swapchain), s});
+    }
+}
+
+SwapchainState::~SwapchainState() {
+    if (!surface) return;
+    LockGuard lock(surface.state()->mutex);
+    surface.state()->taken = false;
+    if (chain) {
+        // Set before the chain member is released (after this body).
+        chain->last = true;
+        surface.state()->releasing = true;
+    }
+}
+
+}  // namespace detail
+
+namespace {
+
+std::string format_name(VkFormat format) {
+    switch (format) {
+        case VK_FORMAT_B8G8R8A8_SRGB: return "B8G8R8A8_SRGB";
+        case VK_FORMAT_B8G8R8A8_UNORM: return "B8G8R8A8_UNORM";
+        case VK_FORMAT_R8G8B8A8_SRGB: return "R8G8B8A8_SRGB";
+        case VK_FORMAT_R8G8B8A8_UNORM: return "R8G8B8A8_UNORM";
+        case VK_FORMAT_A2B10G10R10_UNORM_PACK32: return "A2B10G10R10_UNORM_PACK32";
+        default: return "VkFormat " + std::to_string(format);
+    }
+}
+
+const char* present_mode_name(VkPresentModeKHR mode) {
+    switch (mode) {
+        case VK_PRESENT_MODE_IMMEDIATE_KHR: return "IMMEDIATE";
+        case VK_PRESENT_MODE_MAILBOX_KHR: return "MAILBOX";
+        case VK_PRESENT_MODE_FIFO_KHR: return "FIFO";
+        case VK_PRESENT_MODE_FIFO_RELAXED_KHR: return "FIFO_RELAXED";
+        default: return "other";
+    }
+}
+
+void log(const detail::SwapchainState& s, const std::string& message) {
+    if (s.info.log) s.info.log("vkrc::Swapchain: " + message);
+}
+
+// Format, colour space and present mode: fixed for the swapchain's life,
+// so that pipelines made for its format stay valid across re-creation.
+void choose_format_and_mode(detail::SwapchainState& s) {
+    const auto& physical = s.queue.device().physical_device();
+    auto formats = s.surface.formats(physical);
+    if (formats.empty()) throw UsageError("vkrc::Swapchain::create: the surface reports no formats");
+    std::string reason;
+    if (formats.size() == 1 && formats[0].format == VK_FORMAT_UNDEFINED && !s.info.preferred_formats.empty()) {
+        s.surface_format = s.info.preferred_formats[0];
+        reason = "the surface accepts any format: the first preferred one";
+    } else {
+        s.surface_format = formats[0];
+        reason = "no preferred format is supported: the surface's first";
+        for (std::size_t i = 0; i < s.info.preferred_formats.size(); ++i) {
+            const auto& want = s.info.preferred_formats[i];
+            auto it = std::find_if(formats.begin(), formats.end(), [&](const VkSurfaceFormatKHR& f) {
+                return f.format == want.format && f.colorSpace == want.colorSpace;
+            });
+            if (it != formats.end()) {
+                s.surface_format = *it;
+                reason = "preferred format " + std::to_string(i + 1) + " of " +
+                         std::to_string(s.info.preferred_formats.size()) + ", the first the surface supports";
+                break;
+            }
+        }
+    }
+    const bool srgb = s.surface_format.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR;
+    log(s, "format " + format_name(s.surface_format.format) + ", colour space " +
+               (srgb ? std::string("SRGB_NONLINEAR") : std::to_string(s.surface_format.colorSpace)) + " (" + reason +
+               ")");
+
+    auto modes = s.surface.present_modes(physical);
+    const VkPresentModeKHR requested = s.info.present_mode;
+    std::vector<VkPresentModeKHR> order{requested};
+    if (requested == VK_PRESENT_MODE_IMMEDIATE_KHR) order.push_back(VK_PRESENT_MODE_MAILBOX_KHR);
+    if (requested == VK_PRESENT_MODE_MAILBOX_KHR) order.push_back(VK_PRESENT_MODE_IMMEDIATE_KHR);
+    order.push_back(VK_PRESENT_MODE_FIFO_KHR);
+    s.present_mode = VK_PRESENT_MODE_FIFO_KHR;
+    for (auto mode : order) {
+        if (mode == VK_PRESENT_MODE_FIFO_KHR || std::find(modes.begin(), modes.end(), mode) != modes.end()) {
+            s.present_mode = mode;
+            break;
+        }
+    }
+    std::string message = std::string("present mode ") + present_mode_name(s.present_mode);
+    if (s.present_mode == requested) {
+        message += " (as requested)";
+    } else {
+        message += std::string(" (requested ") + present_mode_name(requested) +
+                   ", which the surface does not support; the fallback order is IMMEDIATE/MAILBOX, the other, FIFO)";
+    }
+    log(s, message);
+}
+
+// Creates the next Vulkan swapchain, retiring the current one. Under s.mutex.
+PresentStatus recreate_locked(detail::SwapchainState& s) {
+    const Device& device = s.queue.device();
+    const auto caps = s.surface.capabilities(device.physical_device());
+    VkExtent2D extent = caps.currentExtent;
+    const char* extent_reason = "the surface's current extent";
+    if (extent.width == UINT32_MAX) {
+        extent.width = std::clamp(s.info.extent.width, caps.minImageExtent.width, caps.maxImageExtent.width);
+        extent.height = std::clamp(s.info.extent.height, caps.minImageExtent.height, caps.maxImageExtent.height);
+        extent_reason = "the application's extent (the surface leaves it to the swapchain), clamped to its limits";
+    }
+    if (extent.width == 0 || extent.height == 0) {
+        // A minimised window: no swapchain can have this extent. The current
+        // one (if any) stays until the window has an area again.
+        s.needs_recreate = true;
+        return PresentStatus::zero_extent;
+    }
+    if ((caps.supportedUsageFlags & s.info.image_usage) != s.info.image_usage) {
+        throw UsageError("vkrc::Swapchain: the surface does not support image_usage " +
+                         std::to_string(s.info.image_usage) + " (supported: " +
+                         std::to_string(caps.supportedUsageFlags) + ")");
+    }
+    std::uint32_t count = std::max(s.info.min_image_count, caps.minImageCount);
+    if (caps.maxImageCount != 0) count = std::min(count, caps.maxImageCount);
+    VkCompositeAlphaFlagBitsKHR alpha = s.info.composite_alpha;
+    if (!(caps.supportedCompositeAlpha & alpha)) {
+        for (std::uint32_t bit = 1; bit != 0 && bit <= caps.supportedCompositeAlpha; bit <<= 1) {
+            if (caps.supportedCompositeAlpha & bit) {
+                alpha = static_cast<VkCompositeAlphaFlagBitsKHR>(bit);
+                break;
+            }
+        }
+    }
+
+    VkSwapchainCreateInfoKHR create{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+    create.surface = s.surface.vk();
+    create.minImageCount = count;
+    create.imageFormat = s.surface_format.format;
+    create.imageColorSpace = s.surface_format.colorSpace;
+    create.imageExtent = extent;
+    create.imageArrayLayers = 1;
+    create.imageUsage = s.info.image_usage;
+    create.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    create.preTransform = caps.currentTransform;
+    create.compositeAlpha = alpha;
+    create.presentMode = s.present_mode;
+    create.clipped = s.info.clipped ? VK_TRUE : VK_FALSE;
+    const bool replacing = static_cast<bool>(s.chain);
+    create.oldSwapchain = replacing ? s.chain->swapchain : VK_NULL_HANDLE;
+
+    detail::Ref<detail::SwapchainChainState> chain(new detail::SwapchainChainState);
+    chain->queue = s.queue;
+    chain->surface = s.surface;
+    VkResult created = device.fn().vkCreateSwapchainKHR(device.vk(), &create, nullptr, &chain->swapchain);
+    if (created != VK_SUCCESS) {
+        // The old swapchain is retired even when creation fails: drop it, so
+        // that the next attempt starts without an oldSwapchain.
+        s.views.clear();
+        s.images.clear();
+        s.chain.reset();
+        s.needs_recreate = true;
+        check(created, "vkCreateSwapchainKHR");
+    }
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    try {
+        std::uint32_t n = 0;
+        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, nullptr), "vkGetSwapchainImagesKHR");
+        std::vector<VkImage> raw(n);
+        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, raw.data()),
+              "vkGetSwapchainImagesKHR");
+        ImageCreateInfo info;
+        info.format = s.surface_format.format;
+        info.extent = {extent.width, extent.height, 1};
+        info.usage = s.info.image_usage;
+        for (VkImage image : raw) {
+            auto wrapped = Image::adopt(device, image, info, Ownership::borrowed);
+            wrapped.state()->owner = detail::Ref<detail::RefCounted>::share(chain.get());
+            views.push_back(ImageView::create(wrapped));
+            images.push_back(std::move(wrapped));
+            chain->render_done.push_back(Semaphore::create_binary(device));
+        }
+        // One acquire semaphore more than images, so that the next acquire
+        // normally finds its semaphore's last frame long finished.
+        while (s.acquire_semaphores.size() < n + 1) {
+            s.acquire_semaphores.push_back(Semaphore::create_binary(device));
+            s.acquire_done_values.push_back(0);
+        }
+    } catch (...) {
+        s.views.clear();
+        s.images.clear();
+        s.chain.reset();
+        s.needs_recreate = true;
+        throw;
+    }
+    // The old images and views go; the old swapchain follows once no frame
+    // holds its images (its destruction then waits for the GPU).
+    s.views = std::move(views);
+    s.images = std::move(images);
+    s.chain = std::move(chain);
+    s.extent = extent;
+    s.needs_recreate = false;
+    log(s, std::to_string(s.images.size()) + " images (asked for " + std::to_string(s.info.min_image_count) +
+               ", the surface allows " + std::to_string(caps.minImageCount) + " to " +
+               (caps.maxImageCount ? std::to_string(caps.maxImageCount) : std::string("any number")) + "), extent " +
+               std::to_string(extent.width) + "x" + std::to_string(extent.height) + " (" + extent_reason + ")" +
+               (replacing ? ", replacing the previous swapchain" : ""));
+    return PresentStatus::success;
+}
+
+// Waits until queue's timeline has reached value (0: nothing to wait for).
+void wait_for_queue(const Queue& queue, std::uint64_t value) {
+    if (value == 0) return;
+    const Device& device = queue.device();
+    VkSemaphore timeline = queue.timeline_semaphore();
+    VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    wait.semaphoreCount = 1;
+    wait.pSemaphores = &timeline;
+    wait.pValues = &value;
+    VkResult r = device.fn().vkWaitSemaphores(device.vk(), &wait, UINT64_MAX);
+    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
+    check(r, "vkWaitSemaphores");
+}
+
+}  // namespace
+
+Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info) {
+    if (!queue) throw UsageError("vkrc::Swapchain::create: the Queue is empty");
+    if (!surface) throw UsageError("vkrc::Swapchain::create: the Surface handle is empty");
+    const Device& device = queue.device();
+    if (!device.extension_enabled(VK_KHR_SWAPCHAIN_EXTENSION_NAME)) {
+        throw UsageError("vkrc::Swapchain::create: the device was created without VK_KHR_swapchain");
+    }
+    VkBool32 supported = VK_FALSE;
+    check(device.instance().fn().vkGetPhysicalDeviceSurfaceSupportKHR(device.physical_device().vk(),
+                                                                      queue.family_index(), surface.vk(), &supported),
+          "vkGetPhysicalDeviceSurfaceSupportKHR");
+    if (!supported) {
+        throw UsageError("vkrc::Swapchain::create: queue family " + std::to_string(queue.family_index()) +
+                         " cannot present to the surface");
+    }
+    detail::Ref<detail::SwapchainState> state(new detail::SwapchainState);
+    auto& surface_state = *surface.state();
+    for (bool waited = false;; waited = true) {
+        {
+            LockGuard lock(surface_state.mutex);
+            if (surface_state.taken) {
+                throw UsageError("vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
+            }
+            if (!surface_state.releasing) {
+                surface_state.taken = true;
+                break;
+            }
+        }
+        if (waited) {
+            throw UsageError("vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
+                             "Image holds one of its images, or another device has not destroyed it)");
+        }
+        // The previous Swapchain's Vulkan swapchain is not retired: its
+        // destruction must run before a new one can be made for the surface.
+        device.wait_idle();
+    }
+    state->surface = surface;  // from here the state's destructor gives the surface back
+    state->queue = queue;
+    state->info = info;
+    choose_format_and_mode(*state);
+    recreate_locked(*state);
+    return Swapchain(std::move(state));
+}
+
+Frame Swapchain::acquire() {
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    Frame frame;
+    if (s.needs_recreate || !s.chain) {
+        frame.status = recreate_locked(s);
+        if (frame.status != PresentStatus::success) return frame;
+    }
+    const Device& device = s.queue.device();
+    const std::uint32_t slot = s.next_acquire;
+    // The semaphore must have no pending wait: its last frame was presented
+    // after the submission that waited on it, at this queue value.
+    wait_for_queue(s.queue, s.acquire_done_values[slot]);
+    std::uint32_t index = 0;
+    VkResult r = device.fn().vkAcquireNextImageKHR(device.vk(), s.chain->swapchain, UINT64_MAX,
+                                                   s.acquire_semaphores[slot].vk(), VK_NULL_HANDLE, &index);
+    if (r == VK_ERROR_OUT_OF_DATE_KHR) {
+        s.needs_recreate = true;
+        frame.status = PresentStatus::out_of_date;
+        return frame;
+    }
+    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
+    check(r, "vkAcquireNextImageKHR");
+    if (r == VK_SUBOPTIMAL_KHR) s.needs_recreate = true;
+    s.next_acquire = (slot + 1) % static_cast<std::uint32_t>(s.acquire_semaphores.size());
+    frame.status = r == VK_SUBOPTIMAL_KHR ? PresentStatus::suboptimal : PresentStatus::success;
+    frame.image_index = index;
+    frame.image = s.images[index];
+    frame.view = s.views[index];
+    frame.extent = s.extent;
+    frame.format = s.surface_format.format;
+    frame.present_layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+    frame.wait_ = SemaphoreSubmit(s.acquire_semaphores[slot], 0, Frame::acquire_stage);
+    frame.signal_ = SemaphoreSubmit(s.chain->render_done[index], 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
+    frame.sync_count_ = 1;
+    frame.acquire_slot_ = slot;
+    frame.chain_ = s.chain.get();
+    return frame;
+}
+
+PresentStatus Swapchain::present(const Frame& frame) {
+    auto& s = *state_;
+    if (!frame.chain_ || frame.chain_->surface.state() != s.surface.state()) {
+        throw UsageError("vkrc::Swapchain::present: the frame was not acquired from this swapchain");
+    }
+    LockGuard lock(s.mutex);
+    auto& chain = *frame.chain_;
+    VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+    info.waitSemaphoreCount = 1;
+    info.pWaitSemaphores = &frame.signal_.semaphore;
+    info.swapchainCount = 1;
+    info.pSwapchains = &chain.swapchain;
+    info.pImageIndices = &frame.image_index;
+    const Device& device = s.queue.device();
+    VkResult r;
+    {
+        LockGuard queue_lock(s.queue.mutex());
+        r = device.fn().vkQueuePresentKHR(s.queue.vk(), &info);
+    }
+    // Even out of date, the present waits on its semaphore (queued as usual).
+    chain.presented = true;
+    s.acquire_done_values[frame.acquire_slot_] = s.queue.last_submitted_value();
+    if (r == VK_ERROR_OUT_OF_DATE_KHR) {
+        s.needs_recreate = true;
+        return PresentStatus::out_of_date;
+    }
+    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
+    check(r, "vkQueuePresentKHR");
+    if (r == VK_SUBOPTIMAL_KHR) {
+        s.needs_recreate = true;
+        return PresentStatus::suboptimal;
+    }
+    return PresentStatus::success;
+}
+
+PresentStatus Swapchain::recreate() {
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    return recreate_locked(s);
+}
+
+void Swapchain::set_extent(VkExtent2D extent) {
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    s.info.extent = extent;
+}
+
+namespace {
+
+void make_ring(detail::HeadlessPresenterState& s) {
+    ImageCreateInfo info;
+    info.format = s.info.format;
+    info.extent = {s.info.extent.width, s.info.extent.height, 1};
+    info.usage = s.info.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    for (std::uint32_t i = 0; i < s.info.image_count; ++i) {
+        images.push_back(Image::create(s.queue.device(), info));
+        views.push_back(ImageView::create(images.back()));
+    }
+    s.images = std::move(images);
+    s.views = std::move(views);
+    s.needs_resize = false;
+}
+
+}  // namespace
+
+HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPresenterCreateInfo& info) {
+    if (!queue) throw UsageError("vkrc::HeadlessPresenter::create: the Queue is empty");
+    if (info.extent.width == 0 || info.extent.height == 0) {
+        throw UsageError("vkrc::HeadlessPresenter::create: extent is zero");
+    }
+    if (info.image_count == 0) throw UsageError("vkrc::HeadlessPresenter::create: image_count is 0");
+    detail::Ref<detail::HeadlessPresenterState> state(new detail::HeadlessPresenterState);
+    state->queue = queue;
+    state->info = info;
+    make_ring(*state);
+    return HeadlessPresenter(std::move(state));
+}
+
+Frame HeadlessPresenter::acquire() {
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    Frame frame;
+    if (s.needs_resize) {
+        if (s.info.extent.width == 0 || s.info.extent.height == 0) {
+            frame.status = PresentStatus::zero_extent;
+            return frame;
+        }
+        make_ring(s);
+    }
+    const auto index = static_cast<std::uint32_t>(s.frame % s.info.image_count);
+    frame.status = PresentStatus::success;
+    frame.image_index = index;
+    frame.image = s.images[index];
+    frame.view = s.views[index];
+    frame.extent = s.info.extent;
+    frame.format = s.info.format;
+    frame.present_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    return frame;
+}
+
+PresentStatus HeadlessPresenter::present(const Frame& frame) {
+    auto& s = *state_;
+    if (!frame.image || frame.chain_ || frame.image_index >= s.info.image_count) {
+        throw UsageError("vkrc::HeadlessPresenter::present: the frame was not acquired from this presenter");
+    }
+    LockGuard lock(s.mutex);
+    s.last_presented = frame.image_index;
+    ++s.frame;
+    return PresentStatus::success;
+}
+
+std::vector<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
+    auto& s = *state_;
+    Image image;
+    {
+        LockGuard lock(s.mutex);
+        if (image_index >= s.images.size()) {
+            throw UsageError("vkrc::HeadlessPresenter::read_back: image " + std::to_string(image_index) +
+                             " does not exist (the ring has " + std::to_string(s.images.size()) + ")");
+        }
+        image = s.images[image_index];
+    }
+    wait_for_queue(s.queue, s.queue.last_submitted_value());
+    return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+}
+
+void HeadlessPresenter::resize(VkExtent2D extent) {
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    s.info.extent = extent;
+    s.needs_resize = true;
+}
+
+VKRC_END_NAMESPACE

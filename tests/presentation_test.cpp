@@ -1,0 +1,321 @@
+// Presentation: a GLFW window on a private Xvfb, its Swapchain re-created
+// while rendering, minimised (zero extent), and the headless presenter
+// rendering the same pixels through the same frame loop.
+#include "support/vk_test.hpp"
+#include "support/xvfb.hpp"
+
+#include "shaders/triangle.frag.h"
+#include "shaders/triangle.vert.h"
+
+#include <vkrc/glfw.hpp>
+
+#include <GLFW/glfw3.h>
+
+#include <array>
+#include <cstring>
+
+namespace {
+
+using vkrc_test::ValidationLog;
+
+struct Vertex {
+    float position[2];
+    float color[3];
+};
+
+// Everything a frame loop needs besides the presenter: two frames in flight.
+struct Renderer {
+    static constexpr int frames_in_flight = 2;
+
+    Renderer(const vkrc::Queue& q, VkFormat format) : queue(q) {
+        const auto& device = q.device();
+        const Vertex vertices[] = {{{0.0f, -0.6f}, {1, 0, 0}}, {{-0.6f, 0.6f}, {0, 1, 0}}, {{0.6f, 0.6f}, {0, 0, 1}}};
+        vertex_buffer = vkrc::Buffer::create(device, {.size = sizeof vertices,
+                                                      .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                                                      .memory = {.usage = vkrc::MemoryUsage::upload}});
+        vertex_buffer.allocation().write(0, vertices, 3);
+        pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+                       .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+                       .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+                       .vertex_binding(0, sizeof(Vertex))
+                       .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+                       .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+                       .rendering(std::array{format})
+                       .build();
+        for (auto& slot : slots) {
+            slot.pool = vkrc::CommandPool::create(device, {.queue_family_index = q.family_index()});
+            slot.cmd = slot.pool.allocate();
+            slot.fence = vkrc::Fence::create(device, true);
+        }
+    }
+
+    // One iteration of the frame loop; the status of acquire, or of present
+    // when an image was rendered. With readback, the image is also copied
+    // there (the presenter's images need TRANSFER_SRC).
+    vkrc::PresentStatus frame(vkrc::Presenter& presenter, const vkrc::Buffer* readback = nullptr) {
+        auto& slot = slots[count % frames_in_flight];
+        EXPECT_EQ(slot.fence.wait(), VK_SUCCESS);
+        vkrc::Frame frame = presenter.acquire();
+        if (!frame) return frame.status;
+        slot.fence.unsignal();
+        record(slot.cmd, frame, readback);
+        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1), .signals = frame.signals()},
+                     slot.fence);
+        ++count;
+        auto status = presenter.present(frame);
+        return frame.status == vkrc::PresentStatus::success ? status : frame.status;
+    }
+
+    void record(const vkrc::CommandBuffer& cmd, const vkrc::Frame& frame, const vkrc::Buffer* readback) {
+        cmd.begin();
+        auto to_attachment = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED,
+                                                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, vkrc::Frame::acquire_stage, 0,
+                                                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
+        vkrc::RenderingAttachment target{.image_view = frame.view.vk()};
+        target.clear_value.color = {{0.1f, 0.2f, 0.3f, 1.0f}};
+        cmd.begin_rendering({.render_area = {{0, 0}, frame.extent}, .color_attachments = std::span(&target, 1)});
+        cmd.bind_pipeline(pipeline);
+        cmd.set_viewport_and_scissor(frame.extent);
+        cmd.bind_vertex_buffer(0, vertex_buffer);
+        cmd.draw(3);
+        cmd.end_rendering();
+        VkImageLayout layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        VkAccessFlags2 access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+        if (readback) {
+            auto to_copy = vkrc::image_barrier(frame.image.vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage,
+                                               access, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+            cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
+            VkBufferImageCopy region{};
+            region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+            region.imageExtent = {frame.extent.width, frame.extent.height, 1};
+            cmd.copy_image_to_buffer(frame.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, *readback, std::span(&region, 1));
+            auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+            cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+            layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+            stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+            access = 0;
+        }
+        auto to_present = vkrc::image_barrier(frame.image.vk(), layout, frame.present_layout, stage, access,
+                                              VK_PIPELINE_STAGE_2_NONE, 0);
+        cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
+        cmd.end();
+    }
+
+    void wait() {
+        for (auto& slot : slots) EXPECT_EQ(slot.fence.wait(), VK_SUCCESS);
+    }
+
+    struct Slot {
+        vkrc::CommandPool pool;
+        vkrc::CommandBuffer cmd;
+        vkrc::Fence fence;
+    };
+    vkrc::Queue queue;
+    vkrc::Buffer vertex_buffer;
+    vkrc::GraphicsPipeline pipeline;
+    std::array<Slot, frames_in_flight> slots;
+    std::uint64_t count = 0;
+};
+
+class PresentationTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        xvfb = std::make_unique<vkrc_test::Xvfb>();
+        ASSERT_TRUE(xvfb->running()) << xvfb->error();
+        window = vkrc::glfw::create_window_surface({.width = 320, .height = 240, .title = "vkrc presentation test"},
+                                                   vkrc_test::validated_instance_info(log));
+        auto requirements = vkrc_test::test_device_requirements();
+        requirements.present_surface = window.surface.vk();
+        requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+        auto physical = vkrc::PhysicalDevice::select(window.instance, requirements);
+        device = vkrc::Device::create(physical, {.enabled_extension_names = {VK_KHR_SWAPCHAIN_EXTENSION_NAME}});
+        queue = device.default_queue();
+    }
+
+    void TearDown() override {
+        queue = {};
+        device.reset();
+        window = {};
+        glfwPollEvents();
+        vkrc_test::expect_no_validation_messages(*log);
+        xvfb.reset();
+    }
+
+    vkrc::Swapchain make_swapchain(VkImageUsageFlags usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) {
+        return vkrc::Swapchain::create(queue, window.surface,
+                                       {.image_usage = usage, .log = [this](const std::string& m) { choices.push_back(m); }});
+    }
+
+    std::shared_ptr<ValidationLog> log = std::make_shared<ValidationLog>();
+    std::unique_ptr<vkrc_test::Xvfb> xvfb;
+    vkrc::glfw::WindowSurface window;
+    vkrc::Device device;
+    vkrc::Queue queue;
+    std::vector<std::string> choices;
+};
+
+TEST_F(PresentationTest, RendersTenFramesAndLogsItsChoices) {
+    auto swapchain = make_swapchain();
+    EXPECT_EQ(swapchain.extent().width, 320u);
+    EXPECT_EQ(swapchain.extent().height, 240u);
+    EXPECT_GE(swapchain.image_count(), 2u);
+    ASSERT_EQ(choices.size(), 3u);  // format, present mode, images and extent
+    EXPECT_NE(choices[0].find("format"), std::string::npos);
+    EXPECT_NE(choices[1].find("present mode FIFO (as requested)"), std::string::npos) << choices[1];
+    EXPECT_NE(choices[2].find("extent 320x240"), std::string::npos) << choices[2];
+
+    Renderer renderer(queue, swapchain.format());
+    for (int i = 0; i < 10; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+    EXPECT_EQ(renderer.count, 10u);
+    renderer.wait();
+}
+
+TEST_F(PresentationTest, ResizedHundredTimesWhileRendering) {
+    auto swapchain = make_swapchain();
+    Renderer renderer(queue, swapchain.format());
+    int recreations = 0;
+    for (int i = 0; i < 100; ++i) {
+        const int width = 160 + (i * 37) % 400, height = 120 + (i * 53) % 300;
+        glfwSetWindowSize(window.window.get(), width, height);
+        glfwPollEvents();
+        // What an application does in its framebuffer-size callback.
+        if (window.window.framebuffer_extent().width != swapchain.extent().width ||
+            window.window.framebuffer_extent().height != swapchain.extent().height) {
+            ASSERT_EQ(swapchain.recreate(), vkrc::PresentStatus::success);
+            ++recreations;
+        }
+        // Out of date or suboptimal: the next acquire re-creates.
+        vkrc::PresentStatus status = vkrc::PresentStatus::out_of_date;
+        for (int attempt = 0; attempt < 3 && status != vkrc::PresentStatus::success; ++attempt) {
+            status = renderer.frame(swapchain);
+        }
+        EXPECT_EQ(status, vkrc::PresentStatus::success) << "resize " << i;
+        EXPECT_EQ(swapchain.extent().width, static_cast<std::uint32_t>(width));
+        EXPECT_EQ(swapchain.extent().height, static_cast<std::uint32_t>(height));
+    }
+    EXPECT_GE(recreations, 90);
+    renderer.wait();
+    EXPECT_NE(choices.back().find("replacing the previous swapchain"), std::string::npos);
+}
+
+// The capabilities a minimised window reports on platforms with a window
+// manager (Xvfb has none, so iconifying changes nothing there).
+PFN_vkGetPhysicalDeviceSurfaceCapabilitiesKHR real_capabilities = nullptr;
+VKAPI_ATTR VkResult VKAPI_CALL minimised_capabilities(VkPhysicalDevice physical, VkSurfaceKHR surface,
+                                                      VkSurfaceCapabilitiesKHR* caps) {
+    VkResult r = real_capabilities(physical, surface, caps);
+    caps->currentExtent = caps->minImageExtent = caps->maxImageExtent = {0, 0};
+    return r;
+}
+
+TEST_F(PresentationTest, MinimisedAndRestored) {
+    auto swapchain = make_swapchain();
+    Renderer renderer(queue, swapchain.format());
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+
+    glfwIconifyWindow(window.window.get());
+    glfwPollEvents();
+    for (int i = 0; i < 3; ++i) renderer.frame(swapchain);  // whatever the server does, no crash
+
+    auto& fn = window.instance.state()->fn;
+    real_capabilities = fn.vkGetPhysicalDeviceSurfaceCapabilitiesKHR;
+    fn.vkGetPhysicalDeviceSurfaceCapabilitiesKHR = minimised_capabilities;
+    EXPECT_EQ(swapchain.recreate(), vkrc::PresentStatus::zero_extent);
+    auto before = renderer.count;
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::zero_extent);
+    EXPECT_EQ(renderer.count, before);  // skipped: nothing acquired, submitted or presented
+    fn.vkGetPhysicalDeviceSurfaceCapabilitiesKHR = real_capabilities;
+
+    glfwRestoreWindow(window.window.get());
+    glfwPollEvents();
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+    EXPECT_EQ(renderer.count, before + 5);
+    renderer.wait();
+}
+
+TEST_F(PresentationTest, OneLiveSwapchainPerSurface) {
+    auto swapchain = make_swapchain();
+    EXPECT_THROW(make_swapchain(), vkrc::UsageError);
+    {
+        Renderer renderer(queue, swapchain.format());
+        for (int i = 0; i < 3; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+        // Dropped with frames in flight: the next create waits for its destruction.
+        swapchain.reset();
+        swapchain = make_swapchain();
+        EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+        renderer.wait();
+    }
+    // A frame that outlives its Swapchain keeps the Vulkan swapchain, so the
+    // surface is not free until the frame goes.
+    auto frame = swapchain.acquire();
+    ASSERT_TRUE(frame);
+    Renderer renderer(queue, swapchain.format());
+    renderer.record(renderer.slots[0].cmd, frame, nullptr);
+    renderer.slots[0].fence.unsignal();
+    vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1),
+                         .signals = frame.signals()},
+                 renderer.slots[0].fence);
+    EXPECT_EQ(swapchain.present(frame), vkrc::PresentStatus::success);
+    swapchain.reset();
+    EXPECT_THROW(make_swapchain(), vkrc::UsageError);
+    frame = {};
+    EXPECT_TRUE(make_swapchain());
+    renderer.wait();
+}
+
+TEST_F(PresentationTest, RetiredSwapchainLivesWhileAFrameHoldsItsImage) {
+    auto swapchain = make_swapchain();
+    Renderer renderer(queue, swapchain.format());
+    auto frame = swapchain.acquire();
+    ASSERT_TRUE(frame);
+    renderer.record(renderer.slots[0].cmd, frame, nullptr);
+    renderer.slots[0].fence.unsignal();
+    vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1),
+                         .signals = frame.signals()},
+                 renderer.slots[0].fence);
+    const VkSwapchainKHR old = swapchain.vk();
+    ASSERT_EQ(swapchain.recreate(), vkrc::PresentStatus::success);
+    EXPECT_NE(swapchain.vk(), old);
+    // Presenting an image of the retired swapchain is still allowed.
+    EXPECT_NE(swapchain.present(frame), vkrc::PresentStatus::zero_extent);
+    EXPECT_GE(frame.image.use_count(), 1u);
+    frame = {};
+    renderer.count = 1;
+    for (int i = 0; i < 4; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
+    renderer.wait();
+}
+
+TEST_F(PresentationTest, HeadlessRendersTheSamePixelsAsTheWindow) {
+    auto swapchain = make_swapchain(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    const VkExtent2D extent = swapchain.extent();
+    const VkDeviceSize size = VkDeviceSize{extent.width} * extent.height * 4;
+    auto readback = vkrc::Buffer::create(device, {.size = size, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                  .memory = {.usage = vkrc::MemoryUsage::readback}});
+    Renderer renderer(queue, swapchain.format());
+    ASSERT_EQ(renderer.frame(swapchain, &readback), vkrc::PresentStatus::success);
+    renderer.wait();
+    std::vector<std::byte> windowed(size);
+    readback.allocation().read(0, std::span(windowed));
+
+    auto headless = vkrc::HeadlessPresenter::create(queue, {.extent = extent, .format = swapchain.format()});
+    Renderer headless_renderer(queue, headless.format());
+    for (int i = 0; i < 4; ++i) ASSERT_EQ(headless_renderer.frame(headless), vkrc::PresentStatus::success);
+    EXPECT_EQ(headless.last_presented(), 0u);  // frame 3 of a ring of 3
+    auto pixels = headless.read_back(headless.last_presented());
+    ASSERT_EQ(pixels.size(), windowed.size());
+    EXPECT_TRUE(pixels == windowed);
+    // Not trivially equal: the centre is the triangle, a corner the clear colour.
+    auto texel = [&](std::uint32_t x, std::uint32_t y) {
+        std::uint32_t v;
+        std::memcpy(&v, &pixels[(std::size_t{y} * extent.width + x) * 4], 4);
+        return v;
+    };
+    EXPECT_NE(texel(extent.width / 2, extent.height / 2), texel(1, 1));
+    headless_renderer.wait();
+}
+
+}  // namespace
