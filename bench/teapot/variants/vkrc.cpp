@@ -49,7 +49,7 @@ public:
     void uniform() override {
         const std::size_t offset = slot_ * uniform_stride_;
         for (int i = 0; i < config_.uniform_writes; ++i) {
-            uniform_memory_.write_value(offset, camera_);
+            uniform_writer_.write_value(offset, camera_);
             asm volatile("" ::: "memory");  // as write_camera_uniforms: N writes stay N writes
         }
     }
@@ -213,7 +213,7 @@ private:
                       .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                       .memory = {.usage = vkrc::MemoryUsage::upload,
                                  .required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT}});
-        uniform_memory_ = uniforms_.allocation();
+        uniform_writer_ = uniforms_.allocation().write_only();
     }
 
     vkrc::Image create_image(VkFormat format, VkImageUsageFlags usage) {
@@ -280,7 +280,7 @@ private:
     vkrc::Queue queue_;
     vkrc::Buffer positions_, normals_, indices_;
     vkrc::Buffer uniforms_;
-    vkrc::Allocation uniform_memory_;
+    vkrc::WriteOnlyView uniform_writer_;
     VkDeviceSize uniform_stride_ = 0;
     std::vector<TargetImage> targets_;
     vkrc::Image depth_;
