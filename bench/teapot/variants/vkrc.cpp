@@ -24,8 +24,8 @@ namespace {
 class VkrcVariant final : public Variant {
 public:
     ~VkrcVariant() override {
-        // The handles release themselves; waiting first lets every deferred
-        // destruction run now, inside the harness's validation check.
+        // The members release themselves; with the device idle first, each
+        // Vulkan object is destroyed as its handle goes (nothing deferred).
         if (device_) device_.wait_idle();
     }
 
