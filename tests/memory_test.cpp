@@ -171,7 +171,9 @@ TEST_P(AllocatorTest, BufferWriteReadAtAnyAlignment) {
     EXPECT_EQ(memory.read_value<std::uint16_t>(998), 0xbeef);
     // Zero elements: nothing to do, even at the end.
     memory.write(1000, values.data(), 0);
-    auto writer = memory.write_only();
+    vkrc::WriteOnlyView writer;  // kept as a member would be, assigned later
+    writer = memory.write_only();
+    EXPECT_EQ(writer.size(), memory.size());
     writer.write(11, std::span<const std::uint64_t>(values.data(), 1));
     EXPECT_EQ(memory.read_value<std::uint64_t>(11), 1u);
     // Explicit flushes and invalidations of exact ranges, ends and whole size.
@@ -199,6 +201,10 @@ TEST_P(AllocatorTest, WritesOutsideTheAllocationThrow) {
         EXPECT_NE(std::string(e.what()).find("overflows"), std::string::npos) << e.what();
     }
     EXPECT_THROW(memory.write_only().write(0, values.data(), huge), vkrc::UsageError);
+    // An empty view (a member not yet assigned) has no bytes to write.
+    vkrc::WriteOnlyView empty;
+    EXPECT_EQ(empty.size(), 0u);
+    EXPECT_THROW(empty.write_value(0, values[0]), vkrc::UsageError);
 #endif
     EXPECT_THROW(memory.flush(memory.size() + 1, VK_WHOLE_SIZE), vkrc::UsageError);
     EXPECT_THROW(memory.invalidate(memory.size() - 1, 2), vkrc::UsageError);

@@ -137,5 +137,8 @@ const std::vector<VariantEntry>& variant_registry();
 std::unique_ptr<Variant> make_raw_variant();
 std::unique_ptr<Variant> make_raw_direct_variant();
 std::unique_ptr<Variant> make_vkhpp_variant();
+// variants/vkrc.cpp, compiled against vkrc::st and against vkrc::mt.
+std::unique_ptr<Variant> make_vkrc_st_variant();
+std::unique_ptr<Variant> make_vkrc_mt_variant();
 
 }  // namespace teapot

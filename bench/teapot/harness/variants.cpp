@@ -10,6 +10,12 @@ const std::vector<VariantEntry>& variant_registry() {
         {"raw", make_raw_variant},
         {"raw-direct", make_raw_direct_variant},
         {"vkhpp", make_vkhpp_variant},
+#if TEAPOT_HAS_VKRC_ST
+        {"vkrc-st", make_vkrc_st_variant},
+#endif
+#if TEAPOT_HAS_VKRC_MT
+        {"vkrc-mt", make_vkrc_mt_variant},
+#endif
     };
     return registry;
 }
