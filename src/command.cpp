@@ -202,6 +202,7 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         // At least this submission's value (a later one under concurrent submits).
         fence.state()->queue_timeline = queue.timeline_semaphore();
         fence.state()->queue_value = queue.last_submitted_value();
+        fence.state()->in_flight = true;
     }
 }
 

@@ -1,5 +1,7 @@
 #include "vkrc/upload.hpp"
 
+#include "vkrc/sync.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -52,9 +54,15 @@ public:
         }
     }
     ~OneTimeCommands() {
-        // Either never submitted or waited for: nothing on the GPU uses the pool.
-        if (fence_ != VK_NULL_HANDLE) device_.fn().vkDestroyFence(device_.vk(), fence_, nullptr);
-        device_.fn().vkDestroyCommandPool(device_.vk(), pool_, nullptr);
+        // Deferred like every other object: when the fence wait failed (out of
+        // memory), the submitted work may still use the pool and the fence.
+        auto& d = *device_.state();
+        if (submitted_ && !waited_) {
+            detail::destroy_submitted_fence(d, fence_);
+        } else {
+            detail::defer_destroy<&DeviceFunctions::vkDestroyFence>(d, fence_);
+        }
+        detail::defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(d, pool_);
     }
     OneTimeCommands(const OneTimeCommands&) = delete;
     OneTimeCommands& operator=(const OneTimeCommands&) = delete;
@@ -72,7 +80,9 @@ public:
         submit.commandBufferInfoCount = 1;
         submit.pCommandBufferInfos = &cmd_info;
         queue_.submit({&submit, 1}, fence_);
+        submitted_ = true;
         VkResult r = fn.vkWaitForFences(device_.vk(), 1, &fence_, VK_TRUE, UINT64_MAX);
+        waited_ = r == VK_SUCCESS;
         if (r == VK_ERROR_DEVICE_LOST) device_.state()->mark_lost();
         check(r, "vkWaitForFences");
         device_.collect_garbage();
@@ -112,6 +122,8 @@ private:
     VkCommandPool pool_ = VK_NULL_HANDLE;
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
     VkFence fence_ = VK_NULL_HANDLE;
+    bool submitted_ = false;
+    bool waited_ = false;
 };
 
 Buffer staging_buffer(const Device& device, VkDeviceSize size, MemoryUsage usage) {
