@@ -6,6 +6,11 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
+void throw_too_many_color_attachments(std::size_t count) {
+    throw UsageError("vkrc::CommandBuffer::begin_rendering: " + std::to_string(count) + " colour attachments; at most " +
+                     std::to_string(RenderingInfo::max_color_attachments));
+}
+
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
@@ -193,15 +198,26 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         info.pCommandBufferInfos = cmds + n_cmds;
         for (const auto& c : batch.command_buffers) {
             if (!c) throw UsageError("vkrc::submit: a CommandBuffer handle is empty");
+#if VKRC_RUNTIME_CHECKS
+            if (!(c.pool().device() == queue.device())) {
+                throw UsageError("vkrc::submit: a CommandBuffer belongs to another device than the queue");
+            }
+#endif
             cmds[n_cmds] = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
             cmds[n_cmds++].commandBuffer = c.vk();
         }
     }
+#if VKRC_RUNTIME_CHECKS
+    if (fence && !(fence.device() == queue.device())) {
+        throw UsageError("vkrc::submit: the Fence belongs to another device than the queue");
+    }
+#endif
     queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
     if (fence) {
         // At least this submission's value (a later one under concurrent submits).
         fence.state()->queue_timeline = queue.timeline_semaphore();
         fence.state()->queue_value = queue.last_submitted_value();
+        fence.state()->in_flight = true;
     }
 }
 

@@ -37,6 +37,7 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
     ci.pBindings = bindings.data();
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     s->device = device;
+    s->bindings = info.bindings;
     check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->layout),
           "vkCreateDescriptorSetLayout");
     return DescriptorSetLayout(std::move(s));
@@ -60,10 +61,14 @@ DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPool
 
 DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout) const {
     if (!layout) throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout handle is empty");
+    if (!(layout.device() == device())) {
+        throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout belongs to another device");
+    }
     auto& p = *state_;
     auto& d = *p.device.state();
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
     s->pool = *this;
+    s->layout = layout;
     VkDescriptorSetLayout raw_layout = layout.vk();
     VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     ai.descriptorPool = p.pool;
@@ -95,8 +100,78 @@ std::size_t DescriptorPool::pending_free_count() const {
     return state_->pending.size();
 }
 
+namespace {
+
+bool is_buffer_type(VkDescriptorType t) {
+    return t == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || t == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER ||
+           t == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC || t == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC;
+}
+bool is_image_type(VkDescriptorType t) {
+    return t == VK_DESCRIPTOR_TYPE_SAMPLER || t == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER ||
+           t == VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE || t == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE ||
+           t == VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT;
+}
+
+// The layout binding a write targets must exist, have the write's type and
+// hold array_element (VUID-VkWriteDescriptorSet-dstBinding-00315,
+// -descriptorType-00319, -dstArrayElement-00321).
+void check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                 std::uint32_t array_element, const char* who) {
+    if (!s.layout) return;
+    for (const auto& b : s.layout.state()->bindings) {
+        if (b.binding != binding) continue;
+        if (b.descriptor_type != type) {
+            throw UsageError(std::string(who) + ": binding " + std::to_string(binding) + " has descriptor type " +
+                             std::to_string(b.descriptor_type) + " in the set layout, the write has type " +
+                             std::to_string(type));
+        }
+        if (array_element >= b.descriptor_count) {
+            throw UsageError(std::string(who) + ": array element " + std::to_string(array_element) +
+                             " is past binding " + std::to_string(binding) + "'s " +
+                             std::to_string(b.descriptor_count) + " descriptors");
+        }
+        return;
+    }
+    throw UsageError(std::string(who) + ": the set layout has no binding " + std::to_string(binding));
+}
+
+}  // namespace
+
+void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer,
+                                 VkDeviceSize offset, VkDeviceSize range, std::uint32_t array_element) const {
+    constexpr const char* who = "vkrc::DescriptorSet::write_buffer";
+    if (!buffer) throw UsageError(std::string(who) + ": the Buffer handle is empty");
+    if (!(buffer.device() == pool().device())) throw UsageError(std::string(who) + ": the buffer belongs to another device");
+    const VkBufferUsageFlags needs =
+        type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC
+            ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+            : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    if (is_buffer_type(type) && !(buffer.usage() & needs)) {
+        throw UsageError(std::string(who) + ": the buffer lacks the usage descriptor type " + std::to_string(type) +
+                         " needs (VUID-VkWriteDescriptorSet-descriptorType-00330/00331)");
+    }
+    write_buffer(binding, type, buffer.vk(), offset, range, array_element);
+}
+
+void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, const ImageView& view,
+                                VkImageLayout layout, const Sampler& sampler, std::uint32_t array_element) const {
+    constexpr const char* who = "vkrc::DescriptorSet::write_image";
+    const auto& device = pool().device();
+    if (view && !(view.image().device() == device)) {
+        throw UsageError(std::string(who) + ": the image view belongs to another device");
+    }
+    if (sampler && !(sampler.device() == device)) throw UsageError(std::string(who) + ": the sampler belongs to another device");
+    write_image(binding, type, view ? view.vk() : VK_NULL_HANDLE, layout, sampler ? sampler.vk() : VK_NULL_HANDLE,
+                array_element);
+}
+
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
+    if (!is_buffer_type(type)) {
+        throw UsageError("vkrc::DescriptorSet::write_buffer: descriptor type " + std::to_string(type) +
+                         " is not a buffer type");
+    }
+    check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_buffer");
     VkDescriptorBufferInfo bi{buffer, offset, range};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = state_->set;
@@ -111,6 +186,11 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, V
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
+    if (!is_image_type(type)) {
+        throw UsageError("vkrc::DescriptorSet::write_image: descriptor type " + std::to_string(type) +
+                         " is not an image or sampler type");
+    }
+    check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_image");
     VkDescriptorImageInfo ii{sampler, view, layout};
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = state_->set;

@@ -251,6 +251,10 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
     if (info.allocator != a) {
         throw UsageError("vkrc::Allocation::create: the allocator returned a range that names another allocator");
     }
+    if (info.memory == VK_NULL_HANDLE) {
+        // An allocator that reports no memory instead of throwing: the same as running out.
+        throw Error(VK_ERROR_OUT_OF_DEVICE_MEMORY, "vkrc::DeviceAllocator::allocate");
+    }
     detail::AllocationState* st = nullptr;
     try {
         st = new detail::AllocationState;

@@ -38,6 +38,7 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
     std::vector<VkDescriptorSetLayout> sets;
     for (const auto& l : info.set_layouts) {
         require(static_cast<bool>(l), "vkrc::PipelineLayout::create", "a DescriptorSetLayout handle is empty");
+        require(l.device() == device, "vkrc::PipelineLayout::create", "a DescriptorSetLayout belongs to another device");
         sets.push_back(l.vk());
     }
     VkPipelineLayoutCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -222,6 +223,9 @@ GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout) : layout
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                                          const char* entry_point) {
+    require(static_cast<bool>(module), "vkrc::GraphicsPipelineBuilder::shader", "the ShaderModule handle is empty");
+    require(module.device() == layout_.device(), "vkrc::GraphicsPipelineBuilder::shader",
+            "the ShaderModule belongs to another device than the pipeline layout");
     stages_.push_back({stage, module, entry_point});
     return *this;
 }

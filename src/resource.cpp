@@ -1,5 +1,8 @@
 #include "vkrc/resource.hpp"
 
+#include "vkrc/upload.hpp"
+
+#include <algorithm>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -45,6 +48,19 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     if (!device) throw UsageError("vkrc::Buffer::create: the Device handle is empty");
     if (info.size == 0) throw UsageError("vkrc::Buffer::create: size is 0");
     if (info.usage == 0) throw UsageError("vkrc::Buffer::create: usage is 0");
+    if (!(info.flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
+        // A size no heap can hold (a negative number cast to VkDeviceSize, a
+        // product that wrapped) fails here with its value, not later with
+        // an out-of-memory from the allocator's alignment arithmetic.
+        const auto& memory = device.physical_device().memory_properties();
+        VkDeviceSize largest = 0;
+        for (std::uint32_t i = 0; i < memory.memoryHeapCount; ++i) largest = std::max(largest, memory.memoryHeaps[i].size);
+        if (info.size > largest) {
+            throw UsageError("vkrc::Buffer::create: size " + std::to_string(info.size) +
+                             " is larger than every memory heap of the device (the largest has " +
+                             std::to_string(largest) + " bytes)");
+        }
+    }
     VkBufferCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, info.next};
     create.flags = info.flags;
     create.size = info.size;
@@ -135,6 +151,7 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
     state->array_layers = info.array_layers;
     state->samples = info.samples;
     state->usage = info.usage;
+    state->flags = info.flags;
 
     VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
     VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
@@ -164,6 +181,7 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
     state->array_layers = info.array_layers;
     state->samples = info.samples;
     state->usage = info.usage;
+    state->flags = info.flags;
     return Image(std::move(state));
 }
 
@@ -177,6 +195,36 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     create.components = info.components;
     create.subresourceRange = info.subresource_range;
     if (create.subresourceRange.aspectMask == 0) create.subresourceRange.aspectMask = format_aspects(create.format);
+    // Free checks (create is a cold path): the range within the image, the
+    // format the image's or, with MUTABLE_FORMAT_BIT, one of the same texel size.
+    constexpr const char* who = "vkrc::ImageView::create";
+    const auto& r = create.subresourceRange;
+    auto range_fits = [](std::uint32_t base, std::uint32_t count, std::uint32_t total) {
+        return base < total && (count == VK_REMAINING_MIP_LEVELS || (count != 0 && count <= total - base));
+    };
+    if (!range_fits(r.baseMipLevel, r.levelCount, image.mip_levels())) {
+        throw UsageError(std::string(who) + ": mip levels " + std::to_string(r.baseMipLevel) + "+" +
+                         (r.levelCount == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(r.levelCount)) +
+                         " are outside the image's " + std::to_string(image.mip_levels()) + " levels");
+    }
+    if (!range_fits(r.baseArrayLayer, r.layerCount, image.array_layers())) {
+        throw UsageError(std::string(who) + ": array layers " + std::to_string(r.baseArrayLayer) + "+" +
+                         (r.layerCount == VK_REMAINING_ARRAY_LAYERS ? std::string("remaining") : std::to_string(r.layerCount)) +
+                         " are outside the image's " + std::to_string(image.array_layers()) + " layers");
+    }
+    if (create.format != image.format()) {
+        if (!(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT)) {
+            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) + " differs from the image's " +
+                             std::to_string(image.format()) + " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
+        }
+        const std::uint32_t view_texel = format_texel_size(create.format);
+        const std::uint32_t image_texel = format_texel_size(image.format());
+        if (view_texel != 0 && image_texel != 0 && view_texel != image_texel) {
+            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) + " has " +
+                             std::to_string(view_texel) + "-byte texels, the image's format " +
+                             std::to_string(image.format()) + " has " + std::to_string(image_texel));
+        }
+    }
     detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
     const auto& device = image.device();
     check(device.fn().vkCreateImageView(device.vk(), &create, nullptr, &state->view), "vkCreateImageView");

@@ -25,8 +25,23 @@ VkResult FenceState::settle(VkResult fence_result) noexcept {
     return r == VK_SUCCESS ? fence_result : r;
 }
 
+void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept {
+    if (fence == VK_NULL_HANDLE) return;
+    device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
+                                  auto f = handle_from_bits<VkFence>(bits);
+                                  d.fn.vkWaitForFences(d.device, 1, &f, VK_TRUE, UINT64_MAX);
+                                  d.fn.vkDestroyFence(d.device, f, nullptr);
+                              },
+                              handle_bits(fence), nullptr});
+}
+
 FenceState::~FenceState() {
-    if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence);
+    if (ownership != Ownership::owned) return;
+    if (in_flight) {
+        destroy_submitted_fence(*device.state(), fence);
+    } else {
+        defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence);
+    }
 }
 SemaphoreState::~SemaphoreState() {
     if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore);
@@ -58,18 +73,22 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
     VkResult r = d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns);
+    if (r == VK_SUCCESS) state_->in_flight = false;
     return after_wait(d, state_->settle(r), "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
     const auto& d = state_->device;
-    return after_wait(d, state_->settle(d.fn().vkGetFenceStatus(d.vk(), state_->fence)), "vkGetFenceStatus");
+    VkResult r = d.fn().vkGetFenceStatus(d.vk(), state_->fence);
+    if (r == VK_SUCCESS) state_->in_flight = false;
+    return after_wait(d, state_->settle(r), "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
     const auto& d = state_->device;
     check(d.fn().vkResetFences(d.vk(), 1, &state_->fence), "vkResetFences");
     state_->queue_timeline = VK_NULL_HANDLE;
+    state_->in_flight = false;
 }
 
 namespace {

@@ -1,5 +1,7 @@
 #include "vkrc/upload.hpp"
 
+#include "vkrc/sync.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -52,9 +54,15 @@ public:
         }
     }
     ~OneTimeCommands() {
-        // Either never submitted or waited for: nothing on the GPU uses the pool.
-        if (fence_ != VK_NULL_HANDLE) device_.fn().vkDestroyFence(device_.vk(), fence_, nullptr);
-        device_.fn().vkDestroyCommandPool(device_.vk(), pool_, nullptr);
+        // Deferred like every other object: when the fence wait failed (out of
+        // memory), the submitted work may still use the pool and the fence.
+        auto& d = *device_.state();
+        if (submitted_ && !waited_) {
+            detail::destroy_submitted_fence(d, fence_);
+        } else {
+            detail::defer_destroy<&DeviceFunctions::vkDestroyFence>(d, fence_);
+        }
+        detail::defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(d, pool_);
     }
     OneTimeCommands(const OneTimeCommands&) = delete;
     OneTimeCommands& operator=(const OneTimeCommands&) = delete;
@@ -72,7 +80,9 @@ public:
         submit.commandBufferInfoCount = 1;
         submit.pCommandBufferInfos = &cmd_info;
         queue_.submit({&submit, 1}, fence_);
+        submitted_ = true;
         VkResult r = fn.vkWaitForFences(device_.vk(), 1, &fence_, VK_TRUE, UINT64_MAX);
+        waited_ = r == VK_SUCCESS;
         if (r == VK_ERROR_DEVICE_LOST) device_.state()->mark_lost();
         check(r, "vkWaitForFences");
         device_.collect_garbage();
@@ -112,6 +122,8 @@ private:
     VkCommandPool pool_ = VK_NULL_HANDLE;
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
     VkFence fence_ = VK_NULL_HANDLE;
+    bool submitted_ = false;
+    bool waited_ = false;
 };
 
 Buffer staging_buffer(const Device& device, VkDeviceSize size, MemoryUsage usage) {
@@ -137,9 +149,18 @@ std::uint32_t checked_texel_size(const Image& image, const char* who) {
     return texel;
 }
 
-VkDeviceSize level_size(const Image& image, std::uint32_t level, std::uint32_t texel) {
+// a * b, or UsageError naming who when it does not fit in 64 bits.
+VkDeviceSize checked_mul(VkDeviceSize a, VkDeviceSize b, const char* who) {
+    VkDeviceSize r;
+    if (__builtin_mul_overflow(a, b, &r)) {
+        throw UsageError(std::string(who) + ": the image's size in bytes overflows 64 bits");
+    }
+    return r;
+}
+
+VkDeviceSize level_size(const Image& image, std::uint32_t level, std::uint32_t texel, const char* who) {
     const VkExtent3D e = image.extent(level);
-    return VkDeviceSize(e.width) * e.height * e.depth * texel;
+    return checked_mul(checked_mul(checked_mul(e.width, e.height, who), e.depth, who), texel, who);
 }
 
 }  // namespace
@@ -198,7 +219,10 @@ VkDeviceSize image_data_size(const Image& image) {
     const std::uint32_t texel = checked_texel_size(image, "vkrc::image_data_size");
     VkDeviceSize total = 0;
     for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
-        total += level_size(image, level, texel) * image.array_layers();
+        const VkDeviceSize level_bytes = checked_mul(level_size(image, level, texel, "vkrc::image_data_size"),
+                                                     image.array_layers(), "vkrc::image_data_size");
+        if (total + level_bytes < total) throw UsageError("vkrc::image_data_size: the image's size in bytes overflows 64 bits");
+        total += level_bytes;
     }
     return total;
 }
@@ -231,7 +255,7 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
         r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, image.array_layers()};
         r.imageExtent = image.extent(level);
         regions.push_back(r);
-        offset += level_size(image, level, texel) * image.array_layers();
+        offset += level_size(image, level, texel, who) * image.array_layers();
     }
     const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, image.mip_levels(), 0, image.array_layers()};
     OneTimeCommands commands(queue);
@@ -263,7 +287,7 @@ std::vector<std::byte> download_image(const Queue& queue, const Image& image, Vk
     }
     if (layout == VK_IMAGE_LAYOUT_UNDEFINED) throw UsageError(std::string(who) + ": the image's layout is UNDEFINED");
     const std::uint32_t texel = checked_texel_size(image, who);
-    const VkDeviceSize size = level_size(image, mip_level, texel);
+    const VkDeviceSize size = level_size(image, mip_level, texel, who);
     Buffer readback = staging_buffer(image.device(), size, MemoryUsage::readback);
     const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, mip_level, 1, array_layer, 1};
     OneTimeCommands commands(queue);

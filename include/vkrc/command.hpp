@@ -116,7 +116,9 @@ public:
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
     void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
     void end_render_pass() const noexcept;
-    void begin_rendering(const RenderingInfo& info) const noexcept;
+    // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
+    // RenderingInfo::max_color_attachments colour attachments.
+    void begin_rendering(const RenderingInfo& info) const;
     void end_rendering() const noexcept;
 
     // State
@@ -293,7 +295,16 @@ inline void CommandBuffer::next_subpass(VkSubpassContents contents) const noexce
 }
 inline void CommandBuffer::end_render_pass() const noexcept { state_->fn->vkCmdEndRenderPass(state_->cmd); }
 
-inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const noexcept {
+namespace detail {
+[[noreturn]] void throw_too_many_color_attachments(std::size_t count);
+}
+
+inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
+#if VKRC_RUNTIME_CHECKS
+    if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
+        detail::throw_too_many_color_attachments(info.color_attachments.size());
+    }
+#endif
     auto convert = [](const RenderingAttachment& a) {
         VkRenderingAttachmentInfo r{};
         r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;

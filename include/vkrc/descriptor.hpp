@@ -80,17 +80,17 @@ public:
 
     // vkUpdateDescriptorSets with one buffer descriptor. The set does not keep
     // what it points to alive: drop it only after the work that uses it is submitted.
+    // Throws UsageError when the binding does not exist, has another
+    // descriptor type, or the buffer belongs to another device or lacks the
+    // usage the type needs.
     void write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer, VkDeviceSize offset = 0,
-                      VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const {
-        write_buffer(binding, type, buffer.vk(), offset, range, array_element);
-    }
+                      VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const;
     void write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset = 0,
                       VkDeviceSize range = VK_WHOLE_SIZE, std::uint32_t array_element = 0) const;
     // vkUpdateDescriptorSets with one image/sampler descriptor.
+    // Same checks as write_buffer for the view and sampler.
     void write_image(std::uint32_t binding, VkDescriptorType type, const ImageView& view, VkImageLayout layout,
-                     const Sampler& sampler = {}, std::uint32_t array_element = 0) const {
-        write_image(binding, type, view.vk(), layout, sampler ? sampler.vk() : VK_NULL_HANDLE, array_element);
-    }
+                     const Sampler& sampler = {}, std::uint32_t array_element = 0) const;
     void write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                      VkSampler sampler = VK_NULL_HANDLE, std::uint32_t array_element = 0) const;
 
@@ -106,6 +106,8 @@ public:
     ~DescriptorSetLayoutState() override;
     Device device;
     VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    // For checking writes against the layout.
+    std::vector<DescriptorSetLayoutBinding> bindings;
 };
 
 class DescriptorPoolState final : public RefCounted {
@@ -125,6 +127,7 @@ class DescriptorSetState final : public RefCounted {
 public:
     ~DescriptorSetState() override;
     DescriptorPool pool;
+    DescriptorSetLayout layout;  // checks writes (the raw layout may go once the set exists)
     VkDescriptorSet set = VK_NULL_HANDLE;
     std::uint64_t generation = 0;
 };

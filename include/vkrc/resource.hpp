@@ -203,6 +203,7 @@ struct ImageState final : RefCounted {
     std::uint32_t array_layers = 1;
     VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
     VkImageUsageFlags usage = 0;
+    VkImageCreateFlags flags = 0;
     Ownership ownership = Ownership::owned;
     Allocation allocation;
     // What a borrowed image belongs to and keeps alive (a swapchain's images

@@ -125,9 +125,18 @@ public:
     // synchronised for the fence.
     VkSemaphore queue_timeline = VK_NULL_HANDLE;
     std::uint64_t queue_value = 0;
+    // Submitted and not yet seen signalled: the queue timeline passing its
+    // value does not mean the fence's own signal operation has completed,
+    // so destruction then waits for the fence (see destroy_submitted_fence).
+    bool in_flight = false;
     // Waits for queue_value once the fence has signalled.
     VkResult settle(VkResult fence_result) noexcept;
 };
+
+// Queues the destruction of a fence that was submitted and may not have been
+// seen signalled: after the work submitted so far, it waits for the fence
+// (at once in practice; a lost device returns at once too), then destroys it.
+void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept;
 
 class SemaphoreState final : public RefCounted {
 public:

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <cstring>
 #include <string_view>
+#include <tuple>
 #include <type_traits>
 
 namespace vkrc_test::faults {
@@ -22,6 +23,8 @@ std::atomic<std::uint64_t> calls{0};
 std::atomic<std::uint64_t> armed_call{0};
 std::atomic<VkResult> armed_error{VK_SUCCESS};
 std::atomic<const char*> fired_name{nullptr};
+// The device of the scenario, for simulating loss (one device at a time).
+std::atomic<VkDevice> current_device{VK_NULL_HANDLE};
 const char* names[int(Fn::count)] = {
 #define VKRC_GLOBAL_FUNCTION(name) #name,
 #define VKRC_INSTANCE_FUNCTION(name) #name,
@@ -29,12 +32,48 @@ const char* names[int(Fn::count)] = {
 #include <vkrc/detail/function_list.inl>
 };
 
+// A lost device runs nothing any more. lavapipe is not really lost, so the
+// work already submitted is finished here, as a real loss would end it; what
+// vkrc then destroys is not in use. Real calls made later keep working.
+void simulate_loss() {
+    VkDevice device = current_device.load();
+    auto wait_idle = reinterpret_cast<PFN_vkDeviceWaitIdle>(real[int(Fn::vkDeviceWaitIdle)].load());
+    if (device != VK_NULL_HANDLE && wait_idle) wait_idle(device);
+}
+
+std::atomic<bool> lost{false};
+
+// The calls that report VK_ERROR_DEVICE_LOST once a device is lost.
+bool reports_loss(Fn id) {
+    switch (id) {
+        case Fn::vkQueueSubmit:
+        case Fn::vkQueueSubmit2:
+        case Fn::vkQueueWaitIdle:
+        case Fn::vkDeviceWaitIdle:
+        case Fn::vkWaitForFences:
+        case Fn::vkGetFenceStatus:
+        case Fn::vkWaitSemaphores:
+        case Fn::vkGetSemaphoreCounterValue:
+        case Fn::vkGetEventStatus:
+        case Fn::vkGetQueryPoolResults:
+        case Fn::vkQueuePresentKHR:
+        case Fn::vkAcquireNextImageKHR: return true;
+        default: return false;
+    }
+}
+
 // Counts the call; returns the error to inject, or VK_SUCCESS to go through.
 VkResult next_call(Fn id) {
+    if (lost.load() && reports_loss(id)) {
+        fired_name.store(names[int(id)]);
+        return VK_ERROR_DEVICE_LOST;
+    }
     std::uint64_t n = calls.fetch_add(1) + 1;
     if (n == armed_call.load()) {
         fired_name.store(names[int(id)]);
-        return armed_error.load();
+        const VkResult error = armed_error.load();
+        if (error == VK_ERROR_DEVICE_LOST) simulate_loss();
+        return error;
     }
     return VK_SUCCESS;
 }
@@ -44,6 +83,11 @@ struct Wrap;
 template <Fn id, class R, class... Args>
 struct Wrap<id, R(VKAPI_PTR*)(Args...)> {
     static R VKAPI_PTR call(Args... args) {
+        if constexpr (id == Fn::vkDestroyDevice) {
+            VkDevice device = reinterpret_cast<VkDevice>(std::get<0>(std::tuple<Args...>(args...)));
+            VkDevice expected = device;
+            current_device.compare_exchange_strong(expected, VK_NULL_HANDLE);
+        }
         if constexpr (std::is_same_v<R, VkResult>) {
             if (VkResult e = next_call(id); e != VK_SUCCESS) return e;
         }
@@ -75,6 +119,7 @@ PFN_vkVoidFunction intercept(const char* name, PFN_vkVoidFunction found) {
 }
 
 VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL get_device_proc_addr(VkDevice device, const char* name) {
+    if (device != VK_NULL_HANDLE) current_device.store(device);
     return intercept(name, real_get_device_proc_addr.load()(device, name));
 }
 
@@ -92,6 +137,7 @@ VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL wrapped_get_instance_proc_addr(VkInstan
 PFN_vkGetInstanceProcAddr get_instance_proc_addr() { return &wrapped_get_instance_proc_addr; }
 
 void arm(std::uint64_t call, VkResult error) {
+    lost.store(false);
     armed_error.store(error);
     armed_call.store(call);
     calls.store(0);
@@ -99,6 +145,11 @@ void arm(std::uint64_t call, VkResult error) {
 }
 std::uint64_t failable_calls() {
     return calls.load();
+}
+void lose_device() {
+    fired_name.store(nullptr);
+    simulate_loss();
+    lost.store(true);
 }
 bool fired() { return fired_name.load() != nullptr; }
 const char* fired_in() { return fired_name.load(); }

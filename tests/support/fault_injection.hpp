@@ -15,7 +15,14 @@ namespace vkrc_test::faults {
 PFN_vkGetInstanceProcAddr get_instance_proc_addr();
 
 // From now on, the call-th failable call (1-based) returns error; 0 disarms.
+// VK_ERROR_DEVICE_LOST is simulated faithfully: before returning it the
+// wrapper waits for the device to finish its work (a lost device runs
+// nothing), so destroying what was in use is then valid.
 void arm(std::uint64_t call, VkResult error);
+// The device is lost from now on (until the next arm()): its work so far is
+// finished, and every call that reports loss (submits, waits, status
+// queries, present, acquire) returns VK_ERROR_DEVICE_LOST; other calls work.
+void lose_device();
 // Failable calls made since the last arm().
 std::uint64_t failable_calls();
 // Whether the armed failure has been returned, and by which function.

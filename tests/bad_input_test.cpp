@@ -1,0 +1,183 @@
+// Bad input gets a UsageError naming the function and the problem, before
+// Vulkan sees it, and leaks nothing (the fixture fails on any validation
+// message, including the object tracker's leak reports at teardown).
+#include "support/vk_test.hpp"
+
+#include <array>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+// Runs f, which must throw UsageError whose message contains every part.
+void expect_usage_error(const std::function<void()>& f, std::initializer_list<const char*> parts) {
+    try {
+        f();
+        ADD_FAILURE() << "no UsageError; expected one saying: " << *parts.begin();
+    } catch (const vkrc::UsageError& e) {
+        for (const char* part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(VulkanTest, InvalidSpirvIsRejected) {
+    expect_usage_error([&] { vkrc::ShaderModule::create(device, std::span<const std::uint32_t>()); },
+                       {"vkrc::ShaderModule::create", "empty"});
+    const std::array<std::byte, 5> odd{std::byte{0x03}, std::byte{0x02}, std::byte{0x23}, std::byte{0x07}, {}};
+    expect_usage_error([&] { vkrc::ShaderModule::create(device, std::span<const std::byte>(odd)); },
+                       {"vkrc::ShaderModule::create", "5 bytes", "not a multiple of 4"});
+    const std::array<std::uint32_t, 5> bad_magic{0xdeadbeef, 0x00010000, 0, 1, 0};
+    expect_usage_error([&] { vkrc::ShaderModule::create(device, std::span<const std::uint32_t>(bad_magic)); },
+                       {"vkrc::ShaderModule::create", "not SPIR-V", "0xdeadbeef"});
+}
+
+TEST_F(VulkanTest, ZeroAndOverflowingBufferSizesAreRejected) {
+    expect_usage_error([&] { vkrc::Buffer::create(device, {.size = 0, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT}); },
+                       {"vkrc::Buffer::create", "size is 0"});
+    expect_usage_error(
+        [&] { vkrc::Buffer::create(device, {.size = UINT64_MAX - 3, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT}); },
+        {"vkrc::Buffer::create", "18446744073709551612", "larger than every memory heap"});
+}
+
+TEST_F(VulkanTest, ImageSizeThatOverflowsInStagingIsRejected) {
+    auto real = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    // An adopted image is described by the application; a description whose
+    // byte size wraps 64 bits must not turn into a small staging buffer.
+    auto huge = vkrc::Image::adopt(device, real.vk(),
+                                   {.format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                    .extent = {UINT32_MAX, UINT32_MAX, 2},
+                                    .array_layers = 1u << 20,
+                                    .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT},
+                                   vkrc::Ownership::borrowed);
+    expect_usage_error([&] { vkrc::image_data_size(huge); }, {"vkrc::image_data_size", "overflows 64 bits"});
+    expect_usage_error([&] { vkrc::upload_image(queue, huge, {}); }, {"overflows 64 bits"});
+}
+
+TEST_F(VulkanTest, MappingMemoryThatIsNotHostVisibleIsRejected) {
+    auto gpu = vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT});
+    const std::uint32_t value = 1;
+    expect_usage_error([&] { gpu.allocation().write_value(0, value); }, {"vkrc::Allocation::write", "host-visible"});
+    expect_usage_error([&] { (void)gpu.allocation().read_value<std::uint32_t>(0); },
+                       {"vkrc::Allocation::read", "host-visible"});
+}
+
+#if VKRC_RUNTIME_CHECKS
+TEST_F(VulkanTest, WritingPastTheEndOfAMappingIsRejected) {
+    auto upload = vkrc::Buffer::create(device, {.size = 16,
+                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                                .memory = {.usage = vkrc::MemoryUsage::upload}});
+    const std::size_t size = upload.allocation().size();
+    std::vector<std::uint32_t> words(size / 4 + 1);
+    expect_usage_error([&] { upload.allocation().write(0, std::span<const std::uint32_t>(words)); },
+                       {"vkrc::Allocation::write"});
+    expect_usage_error([&] { upload.allocation().write_value(size - 2, std::uint32_t{7}); }, {"vkrc::Allocation::write"});
+    expect_usage_error([&] { upload.allocation().write(UINT64_MAX - 1, words.data(), 1); }, {"vkrc::Allocation::write"});
+}
+#endif
+
+TEST_F(VulkanTest, ObjectsOfOneDeviceAreRejectedByAnother) {
+    auto other = vkrc::Device::create(physical_device);
+    auto buffer = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT});
+    auto layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}}});
+    auto other_layout = vkrc::DescriptorSetLayout::create(
+        other, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}}});
+    auto other_pool = vkrc::DescriptorPool::create(
+        other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1}}});
+    auto other_set = other_pool.allocate(other_layout);
+
+    expect_usage_error([&] { other_set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer); },
+                       {"vkrc::DescriptorSet::write_buffer", "another device"});
+    expect_usage_error([&] { other_pool.allocate(layout); }, {"vkrc::DescriptorPool::allocate", "another device"});
+    expect_usage_error([&] { vkrc::PipelineLayout::create(other, {.set_layouts = {layout}}); },
+                       {"vkrc::PipelineLayout::create", "another device"});
+    expect_usage_error([&] { vkrc::upload_buffer(other.default_queue(), buffer, 0, {}); },
+                       {"vkrc::upload_buffer", "another device"});
+    auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto view = vkrc::ImageView::create(image);
+    auto other_image_layout = vkrc::DescriptorSetLayout::create(
+        other, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE}}});
+    auto other_image_pool = vkrc::DescriptorPool::create(
+        other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1}}});
+    auto other_image_set = other_image_pool.allocate(other_image_layout);
+    expect_usage_error(
+        [&] { other_image_set.write_image(0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL); },
+        {"vkrc::DescriptorSet::write_image", "another device"});
+#if VKRC_RUNTIME_CHECKS
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    cmd.end();
+    const vkrc::CommandBuffer cmds[] = {cmd};
+    expect_usage_error([&] { vkrc::submit(other.default_queue(), {.command_buffers = cmds}); },
+                       {"vkrc::submit", "another device"});
+    auto fence = vkrc::Fence::create(device);
+    expect_usage_error([&] { vkrc::submit(other.default_queue(), vkrc::SubmitBatch{}, fence); }, {"vkrc::submit", "another device"});
+#endif
+}
+
+TEST_F(VulkanTest, DescriptorWritesMustMatchTheLayout) {
+    auto layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptor_count = 2}}});
+    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2}}});
+    auto set = pool.allocate(layout);
+    auto buffer = vkrc::Buffer::create(device, {.size = 256,
+                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
+                                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+    expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer); },
+                       {"vkrc::DescriptorSet::write_buffer", "binding 0 has descriptor type 6", "the write has type 7"});
+    expect_usage_error([&] { set.write_buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer); },
+                       {"vkrc::DescriptorSet::write_buffer", "no binding 3"});
+    expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer, 0, VK_WHOLE_SIZE, 2); },
+                       {"vkrc::DescriptorSet::write_buffer", "array element 2"});
+    expect_usage_error(
+        [&] { set.write_image(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_GENERAL); },
+        {"vkrc::DescriptorSet::write_image", "not an image or sampler type"});
+    auto vertex_only = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT});
+    expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, vertex_only); },
+                       {"vkrc::DescriptorSet::write_buffer", "lacks the usage"});
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer, 0, VK_WHOLE_SIZE, 1);  // fits
+}
+
+TEST_F(VulkanTest, ImageViewsMustFitTheirImage) {
+    auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                              .extent = {8, 8, 1},
+                                              .mip_levels = 2,
+                                              .array_layers = 2,
+                                              .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    expect_usage_error([&] { vkrc::ImageView::create(image, {.subresource_range = {0, 2, 1, 0, 1}}); },
+                       {"vkrc::ImageView::create", "mip levels 2+1", "2 levels"});
+    expect_usage_error([&] { vkrc::ImageView::create(image, {.subresource_range = {0, 1, 2, 0, 1}}); },
+                       {"vkrc::ImageView::create", "mip levels 1+2"});
+    expect_usage_error(
+        [&] { vkrc::ImageView::create(image, {.view_type = VK_IMAGE_VIEW_TYPE_2D_ARRAY, .subresource_range = {0, 0, 1, 1, 5}}); },
+        {"vkrc::ImageView::create", "array layers 1+5", "2 layers"});
+    expect_usage_error([&] { vkrc::ImageView::create(image, {.format = VK_FORMAT_R32_SFLOAT}); },
+                       {"vkrc::ImageView::create", "MUTABLE_FORMAT_BIT"});
+    auto mutable_image = vkrc::Image::create(device, {.flags = VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT,
+                                                      .format = VK_FORMAT_R8G8B8A8_UNORM,
+                                                      .extent = {8, 8, 1},
+                                                      .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    expect_usage_error([&] { vkrc::ImageView::create(mutable_image, {.format = VK_FORMAT_R16G16B16A16_SFLOAT}); },
+                       {"vkrc::ImageView::create", "8-byte texels", "has 4"});
+    // Same texel size with MUTABLE_FORMAT_BIT, and a range within the image: fine.
+    vkrc::ImageView::create(mutable_image, {.format = VK_FORMAT_R32_UINT});
+    vkrc::ImageView::create(image, {.subresource_range = {0, 1, 1, 1, 1}});
+}
+
+#if VKRC_RUNTIME_CHECKS
+TEST_F(VulkanTest, MoreThanEightColourAttachmentsAreRejected) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    std::array<vkrc::RenderingAttachment, 9> colors{};
+    expect_usage_error([&] { cmd.begin_rendering({.render_area = {{0, 0}, {8, 8}}, .color_attachments = colors}); },
+                       {"vkrc::CommandBuffer::begin_rendering", "9 colour attachments", "at most 8"});
+    cmd.end();
+}
+#endif
+
+}  // namespace
