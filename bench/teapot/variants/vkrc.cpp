@@ -204,15 +204,17 @@ private:
         positions_ = create_vertex_data(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
         normals_ = create_vertex_data(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
         indices_ = create_vertex_data(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-        // One region per frame slot in coherent upload memory: the one write
-        // strategy of every variant (no flush).
+        // One region per frame slot in coherent upload memory, device-local
+        // where the device has such a type (resizable BAR): the memory type and
+        // write strategy of every variant (no flush).
         const VkDeviceSize alignment = device_.physical_device().properties().limits.minUniformBufferOffsetAlignment;
         uniform_stride_ = (sizeof(CameraUniforms) + alignment - 1) / alignment * alignment;
         uniforms_ = vkrc::Buffer::create(
             device_, {.size = uniform_stride_ * config_.frames_in_flight,
                       .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                       .memory = {.usage = vkrc::MemoryUsage::upload,
-                                 .required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT}});
+                                 .required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                 .preferred_flags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT}});
         uniform_writer_ = uniforms_.allocation().write_only();
     }
 
