@@ -7,49 +7,18 @@
 // so far completes, and from then on every call that reports loss does.
 #include "support/fault_injection.hpp"
 #include "support/vk_test.hpp"
+#include "support/watchdog.hpp"
 
 #include <algorithm>
 #include <array>
-#include <chrono>
-#include <condition_variable>
-#include <cstdio>
-#include <cstdlib>
 #include <functional>
-#include <mutex>
 #include <random>
-#include <thread>
 
 namespace {
 
 namespace faults = vkrc_test::faults;
 
-// Aborts the process if the test body has not finished in time: a hang is
-// the failure being tested for, and gtest cannot interrupt one.
-class Watchdog {
-public:
-    explicit Watchdog(const char* what, std::chrono::seconds limit = std::chrono::seconds(60))
-        : thread_([this, what, limit] {
-              std::unique_lock lock(mutex_);
-              if (!done_cv_.wait_for(lock, limit, [this] { return done_; })) {
-                  std::fprintf(stderr, "device loss: %s hung\n", what);
-                  std::abort();
-              }
-          }) {}
-    ~Watchdog() {
-        {
-            std::lock_guard lock(mutex_);
-            done_ = true;
-        }
-        done_cv_.notify_one();
-        thread_.join();
-    }
-
-private:
-    std::mutex mutex_;
-    std::condition_variable done_cv_;
-    bool done_ = false;
-    std::thread thread_;
-};
+using vkrc_test::Watchdog;
 
 // Objects of every kind, some with work pending on the GPU, some dropped
 // (deferred) and some returned to their pool's pending list at the loss.

@@ -1,7 +1,10 @@
 // Presentation: a GLFW window on a private Xvfb, its Swapchain re-created
 // while rendering, minimised (zero extent), and the headless presenter
-// rendering the same pixels through the same frame loop.
+// rendering the same pixels through the same frame loop; and device loss
+// reported by present or acquire.
+#include "support/fault_injection.hpp"
 #include "support/vk_test.hpp"
+#include "support/watchdog.hpp"
 #include "support/xvfb.hpp"
 
 #include "shaders/triangle.frag.h"
@@ -11,8 +14,12 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
+#include <functional>
+#include <optional>
+#include <random>
 
 namespace {
 
@@ -316,6 +323,120 @@ TEST_F(PresentationTest, HeadlessRendersTheSamePixelsAsTheWindow) {
     };
     EXPECT_NE(texel(extent.width / 2, extent.height / 2), texel(1, 1));
     headless_renderer.wait();
+}
+
+// Device loss on the windowed path (issue 7): VK_ERROR_DEVICE_LOST from
+// vkQueuePresentKHR or vkAcquireNextImageKHR raises DeviceLostError and marks
+// the device lost; afterwards nothing waits for ever (the queue timeline the
+// swapchain's destruction is queued behind will not advance) and every handle
+// drops in any order without validation messages. The loss is simulated by
+// the fault injector, as in device_loss_test.cpp.
+namespace faults = vkrc_test::faults;
+
+enum class LossObserver { present, acquire };
+
+// The window outlives every handle (glfw.hpp) and is made once per test.
+void lose_while_presenting(LossObserver how, unsigned seed, const vkrc::glfw::Window& window) {
+    vkrc_test::Watchdog watchdog("losing the device while presenting and dropping every handle");
+    faults::arm(0, VK_SUCCESS);
+    auto log = std::make_shared<ValidationLog>();
+    auto instance_info = vkrc_test::validated_instance_info(log);
+    instance_info.get_instance_proc_addr = faults::get_instance_proc_addr();
+    for (const char* name : vkrc::glfw::required_instance_extensions()) {
+        instance_info.enabled_extension_names.push_back(name);
+    }
+    auto instance = vkrc::Instance::create(instance_info);
+    auto surface = vkrc::glfw::create_surface(instance, window.get());
+    auto requirements = vkrc_test::test_device_requirements();
+    requirements.present_surface = surface.vk();
+    requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    auto physical = vkrc::PhysicalDevice::select(instance, requirements);
+    auto device = vkrc::Device::create(physical, {.enabled_extension_names = {VK_KHR_SWAPCHAIN_EXTENSION_NAME}});
+    auto queue = device.default_queue();
+    auto swapchain = vkrc::Swapchain::create(queue, surface);
+    std::optional<Renderer> renderer(std::in_place, queue, swapchain.format());
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(renderer->frame(swapchain), vkrc::PresentStatus::success);
+
+    // Present: a frame acquired, rendered and submitted; its present sees the
+    // loss. Acquire: the loss comes between two frames.
+    vkrc::Frame frame;
+    if (how == LossObserver::present) {
+        auto& slot = renderer->slots[renderer->count % Renderer::frames_in_flight];
+        EXPECT_EQ(slot.fence.wait(), VK_SUCCESS);
+        frame = swapchain.acquire();
+        ASSERT_TRUE(frame);
+        slot.fence.unsignal();
+        renderer->record(slot.cmd, frame, nullptr);
+        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1),
+                             .signals = frame.signals()},
+                     slot.fence);
+    }
+    faults::lose_device();
+    try {
+        if (how == LossObserver::present) {
+            swapchain.present(frame);
+        } else {
+            frame = swapchain.acquire();
+        }
+        ADD_FAILURE() << "no DeviceLostError";
+    } catch (const vkrc::DeviceLostError& e) {
+        ASSERT_TRUE(faults::fired()) << e.what();
+        if (how == LossObserver::present) EXPECT_STREQ(faults::fired_in(), "vkQueuePresentKHR");
+    }
+    EXPECT_TRUE(device.lost());
+
+    // Later calls report the loss too, none waits.
+    EXPECT_THROW(swapchain.acquire(), vkrc::DeviceLostError);
+    EXPECT_THROW(swapchain.acquire(), vkrc::DeviceLostError);
+    if (frame) EXPECT_THROW(swapchain.present(frame), vkrc::DeviceLostError);
+    for (auto& slot : renderer->slots) EXPECT_THROW(slot.fence.wait(), vkrc::DeviceLostError);
+    EXPECT_THROW(queue.wait_idle(), vkrc::DeviceLostError);
+    EXPECT_THROW(device.wait_idle(), vkrc::DeviceLostError);
+    EXPECT_EQ(device.deferred_count(), 0u) << "deferred destructions wait for a lost device";
+
+    // Every handle, each with a way to drop it.
+    std::vector<std::function<void()>> drops = {
+        [&] { swapchain.reset(); },
+        [&] { frame = {}; },
+        [&] { surface.reset(); },
+        [&] { instance.reset(); },
+        [&] { physical.reset(); },
+        [&] { device.reset(); },
+        [&] { queue = {}; },
+        [&] { renderer->queue = {}; },
+        [&] { renderer->vertex_buffer.reset(); },
+        [&] { renderer->pipeline.reset(); },
+    };
+    for (auto& slot : renderer->slots) {
+        drops.push_back([&slot] { slot.pool.reset(); });
+        drops.push_back([&slot] { slot.cmd.reset(); });
+        drops.push_back([&slot] { slot.fence.reset(); });
+    }
+    std::vector<std::size_t> order(drops.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (seed == 1) std::reverse(order.begin(), order.end());
+    if (seed > 1) std::shuffle(order.begin(), order.end(), std::mt19937(seed));
+    for (auto i : order) drops[i]();
+    renderer.reset();
+    glfwPollEvents();
+    faults::arm(0, VK_SUCCESS);
+    auto messages = log->take();
+    EXPECT_TRUE(messages.empty()) << "drop order seed " << seed << ": " << messages.size()
+                                  << " validation message(s), first: " << messages.front();
+}
+
+TEST(PresentationDeviceLoss, PresentReportsLossAndEveryHandleDropsInAnyOrder) {
+    vkrc_test::Xvfb xvfb;
+    ASSERT_TRUE(xvfb.running()) << xvfb.error();
+    auto window = vkrc::glfw::Window::create({.width = 320, .height = 240, .title = "vkrc device loss test"});
+    for (unsigned seed = 0; seed < 4; ++seed) lose_while_presenting(LossObserver::present, seed, window);
+}
+
+TEST(PresentationDeviceLoss, AcquireReportsLossAndEveryHandleDropsInAnyOrder) {
+    vkrc_test::Xvfb xvfb;
+    ASSERT_TRUE(xvfb.running()) << xvfb.error();
+    auto window = vkrc::glfw::Window::create({.width = 320, .height = 240, .title = "vkrc device loss test"});
+    for (unsigned seed = 0; seed < 4; ++seed) lose_while_presenting(LossObserver::acquire, seed, window);
 }
 
 }  // namespace
