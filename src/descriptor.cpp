@@ -165,6 +165,24 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, co
                 array_element);
 }
 
+namespace {
+// One descriptor, one vkUpdateDescriptorSets; exactly one of the infos is set.
+void update_one(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                std::uint32_t array_element, const VkDescriptorBufferInfo* buffer_info,
+                const VkDescriptorImageInfo* image_info) {
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = s.set;
+    w.dstBinding = binding;
+    w.dstArrayElement = array_element;
+    w.descriptorCount = 1;
+    w.descriptorType = type;
+    w.pBufferInfo = buffer_info;
+    w.pImageInfo = image_info;
+    const auto& d = s.pool.device();
+    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+}
+}  // namespace
+
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
     if (!is_buffer_type(type)) {
@@ -172,16 +190,8 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, V
                          " is not a buffer type");
     }
     check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_buffer");
-    VkDescriptorBufferInfo bi{buffer, offset, range};
-    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    w.dstSet = state_->set;
-    w.dstBinding = binding;
-    w.dstArrayElement = array_element;
-    w.descriptorCount = 1;
-    w.descriptorType = type;
-    w.pBufferInfo = &bi;
-    const auto& d = state_->pool.device();
-    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+    const VkDescriptorBufferInfo info{buffer, offset, range};
+    update_one(*state_, binding, type, array_element, &info, nullptr);
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
@@ -191,16 +201,8 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, Vk
                          " is not an image or sampler type");
     }
     check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_image");
-    VkDescriptorImageInfo ii{sampler, view, layout};
-    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    w.dstSet = state_->set;
-    w.dstBinding = binding;
-    w.dstArrayElement = array_element;
-    w.descriptorCount = 1;
-    w.descriptorType = type;
-    w.pImageInfo = &ii;
-    const auto& d = state_->pool.device();
-    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+    const VkDescriptorImageInfo info{sampler, view, layout};
+    update_one(*state_, binding, type, array_element, nullptr, &info);
 }
 
 VKRC_END_NAMESPACE

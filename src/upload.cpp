@@ -1,5 +1,6 @@
 #include "vkrc/upload.hpp"
 
+#include "vkrc/command.hpp"
 #include "vkrc/sync.hpp"
 
 #include <string>
@@ -91,16 +92,8 @@ public:
     void image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
                        VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                        const VkImageSubresourceRange& range) const {
-        VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        b.srcStageMask = src_stage;
-        b.srcAccessMask = src_access;
-        b.dstStageMask = dst_stage;
-        b.dstAccessMask = dst_access;
-        b.oldLayout = old_layout;
-        b.newLayout = new_layout;
-        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.image = image;
+        VkImageMemoryBarrier2 b = vkrc::image_barrier(image, old_layout, new_layout, src_stage, src_access, dst_stage,
+                                                      dst_access, range.aspectMask);
         b.subresourceRange = range;
         VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
         dep.imageMemoryBarrierCount = 1;
