@@ -1,5 +1,6 @@
 #include "vkrc/pipeline.hpp"
 
+#include <filesystem>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -152,7 +153,7 @@ const char* cache_data_problem(const PhysicalDevice& physical, const std::vector
 }
 }  // namespace
 
-PipelineCache PipelineCache::load(const Device& device, const std::filesystem::path& file) {
+PipelineCache PipelineCache::load(const Device& device, const std::string& file) {
     require(static_cast<bool>(device), "vkrc::PipelineCache::load", "the Device handle is empty");
     std::vector<std::byte> data;
     const char* problem = nullptr;
@@ -167,7 +168,7 @@ PipelineCache PipelineCache::load(const Device& device, const std::filesystem::p
     }
     if (problem) {
         std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n",
-                     file.string().c_str(), problem);
+                     file.c_str(), problem);
         return create(device);
     }
     return create(device, data);
@@ -184,7 +185,7 @@ std::vector<std::byte> PipelineCache::data() const {
     return out;
 }
 
-void PipelineCache::save(const std::filesystem::path& file) const {
+void PipelineCache::save(const std::string& file) const {
     auto bytes = data();
     // Write beside the target and rename, so a crash never leaves a torn cache.
     auto tmp = file;
@@ -192,7 +193,7 @@ void PipelineCache::save(const std::filesystem::path& file) const {
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-        if (!out) throw std::system_error(errno, std::generic_category(), "vkrc::PipelineCache::save: " + tmp.string());
+        if (!out) throw std::system_error(errno, std::generic_category(), "vkrc::PipelineCache::save: " + tmp);
     }
     std::filesystem::rename(tmp, file);
 }
