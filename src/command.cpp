@@ -212,11 +212,11 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         throw UsageError("vkrc::submit: the Fence belongs to another device than the queue");
     }
 #endif
-    queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
+    const std::uint64_t number =
+        queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
     if (fence) {
-        // At least this submission's value (a later one under concurrent submits).
-        fence.state()->queue_timeline = queue.timeline_semaphore();
-        fence.state()->queue_value = queue.last_submitted_value();
+        fence.state()->queue = queue.state();
+        fence.state()->submit_number = number;
         fence.state()->in_flight = true;
     }
 }

@@ -17,7 +17,8 @@ DeviceState::~DeviceState() {
         // Out of memory while waiting: vkrc's own timelines still say when
         // its submissions are done.
         for (auto& q : queues) {
-            std::uint64_t value = q.submitted.load(std::memory_order_acquire);
+            std::uint64_t value = 0;
+            if (signal_submitted_work(q, value) != VK_SUCCESS) continue;
             VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
             wait.semaphoreCount = 1;
             wait.pSemaphores = &q.timeline;
@@ -36,23 +37,52 @@ DeviceState::~DeviceState() {
     if (ownership == Ownership::owned) fn.vkDestroyDevice(device, nullptr);
 }
 
+bool DeviceState::refresh(QueueState& q) noexcept {
+    std::uint64_t value = 0;
+    VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
+    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+    if (r != VK_SUCCESS) return false;
+    q.note_completed(value);
+    return true;
+}
+
 bool DeviceState::idle_now() noexcept {
     bool idle = true;
     for (auto& q : queues) {
-        std::uint64_t submitted = q.submitted.load(std::memory_order_acquire);
-        if (q.completed.load(std::memory_order_relaxed) >= submitted) continue;
-        std::uint64_t value = 0;
-        VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
-        if (r == VK_ERROR_DEVICE_LOST) mark_lost();
-        if (r == VK_SUCCESS) {
-            // Keep the cache monotonic when several threads refresh it.
-            std::uint64_t seen = q.completed.load(std::memory_order_relaxed);
-            while (seen < value && !q.completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
-            }
+        const std::uint64_t last = q.submitted.load(std::memory_order_acquire);
+        if (q.completed.load(std::memory_order_relaxed) >= last) continue;
+        // Without a signal covering the last submit, nothing says it has completed.
+        if (q.signalled.load(std::memory_order_acquire) < last || !refresh(q) ||
+            q.completed.load(std::memory_order_relaxed) < last) {
+            idle = false;
         }
-        if (value < submitted) idle = false;
     }
     return idle || lost.load(std::memory_order_relaxed);
+}
+
+VkResult DeviceState::signal_submitted_work(QueueState& q, std::uint64_t& value) noexcept {
+    LockGuard lock(q.mutex);
+    const std::uint64_t last = q.submitted.load(std::memory_order_relaxed);
+    value = q.signalled.load(std::memory_order_relaxed);
+    if (value == last) return VK_SUCCESS;
+    const bool wanted = q.signal_wanted.exchange(false, std::memory_order_relaxed);
+    VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    signal.semaphore = q.timeline;
+    signal.value = last + 1;
+    signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.signalSemaphoreInfoCount = 1;
+    submit.pSignalSemaphoreInfos = &signal;
+    VkResult r = fn.vkQueueSubmit2(q.queue, 1, &submit, VK_NULL_HANDLE);
+    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+    if (r != VK_SUCCESS) {
+        if (wanted) q.signal_wanted.store(true, std::memory_order_relaxed);
+        return r;
+    }
+    value = last + 1;
+    q.submitted.store(value, std::memory_order_release);
+    q.signalled.store(value, std::memory_order_release);
+    return VK_SUCCESS;
 }
 
 void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
@@ -69,7 +99,7 @@ void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
                 // while the same work was pending is shared.
                 std::vector<std::uint64_t> values;
                 values.reserve(queues.size());
-                for (auto& q : queues) values.push_back(q.submitted.load(std::memory_order_acquire));
+                for (auto& q : queues) values.push_back(q.covering_value());
                 if (deferred_.empty() || deferred_.back().wait_values != values) {
                     deferred_.push_back(Batch{std::move(values), {}});
                 }
@@ -121,6 +151,7 @@ void DeviceState::take_ready(std::vector<DeferredAction>& out) {
 void DeviceState::collect() noexcept {
     std::vector<DeferredAction> ready;
     {
+        if (deferred_actions_.load(std::memory_order_relaxed) == 0) return;
         LockGuard lock(deferred_mutex_);
         if (deferred_.empty()) return;
         try {
@@ -132,9 +163,9 @@ void DeviceState::collect() noexcept {
     for (auto& a : ready) a.run(*this, a.handle, a.context);
 }
 
-void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) const {
+void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) {
     out.resize(queues.size());
-    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].submitted.load(std::memory_order_acquire);
+    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].covering_value();
 }
 
 bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
@@ -142,17 +173,8 @@ bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
     for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
         auto& q = queues[i];
         if (q.completed.load(std::memory_order_relaxed) >= snapshot[i]) continue;
-        std::uint64_t value = 0;
-        VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
-        if (r == VK_ERROR_DEVICE_LOST) {
-            mark_lost();
-            return true;
-        }
-        if (r != VK_SUCCESS) return false;
-        std::uint64_t seen = q.completed.load(std::memory_order_relaxed);
-        while (seen < value && !q.completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
-        }
-        if (value < snapshot[i]) return false;
+        if (!refresh(q)) return lost.load(std::memory_order_relaxed);
+        if (q.completed.load(std::memory_order_relaxed) < snapshot[i]) return false;
     }
     return true;
 }
@@ -305,8 +327,14 @@ Queue Device::default_queue() const {
 }
 
 void Device::wait_idle() const {
+    // Everything submitted before the wait is complete after it.
+    std::vector<std::uint64_t> submitted;
+    for (auto& q : state_->queues) submitted.push_back(q.submitted.load(std::memory_order_acquire));
     VkResult r = fn().vkDeviceWaitIdle(vk());
     if (r == VK_ERROR_DEVICE_LOST) state_->mark_lost();
+    if (r == VK_SUCCESS) {
+        for (std::size_t i = 0; i < submitted.size(); ++i) state_->queues[i].note_completed(submitted[i]);
+    }
     state_->collect();
     check(r, "vkDeviceWaitIdle");
 }
@@ -315,60 +343,83 @@ void Device::collect_garbage() const noexcept { state_->collect(); }
 std::size_t Device::deferred_count() const noexcept { return state_->deferred_count(); }
 bool Device::lost() const noexcept { return state_->lost.load(std::memory_order_relaxed); }
 
-void Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fence) const {
+std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fence) const {
     auto& q = *queue_;
     auto& d = *device_.state();
     VkResult r;
+    std::uint64_t number;
     {
         LockGuard lock(q.mutex);
-        const std::uint64_t value = q.submitted.load(std::memory_order_relaxed) + 1;
-        VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        timeline.semaphore = q.timeline;
-        timeline.value = value;
-        timeline.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-        // The timeline signal goes into the last batch when it has room on
-        // the stack; otherwise into one more batch, which submission order
-        // still places after all the work before it.
-        constexpr std::uint32_t inline_signals = 8;
-        VkSemaphoreSubmitInfo signals[inline_signals + 1];
-        VkSubmitInfo2 tail[2];
-        std::uint32_t tail_count = 0;
-        std::size_t head = submits.size();
-        if (!submits.empty() && submits.back().signalSemaphoreInfoCount <= inline_signals) {
-            head = submits.size() - 1;
-            tail[0] = submits.back();
-            if (tail[0].signalSemaphoreInfoCount) {
-                std::memcpy(signals, tail[0].pSignalSemaphoreInfos,
-                            tail[0].signalSemaphoreInfoCount * sizeof(VkSemaphoreSubmitInfo));
-            }
-            signals[tail[0].signalSemaphoreInfoCount] = timeline;
-            tail[0].signalSemaphoreInfoCount += 1;
-            tail[0].pSignalSemaphoreInfos = signals;
-            tail_count = 1;
+        number = q.submitted.load(std::memory_order_relaxed) + 1;
+        if (!q.signal_wanted.load(std::memory_order_relaxed)) {
+            r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(submits.size()), submits.data(), fence);
+            if (r == VK_SUCCESS) q.submitted.store(number, std::memory_order_release);
         } else {
-            tail[0] = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-            tail[0].signalSemaphoreInfoCount = 1;
-            tail[0].pSignalSemaphoreInfos = &timeline;
-            tail_count = 1;
+            // Cleared before submitting: a request made meanwhile is either
+            // covered by this submit's signal or asks the next submit again.
+            q.signal_wanted.store(false, std::memory_order_relaxed);
+            VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+            timeline.semaphore = q.timeline;
+            timeline.value = number;
+            timeline.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+            // The signal goes into the last batch when its signals fit on the
+            // stack; otherwise into one more batch, which submission order
+            // still places after all the work before it.
+            constexpr std::uint32_t inline_signals = 8;
+            VkSemaphoreSubmitInfo signals[inline_signals + 1];
+            VkSubmitInfo2 tail{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+            std::size_t head = submits.size();
+            if (!submits.empty() && submits.back().signalSemaphoreInfoCount <= inline_signals) {
+                head = submits.size() - 1;
+                tail = submits.back();
+                if (tail.signalSemaphoreInfoCount) {
+                    std::memcpy(signals, tail.pSignalSemaphoreInfos,
+                                tail.signalSemaphoreInfoCount * sizeof(VkSemaphoreSubmitInfo));
+                }
+                signals[tail.signalSemaphoreInfoCount] = timeline;
+                tail.signalSemaphoreInfoCount += 1;
+                tail.pSignalSemaphoreInfos = signals;
+            } else {
+                tail.signalSemaphoreInfoCount = 1;
+                tail.pSignalSemaphoreInfos = &timeline;
+            }
+            r = VK_SUCCESS;
+            if (head > 0) r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
+            const bool head_went_in = head > 0 && r == VK_SUCCESS;
+            if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
+            if (r == VK_SUCCESS) {
+                q.submitted.store(number, std::memory_order_release);
+                q.signalled.store(number, std::memory_order_release);
+            } else {
+                if (head_went_in) q.submitted.store(number, std::memory_order_release);
+                q.signal_wanted.store(true, std::memory_order_relaxed);
+            }
         }
-        r = VK_SUCCESS;
-        if (head > 0) r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
-        if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, tail_count, tail, fence);
-        if (r == VK_SUCCESS) q.submitted.store(value, std::memory_order_release);
     }
     if (r == VK_ERROR_DEVICE_LOST) d.mark_lost();
     d.collect();
     check(r, "vkQueueSubmit2");
+    return number;
+}
+
+std::uint64_t Queue::completion_value() const {
+    std::uint64_t value = 0;
+    check(device_.state()->signal_submitted_work(*queue_, value), "vkQueueSubmit2");
+    return value;
 }
 
 void Queue::wait_idle() const {
+    auto& d = *device_.state();
     VkResult r;
+    std::uint64_t submitted;
     {
         LockGuard lock(queue_->mutex);
-        r = device_.fn().vkQueueWaitIdle(queue_->queue);
+        submitted = queue_->submitted.load(std::memory_order_relaxed);
+        r = d.fn.vkQueueWaitIdle(queue_->queue);
     }
-    if (r == VK_ERROR_DEVICE_LOST) device_.state()->mark_lost();
-    device_.state()->collect();
+    if (r == VK_ERROR_DEVICE_LOST) d.mark_lost();
+    if (r == VK_SUCCESS) queue_->note_completed(submitted);
+    d.collect();
     check(r, "vkQueueWaitIdle");
 }
 

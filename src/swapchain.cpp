@@ -14,10 +14,12 @@ SwapchainChainState::~SwapchainChainState() {
     auto& device = *queue.device().state();
     if (presented) {
         // Without VK_EXT_swapchain_maintenance1 nothing says when a present
-        // is done. An empty submission after the last present puts a value
-        // of the queue's timeline after it in queue order; destroy_after_gpu
-        // below waits for that value (docs/design.md, Presentation).
+        // is done. An empty submission signalling the queue's timeline after
+        // the last present puts a value after it in queue order;
+        // destroy_after_gpu below waits for that value (docs/design.md,
+        // Presentation).
         try {
+            queue.state()->signal_wanted.store(true, std::memory_order_relaxed);
             queue.submit({});
         } catch (...) {
             LockGuard lock(queue.mutex());
@@ -253,18 +255,22 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     return PresentStatus::success;
 }
 
-// Waits until queue's timeline has reached value (0: nothing to wait for).
+// Waits until the queue's submission number value has completed (0: nothing
+// to wait for): at once when a fence or the timeline has shown it, otherwise
+// on the timeline, first submitting a signal if no submit has made one yet.
 void wait_for_queue(const Queue& queue, std::uint64_t value) {
-    if (value == 0) return;
+    auto& q = *queue.state();
+    if (q.completed.load(std::memory_order_relaxed) >= value) return;
+    if (q.signalled.load(std::memory_order_acquire) < value) value = queue.completion_value();
     const Device& device = queue.device();
-    VkSemaphore timeline = queue.timeline_semaphore();
     VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
     wait.semaphoreCount = 1;
-    wait.pSemaphores = &timeline;
+    wait.pSemaphores = &q.timeline;
     wait.pValues = &value;
     VkResult r = device.fn().vkWaitSemaphores(device.vk(), &wait, UINT64_MAX);
     if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
     check(r, "vkWaitSemaphores");
+    q.note_completed(value);
 }
 
 }  // namespace
@@ -374,7 +380,9 @@ PresentStatus Swapchain::present(const Frame& frame) {
     }
     // Even out of date, the present waits on its semaphore (queued as usual).
     chain.presented = true;
-    s.acquire_done_values[frame.acquire_slot_] = s.queue.last_submitted_value();
+    // The slot's reuse waits for this submission number: in a frame loop the
+    // frame's fence has usually shown it complete by then.
+    s.acquire_done_values[frame.acquire_slot_] = s.queue.state()->submitted.load(std::memory_order_acquire);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         s.needs_recreate = true;
         return PresentStatus::out_of_date;
@@ -477,7 +485,7 @@ std::vector<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) c
         }
         image = s.images[image_index];
     }
-    wait_for_queue(s.queue, s.queue.last_submitted_value());
+    wait_for_queue(s.queue, s.queue.completion_value());
     return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
 }
 

@@ -15,16 +15,6 @@ VkResult after_wait(const Device& device, VkResult r, const char* call) {
 }  // namespace
 
 namespace detail {
-VkResult FenceState::settle(VkResult fence_result) noexcept {
-    if (fence_result != VK_SUCCESS || queue_timeline == VK_NULL_HANDLE) return fence_result;
-    VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-    info.semaphoreCount = 1;
-    info.pSemaphores = &queue_timeline;
-    info.pValues = &queue_value;
-    VkResult r = device.fn().vkWaitSemaphores(device.vk(), &info, UINT64_MAX);
-    return r == VK_SUCCESS ? fence_result : r;
-}
-
 void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept {
     if (fence == VK_NULL_HANDLE) return;
     device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
@@ -73,21 +63,27 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
     VkResult r = d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns);
-    if (r == VK_SUCCESS) state_->in_flight = false;
-    return after_wait(d, state_->settle(r), "vkWaitForFences");
+    if (r == VK_SUCCESS) {
+        state_->in_flight = false;
+        state_->note_signalled();
+    }
+    return after_wait(d, r, "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
     const auto& d = state_->device;
     VkResult r = d.fn().vkGetFenceStatus(d.vk(), state_->fence);
-    if (r == VK_SUCCESS) state_->in_flight = false;
-    return after_wait(d, state_->settle(r), "vkGetFenceStatus");
+    if (r == VK_SUCCESS) {
+        state_->in_flight = false;
+        state_->note_signalled();
+    }
+    return after_wait(d, r, "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
     const auto& d = state_->device;
     check(d.fn().vkResetFences(d.vk(), 1, &state_->fence), "vkResetFences");
-    state_->queue_timeline = VK_NULL_HANDLE;
+    state_->queue = nullptr;
     state_->in_flight = false;
 }
 

@@ -194,17 +194,77 @@ TEST(DeferredDestruction, DeviceTeardownDrainsPendingWork) {
     vkrc_test::expect_no_validation_messages(*log);
 }
 
-TEST_F(VulkanTest, SubmitAppendsOneTimelineSignal) {
-    const std::uint64_t before = queue.last_submitted_value();
+TEST_F(VulkanTest, SubmitSignalsTheTimelineOnlyWhenAsked) {
+    actions_run = 0;
+    auto& q = *queue.state();
+    const std::uint64_t signalled = q.signalled.load();
     VkSubmitInfo2 empty{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     std::array<VkSubmitInfo2, 3> batches{empty, empty, empty};
+    const std::uint64_t first = queue.submit(batches);
+    EXPECT_EQ(queue.submit({}), first + 1) << "submissions are numbered";
+    EXPECT_EQ(q.signalled.load(), signalled) << "nothing dropped: the application's submits only";
+
+    // A drop while work may be pending asks the next submit for one signal.
+    device.state()->destroy_after_gpu({count_action, 1, nullptr});
+    EXPECT_EQ(device.deferred_count(), 1u);
+    const std::uint64_t third = queue.submit(batches);
+    EXPECT_EQ(q.signalled.load(), third);
     queue.submit(batches);
-    queue.submit({});
-    EXPECT_EQ(queue.last_submitted_value(), before + 2);
+    EXPECT_EQ(q.signalled.load(), third) << "one signal per request";
+
+    // Waiting on the timeline needs a signalled value: completion_value submits one.
+    const std::uint64_t value = queue.completion_value();
+    EXPECT_EQ(value, third + 2);
+    EXPECT_EQ(queue.completion_value(), value) << "nothing submitted since";
     queue.wait_idle();
+    EXPECT_EQ(actions_run, 1);
     std::uint64_t reached = 0;
     ASSERT_EQ(device.fn().vkGetSemaphoreCounterValue(device.vk(), queue.timeline_semaphore(), &reached), VK_SUCCESS);
-    EXPECT_EQ(reached, before + 2);
+    EXPECT_EQ(reached, value);
+}
+
+TEST_F(VulkanTest, WaitsRunDropsThatNoSubmitSignalled) {
+    actions_run = 0;
+    VkSubmitInfo2 empty{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    queue.submit(std::span(&empty, 1));
+    device.state()->destroy_after_gpu({count_action, 1, nullptr});
+    device.wait_idle();
+    EXPECT_EQ(actions_run, 1) << "Device::wait_idle";
+    queue.submit(std::span(&empty, 1));
+    device.state()->destroy_after_gpu({count_action, 10, nullptr});
+    queue.wait_idle();
+    EXPECT_EQ(actions_run, 11) << "Queue::wait_idle";
+    // A fence signal covers all earlier work on its queue.
+    auto fence = vkrc::Fence::create(device);
+    queue.submit(std::span(&empty, 1));
+    device.state()->destroy_after_gpu({count_action, 100, nullptr});
+    vkrc::submit(queue, vkrc::SubmitBatch{}, fence);
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(actions_run, 111) << "Fence::wait";
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+TEST_F(VulkanTest, TimelineSignalGoesInItsOwnBatchWhenTheLastIsFull) {
+    std::vector<vkrc::Semaphore> semaphores;
+    std::vector<VkSemaphoreSubmitInfo> signals;
+    for (int i = 0; i < 9; ++i) {
+        semaphores.push_back(vkrc::Semaphore::create_timeline(device, 0));
+        VkSemaphoreSubmitInfo s{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        s.semaphore = semaphores.back().vk();
+        s.value = 1;
+        s.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        signals.push_back(s);
+    }
+    for (std::uint32_t count : {8u, 9u}) {
+        VkSubmitInfo2 batch{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        batch.signalSemaphoreInfoCount = count;
+        batch.pSignalSemaphoreInfos = signals.data();
+        for (auto& s : signals) s.value += 1;
+        queue.state()->signal_wanted.store(true);
+        const std::uint64_t number = queue.submit(std::span(&batch, 1));
+        EXPECT_EQ(queue.state()->signalled.load(), number) << count << " signals in the batch";
+    }
+    queue.wait_idle();
 }
 
 #if VKRC_IS_MULTI_THREAD

@@ -87,22 +87,30 @@ public:
     const Device& device() const noexcept { return device_; }
     explicit operator bool() const noexcept { return queue_ != nullptr; }
 
-    // vkQueueSubmit2 with the batches as given, plus a signal of this queue's
-    // timeline semaphore so vkrc knows when the work has completed (that is
-    // all GPU-lifetime tracking costs: no per-draw or per-object work).
-    // No heap allocation. Throws DeviceLostError on device loss.
-    void submit(std::span<const VkSubmitInfo2> submits, VkFence fence = VK_NULL_HANDLE) const;
+    // vkQueueSubmit2 with the batches as given. When vkrc needs to know when
+    // the work submitted so far completes (an object was dropped, a pool
+    // freed a command buffer, a presenter waits), the submit also signals
+    // the queue's timeline semaphore, once; otherwise it is the application's
+    // submit and nothing more, so a frame loop that drops nothing pays no
+    // GPU-lifetime tracking at all. No heap allocation. Returns the
+    // submission's number on this queue (they count up from 1).
+    // Throws DeviceLostError on device loss.
+    std::uint64_t submit(std::span<const VkSubmitInfo2> submits, VkFence fence = VK_NULL_HANDLE) const;
     // vkQueueWaitIdle, then runs deferred destructions.
     void wait_idle() const;
 
-    // The value this queue's vkrc timeline reaches when all work submitted so
-    // far has completed, and that timeline semaphore (to wait on it).
-    std::uint64_t last_submitted_value() const noexcept;
+    // A value of timeline_semaphore() that is reached once all work
+    // submitted so far through vkrc has completed (the timeline counts in
+    // submission numbers). When the last submits carried no signal, submits
+    // an empty batch that signals, so the value can always be waited on.
+    // Takes the queue's lock: not for the hot path.
+    std::uint64_t completion_value() const;
     VkSemaphore timeline_semaphore() const noexcept;
     // The queue's lock, for applications that call vkQueue* themselves from several threads.
     Mutex& mutex() const noexcept;
 
     friend bool operator==(const Queue& a, const Queue& b) noexcept { return a.queue_ == b.queue_; }
+    detail::QueueState* state() const noexcept { return queue_; }
 
 private:
     friend class Device;

@@ -117,20 +117,24 @@ public:
     Device device;
     VkFence fence = VK_NULL_HANDLE;
     Ownership ownership = Ownership::owned;
-    // Set by vkrc::submit: the queue timeline value of the fenced submission.
-    // Drivers may signal the fence a moment before the timeline, so a
-    // successful wait also waits for it; then everything dropped before that
-    // submission has been destroyed when wait() returns. Written only by
-    // submit and unsignal, which Vulkan already requires to be externally
-    // synchronised for the fence.
-    VkSemaphore queue_timeline = VK_NULL_HANDLE;
-    std::uint64_t queue_value = 0;
+    // Set by vkrc::submit: the fenced submission's queue and number. Once the
+    // fence is seen signalled, all work submitted on that queue up to it has
+    // completed (a fence signal covers everything before it in submission
+    // order), so deferred destructions waiting for it run at that wait. A
+    // fence reset without unsignal() (raw vkResetFences) must have been
+    // waited for first, so the record never claims work that is pending.
+    // Written only by submit and unsignal, which Vulkan already requires to
+    // be externally synchronised for the fence.
+    QueueState* queue = nullptr;
+    std::uint64_t submit_number = 0;
     // Submitted and not yet seen signalled: the queue timeline passing its
     // value does not mean the fence's own signal operation has completed,
     // so destruction then waits for the fence (see destroy_submitted_fence).
     bool in_flight = false;
-    // Waits for queue_value once the fence has signalled.
-    VkResult settle(VkResult fence_result) noexcept;
+    // After a successful wait or status: records the submission as complete.
+    void note_signalled() noexcept {
+        if (queue) queue->note_completed(submit_number);
+    }
 };
 
 // Queues the destruction of a fence that was submitted and may not have been

@@ -15,12 +15,37 @@ struct QueueState {
     VkQueue queue = VK_NULL_HANDLE;
     std::uint32_t family_index = 0;
     std::uint32_t index = 0;
-    // Signalled by every vkrc submit with the next value: the only GPU-side
-    // tracking vkrc does.
+    // vkrc's only GPU-side tracking. Submits are numbered; a submit signals
+    // this semaphore with its own number only when someone asked since the
+    // last signal (signal_wanted): a dropped object, a pool freeing a child,
+    // a wait. Frame loops that drop nothing never pay for a signal.
     VkSemaphore timeline = VK_NULL_HANDLE;
-    std::atomic<std::uint64_t> submitted{0};  // written under mutex, read by retirements
-    std::atomic<std::uint64_t> completed{0};  // last value seen reached (a cache)
+    // The number of the last submit, and of the last one that signalled.
+    // Written under mutex.
+    std::atomic<std::uint64_t> submitted{0};
+    std::atomic<std::uint64_t> signalled{0};
+    std::atomic<bool> signal_wanted{false};
+    // The highest submit number known to have completed: read from the
+    // timeline, or that of a vkrc-submitted fence seen signalled (a fence
+    // signal covers all earlier work on its queue).
+    std::atomic<std::uint64_t> completed{0};
     mutable Mutex mutex;
+
+    // The number whose completion means all work submitted so far has
+    // completed. When no signal covers it yet, asks the next submit for one
+    // (until then only a vkrc fence of that submit or a later one, or a wait
+    // for idle, can show it complete).
+    std::uint64_t covering_value() noexcept {
+        const std::uint64_t last = submitted.load(std::memory_order_acquire);
+        if (signalled.load(std::memory_order_acquire) < last) signal_wanted.store(true, std::memory_order_relaxed);
+        return last;
+    }
+    // Raises the completed cache to value (several threads may refresh it).
+    void note_completed(std::uint64_t value) noexcept {
+        std::uint64_t seen = completed.load(std::memory_order_relaxed);
+        while (seen < value && !completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+        }
+    }
 };
 
 // Work to run once the GPU is done with an object: destroying its Vulkan
@@ -48,12 +73,17 @@ public:
     // queued action may run.
     void mark_lost() noexcept { lost.store(true, std::memory_order_relaxed); }
     std::size_t deferred_count() const noexcept;
+    // Under the queue's lock: when submits since the last timeline signal
+    // carried none, submits an empty batch that signals. value receives a
+    // timeline value, signalled or on its way, that covers all work submitted
+    // so far.
+    VkResult signal_submitted_work(QueueState& queue, std::uint64_t& value) noexcept;
 
     // For objects a pool owns (command buffers, descriptor sets), which must
     // be freed under their pool's lock rather than by a DeferredAction: the
-    // values submitted so far on every queue (out is resized to the queue
-    // count), and whether the GPU has completed the work they stand for.
-    void submitted_snapshot(std::vector<std::uint64_t>& out) const;
+    // covering values of every queue (out is resized to the queue count), and
+    // whether the GPU has completed the work they stand for.
+    void submitted_snapshot(std::vector<std::uint64_t>& out);
     bool reached(std::span<const std::uint64_t> snapshot) noexcept;
 
     VkDevice device = VK_NULL_HANDLE;
@@ -74,6 +104,8 @@ public:
 private:
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
+    // Reads one queue's timeline into its completed cache; false on failure.
+    bool refresh(QueueState& queue) noexcept;
     // Moves the actions whose work has completed to out; may throw bad_alloc.
     void take_ready(std::vector<DeferredAction>& out);
 
@@ -84,7 +116,8 @@ private:
     };
     mutable Mutex deferred_mutex_;
     std::deque<Batch> deferred_;
-    std::size_t deferred_actions_ = 0;
+    // Read without the lock by collect() to skip it when nothing is queued.
+    std::atomic<std::size_t> deferred_actions_{0};
     Mutex allocators_mutex_;
     std::vector<std::shared_ptr<DeviceAllocator>> allocators_;  // the default one first, once made
     DeviceAllocator* default_allocator_ = nullptr;
@@ -123,8 +156,5 @@ inline std::uint32_t Queue::family_index() const noexcept { return queue_->famil
 inline std::uint32_t Queue::index() const noexcept { return queue_->index; }
 inline VkSemaphore Queue::timeline_semaphore() const noexcept { return queue_->timeline; }
 inline Mutex& Queue::mutex() const noexcept { return queue_->mutex; }
-inline std::uint64_t Queue::last_submitted_value() const noexcept {
-    return queue_->submitted.load(std::memory_order_acquire);
-}
 
 VKRC_END_NAMESPACE
