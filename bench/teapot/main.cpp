@@ -240,8 +240,16 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
         stages[frame_stage].push_back(std::chrono::duration<double, std::micro>(marks[7] - marks[0]).count());
     };
 
+    // Windowed: the variant about to run goes on top (harness/window.hpp says why).
+    auto bring_to_front = [&](std::size_t v) {
+        if (!config.window) return;
+        variants[v]->window()->raise();
+        poll_window_events();
+    };
+
     Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
     for (std::size_t v = 0; v < variants.size(); ++v) {
+        bring_to_front(v);
         variants[v]->update(0.0);
         for (int f = 0; f < warmup_frames; ++f) run_frame(v, false);
         variants[v]->drain();
@@ -255,10 +263,10 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
         int in_block = std::min(block_frames, frames - b * block_frames);
         for (std::size_t k = 0; k < variants.size(); ++k) {
             std::size_t v = (k + std::size_t(b)) % variants.size();
+            bring_to_front(v);  // untimed, between blocks
             for (int f = 0; f < config.frames_in_flight; ++f) run_frame(v, false);
             for (int f = 0; f < in_block; ++f) run_frame(v, true);
             variants[v]->drain();
-            if (config.window) poll_window_events();  // untimed, between blocks
         }
         progress.show(b + 1, blocks);
     }

@@ -96,6 +96,8 @@
 
 namespace teapot {
 
+class BenchWindow;  // harness/window.hpp
+
 struct Config {
     int teapots = 25;
     int frames_in_flight = 2;
@@ -142,6 +144,8 @@ public:
     // How frames are presented, e.g. "swapchain B8G8R8A8_UNORM, FIFO, 3
     // images, 800x600": the harness requires it to be the same for all.
     virtual std::string presentation() const = 0;
+    // Windowed: the variant's window; null headless.
+    virtual const BenchWindow* window() const = 0;
 };
 
 // Windowed mode's choices (the convention above), one rule for all variants.

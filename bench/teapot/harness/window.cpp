@@ -50,6 +50,8 @@ BenchWindow::~BenchWindow() {
     if (window_) glfwDestroyWindow(window_);
 }
 
+void BenchWindow::raise() const { glfwFocusWindow(window_); }
+
 void poll_window_events() { glfwPollEvents(); }
 void wait_window_events() { glfwWaitEvents(); }
 

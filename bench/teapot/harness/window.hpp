@@ -41,13 +41,18 @@ public:
     BenchWindow& operator=(BenchWindow&& other) noexcept;
     ~BenchWindow();
     GLFWwindow* get() const noexcept { return window_; }
+    // Brings the window to the front (glfwFocusWindow).
+    void raise() const;
 
 private:
     GLFWwindow* window_ = nullptr;
 };
 
 // glfwPollEvents: the harness calls it between blocks (untimed), so that the
-// windows stay responsive.
+// windows stay responsive. Before each variant's block it also raises that
+// variant's window: the windows overlap, and presenting to the visible one
+// costs the window system more than to a covered one (on Xvfb the topmost
+// window's acquire was 2.3x the others'), so each variant is measured on top.
 void poll_window_events();
 // glfwWaitEvents: for a variant whose surface has no area (a minimised window).
 void wait_window_events();

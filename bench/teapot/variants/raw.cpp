@@ -325,6 +325,8 @@ public:
 
     std::string device_name() const override { return device_name_; }
 
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
     std::string presentation() const override {
         return config_.window ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(),
                                                        swapchain_extent_)

@@ -204,6 +204,8 @@ public:
 
     std::string device_name() const override { return device_name_; }
 
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
     std::string presentation() const override {
         return config_.window ? swapchain_presentation(VkFormat(colour_format_), VkPresentModeKHR(present_mode_),
                                                        swapchain_images_.size(), swapchain_extent_)

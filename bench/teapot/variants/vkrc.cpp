@@ -183,6 +183,8 @@ public:
 
     std::string device_name() const override { return device_.physical_device().name(); }
 
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
     std::string presentation() const override {
         if (config_.window)
             return swapchain_presentation(swapchain_.format(), swapchain_.present_mode(), swapchain_.image_count(),
