@@ -11,17 +11,18 @@ namespace teapot {
 
 namespace {
 
-[[noreturn]] void throw_glfw(const char* call) {
+[[noreturn]] void throw_glfw(const char* call, const char* hint = "") {
     const char* description = nullptr;
     glfwGetError(&description);
     throw std::runtime_error(std::string("--window: ") + call + " failed: " +
-                             (description ? description : "no GLFW error description"));
+                             (description ? description : "no GLFW error description") + hint);
 }
 
 }  // namespace
 
 GlfwSession::GlfwSession() {
-    if (glfwInit() != GLFW_TRUE) throw_glfw("glfwInit (is there a display? try tests/with_xvfb.sh)");
+    if (glfwInit() != GLFW_TRUE)
+        throw_glfw("glfwInit", " (no display? tests/with_xvfb.sh runs a command on a private Xvfb)");
     if (glfwVulkanSupported() != GLFW_TRUE) {
         glfwTerminate();
         throw_glfw("glfwVulkanSupported");
