@@ -44,7 +44,8 @@ class VkrcVariant final : public Variant {
 public:
     ~VkrcVariant() override {
         // The members release themselves; with the device idle first, each
-        // Vulkan object is destroyed as its handle goes (nothing deferred).
+        // Vulkan object is destroyed as its handle goes (a presented
+        // swapchain waits for one empty submission after its last present).
         if (device_) device_.wait_idle();
     }
 
