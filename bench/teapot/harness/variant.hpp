@@ -32,6 +32,8 @@
 //     "render done" semaphore per swapchain image. vkrc's Swapchain applies
 //     the same rule from its SwapchainCreateInfo.
 //     Both: one D32_SFLOAT depth image, at least as large as every target.
+//     Windowed, init (the timed preinit stage) includes creating the
+//     window, its surface and the swapchain.
 //   * acquire: picks frame n's slot and its target image. Headless this is
 //     bookkeeping only: the slot was made free by the previous frame's wait
 //     stage, and the ring image's last user (frame n - frames_in_flight - 1)
