@@ -5,6 +5,7 @@
 #include "harness/plot.hpp"
 #include "harness/stats.hpp"
 #include "harness/variant.hpp"
+#include "harness/window.hpp"
 
 #include <unistd.h>
 
@@ -51,7 +52,9 @@ struct Options {
                  "teapot: %s\n"
                  "usage: teapot [--frames N] [--variants a,b,...] [--teapots N] [--frames-in-flight N]\n"
                  "              [--uniform-writes N] [--tessellation N] [--sweep] [--csv PATH]\n"
-                 "              [--png-dir DIR] [--size WxH] [--validation]\n"
+                 "              [--png-dir DIR] [--size WxH] [--validation] [--window]\n"
+                 "--window: each variant presents to its own window through a swapchain (needs a display,\n"
+                 "          e.g. tests/with_xvfb.sh); the default renders headless into a ring of images\n"
                  "variants:",
                  problem.c_str());
     for (const auto& entry : variant_registry()) std::fprintf(stderr, " %s", std::string(entry.name).c_str());
@@ -100,6 +103,7 @@ Options parse(int argc, char** argv) {
             o.config.width = std::uint32_t(positive(a, v.substr(0, x)));
             o.config.height = std::uint32_t(positive(a, v.substr(x + 1)));
         } else if (a == "--validation") o.config.validation = true;
+        else if (a == "--window") o.config.window = true;
         else if (a == "--help" || a == "-h") usage("help");
         else usage("unknown option '" + a + "'");
     }
@@ -119,6 +123,7 @@ struct VariantResult {
     std::string name;
     std::vector<double> stage_us[stage_count];  // preinit holds preinit_rounds samples
     std::vector<std::uint8_t> image;
+    std::string presentation;
     std::size_t differing_pixels = 0;
     int max_channel_difference = 0;
 };
@@ -235,8 +240,16 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
         stages[frame_stage].push_back(std::chrono::duration<double, std::micro>(marks[7] - marks[0]).count());
     };
 
+    // Windowed: the variant about to run goes on top (harness/window.hpp says why).
+    auto bring_to_front = [&](std::size_t v) {
+        if (!config.window) return;
+        variants[v]->window()->raise();
+        poll_window_events();
+    };
+
     Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
     for (std::size_t v = 0; v < variants.size(); ++v) {
+        bring_to_front(v);
         variants[v]->update(0.0);
         for (int f = 0; f < warmup_frames; ++f) run_frame(v, false);
         variants[v]->drain();
@@ -250,6 +263,7 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
         int in_block = std::min(block_frames, frames - b * block_frames);
         for (std::size_t k = 0; k < variants.size(); ++k) {
             std::size_t v = (k + std::size_t(b)) % variants.size();
+            bring_to_front(v);  // untimed, between blocks
             for (int f = 0; f < config.frames_in_flight; ++f) run_frame(v, false);
             for (int f = 0; f < in_block; ++f) run_frame(v, true);
             variants[v]->drain();
@@ -258,6 +272,7 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
     }
 
     for (std::size_t v = 0; v < variants.size(); ++v) {
+        result.variants[v].presentation = variants[v]->presentation();
         result.variants[v].image = variants[v]->render_reference_frame(reference_time);
         auto [differing, channel] = compare_images(result.variants[v].image, result.variants[0].image);
         result.variants[v].differing_pixels = differing;
@@ -274,6 +289,10 @@ void print_table(const ConfigResult& r) {
                 "%d frames per variant\n",
                 c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
                 std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, r.frames);
+    std::printf("presentation: %s\n", r.variants[0].presentation.c_str());
+    for (const VariantResult& v : r.variants)
+        if (v.presentation != r.variants[0].presentation)
+            std::printf("presentation of %s DIFFERS: %s\n", v.name.c_str(), v.presentation.c_str());
     std::printf("%-8s %-11s %11s %11s %11s %8s %19s\n", "stage", "variant", "median_us", "p5_us", "p95_us", "ratio",
                 "95% CI");
     for (int s = 0; s < stage_count; ++s)
@@ -353,6 +372,9 @@ void write_plots(const std::string& dir, const ConfigResult& r) {
 int run(int argc, char** argv) {
     Options options = parse(argc, argv);
     std::filesystem::create_directories(options.png_dir);
+    // GLFW for every window of the run (harness/window.hpp says why here).
+    std::optional<GlfwSession> glfw;
+    if (options.config.window) glfw.emplace();
 
     // The configurations: the one given, or the sweep, varying one setting
     // at a time from the given one. Larger scenes get proportionally fewer
@@ -393,9 +415,13 @@ int run(int argc, char** argv) {
     std::map<int, Mesh> meshes;
     std::vector<ConfigResult> results;
     bool images_ok = true;
+    bool presentation_ok = true;
     for (std::size_t i = 0; i < plan.size(); ++i) {
         results.push_back(run_configuration(options, plan[i].first, plan[i].second, meshes, int(i), int(plan.size())));
-        for (const VariantResult& v : results.back().variants) images_ok &= v.differing_pixels == 0;
+        for (const VariantResult& v : results.back().variants) {
+            images_ok &= v.differing_pixels == 0;
+            presentation_ok &= v.presentation == results.back().variants[0].presentation;
+        }
     }
 
     // Speed against error: geometric error of every level run, and the image
@@ -460,6 +486,10 @@ int run(int argc, char** argv) {
     int status = 0;
     if (!images_ok) {
         std::fprintf(stderr, "teapot: FAILED: a variant's image differs from %s's\n", results[0].variants[0].name.c_str());
+        status = 1;
+    }
+    if (!presentation_ok) {
+        std::fprintf(stderr, "teapot: FAILED: the variants present differently (format, mode, image count or extent)\n");
         status = 1;
     }
     if (validation_messages > 0) {

@@ -6,56 +6,99 @@
 // translation unit includes vkrc under one policy only). The harness times
 // the stages itself, so a variant only does the work of each stage.
 //
-// Headless presentation convention (every variant follows it exactly, so the
-// stages measure the same work; vkrc's headless presenter must match it):
+// Presentation convention (every variant follows it exactly, so the stages
+// measure the same work). Two modes: headless (the default) and windowed
+// (--window, a real swapchain); what differs between them is marked.
 //   * Frame resources: frames_in_flight slots, each with its own command pool
 //     and primary command buffer, fence, descriptor set and 128-byte region
 //     of one persistently mapped HOST_VISIBLE|HOST_COHERENT uniform buffer
 //     (region stride rounded up to minUniformBufferOffsetAlignment; no flush,
 //     coherent memory is the one write strategy for all variants).
-//   * Images: a ring of frames_in_flight + 1 colour images (R8G8B8A8_UNORM,
-//     the stand-in for a swapchain of that many images) and one D32_SFLOAT
-//     depth image. Frame n uses slot n % frames_in_flight and ring image
+//     Windowed, each slot also has a binary "acquire" semaphore.
+//   * Images, headless: a ring of frames_in_flight + 1 colour images
+//     (R8G8B8A8_UNORM, the stand-in for a swapchain of that many images).
+//     Frame n uses slot n % frames_in_flight and ring image
 //     n % (frames_in_flight + 1).
-//   * acquire: picks frame n's slot and ring image. Bookkeeping only: the
-//     slot was made free by the previous frame's wait stage, and the ring
-//     image's last user (frame n - frames_in_flight - 1) is older still.
+//     Windowed: the variant's own window (harness/window.hpp) and a swapchain
+//     made by the rule of the window_* helpers below: format B8G8R8A8_UNORM
+//     or else R8G8B8A8_UNORM (colour space SRGB_NONLINEAR; UNORM so that the
+//     bytes are the headless ones), present mode IMMEDIATE, else MAILBOX,
+//     else FIFO (the first two do not wait for vertical blank, so the stages
+//     measure the API rather than the display's rate; FIFO is the one every
+//     surface has), minImageCount frames_in_flight + 1 clamped to the
+//     surface's limits, the surface's current extent (Config width x height
+//     where the surface leaves it to the swapchain), COLOR_ATTACHMENT usage,
+//     opaque composite alpha where supported, clipped. One binary
+//     "render done" semaphore per swapchain image. vkrc's Swapchain applies
+//     the same rule from its SwapchainCreateInfo.
+//     Both: one D32_SFLOAT depth image, at least as large as every target.
+//     Windowed, init (the timed preinit stage) includes creating the
+//     window, its surface and the swapchain.
+//   * acquire: picks frame n's slot and its target image. Headless this is
+//     bookkeeping only: the slot was made free by the previous frame's wait
+//     stage, and the ring image's last user (frame n - frames_in_flight - 1)
+//     is older still. Windowed: vkAcquireNextImageKHR (no timeout) signalling
+//     the slot's acquire semaphore, free since the wait stage waited for the
+//     slot's last submission, which waited on it. A swapchain that reported
+//     OUT_OF_DATE or SUBOPTIMAL is re-created here first (new extent, depth
+//     image grown if needed), and acquiring again after OUT_OF_DATE.
 //   * uniform: copies the CameraUniforms (view, proj) into the slot's mapped
 //     region uniform_writes times (write_camera_uniforms below).
 //   * command: vkResetCommandPool on the slot's pool, then records: barrier
-//     colour UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL and depth UNDEFINED ->
-//     DEPTH_ATTACHMENT_OPTIMAL (after earlier frames' depth tests), dynamic
-//     rendering with both cleared (colour clear_colour, depth 1), bind
-//     pipeline, set viewport and scissor, bind the slot's descriptor set,
-//     bind the position and normal vertex buffers and the 16-bit index
-//     buffer, then per teapot vkCmdPushConstants (80 bytes) + vkCmdDrawIndexed;
-//     end rendering, barrier colour -> TRANSFER_SRC_OPTIMAL (where a windowed
-//     run transitions to PRESENT_SRC_KHR), end.
+//     colour UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL (source stage
+//     COLOR_ATTACHMENT_OUTPUT, where a windowed submission waits for its
+//     acquire semaphore) and depth UNDEFINED -> DEPTH_ATTACHMENT_OPTIMAL
+//     (after earlier frames' depth tests), dynamic rendering over the
+//     target's extent with both cleared (colour clear_colour, depth 1), bind
+//     pipeline, set viewport and scissor to that extent, bind the slot's
+//     descriptor set, bind the position and normal vertex buffers and the
+//     16-bit index buffer, then per teapot vkCmdPushConstants (80 bytes) +
+//     vkCmdDrawIndexed; end rendering, barrier colour -> TRANSFER_SRC_OPTIMAL
+//     headless, PRESENT_SRC_KHR windowed (destination stage NONE), end.
 //   * submit: one vkQueueSubmit2 of the command buffer, signalling the slot's
-//     fence; no semaphores.
-//   * present: hands the ring image over. Headless there is no presentation
-//     engine, so present is bookkeeping only: it records the ring image as the
-//     last presented one and advances the frame counter; no Vulkan call.
+//     fence. Headless: no semaphores. Windowed: waits on the slot's acquire
+//     semaphore at COLOR_ATTACHMENT_OUTPUT and signals the image's render-done
+//     semaphore at ALL_COMMANDS.
+//   * present: hands the image over and advances the frame counter. Headless
+//     there is no presentation engine, so present is bookkeeping only: it
+//     records the ring image as the last presented one; no Vulkan call.
+//     Windowed: vkQueuePresentKHR waiting on the image's render-done
+//     semaphore; OUT_OF_DATE or SUBOPTIMAL marks the swapchain for
+//     re-creation at the next acquire.
 //   * wait: waits for the fence of the slot the next frame will use, if that
 //     slot has been submitted, and resets it (with one frame in flight this
 //     waits for the frame just submitted).
 //   * update: the CPU animation of every teapot for time t (teapot::animate)
 //     into the variant's draw array, read by the next command stage.
+//   * Reference frame (render_reference_frame, the image check): in both
+//     modes it is rendered offscreen through the headless path of the stages
+//     above, into a ring image of Config width x height (windowed: a ring of
+//     one image in the swapchain's format, so that the one pipeline serves
+//     both), then read back and converted to RGBA (to_rgba). Presented
+//     swapchain images cannot be read back, and their extent follows the
+//     surface; the offscreen frame is the same pixels in every mode.
+// vkrc's presenters (include/vkrc/swapchain.hpp) do somewhat more than the
+// above on acquire and present, being general: see variants/vkrc.cpp.
 #pragma once
 
 #include "scene/teapot_scene.hpp"
 
 #include <vulkan/vulkan_core.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace teapot {
+
+class BenchWindow;  // harness/window.hpp
 
 struct Config {
     int teapots = 25;
@@ -65,6 +108,7 @@ struct Config {
     std::uint32_t width = 800;
     std::uint32_t height = 600;
     bool validation = false;
+    bool window = false;  // --window: present to a window instead of the headless ring
 };
 
 // What every variant draws: the mesh (shared, built once per tessellation)
@@ -99,7 +143,94 @@ public:
     // row first.
     virtual std::vector<std::uint8_t> render_reference_frame(double t) = 0;
     virtual std::string device_name() const = 0;
+    // How frames are presented, e.g. "swapchain B8G8R8A8_UNORM, FIFO, 3
+    // images, 800x600": the harness requires it to be the same for all.
+    virtual std::string presentation() const = 0;
+    // Windowed: the variant's window; null headless.
+    virtual const BenchWindow* window() const = 0;
 };
+
+// Windowed mode's choices (the convention above), one rule for all variants.
+inline constexpr VkSurfaceFormatKHR window_formats[2] = {
+    {VK_FORMAT_B8G8R8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
+    {VK_FORMAT_R8G8B8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
+inline constexpr VkPresentModeKHR window_present_modes[3] = {VK_PRESENT_MODE_IMMEDIATE_KHR,
+                                                             VK_PRESENT_MODE_MAILBOX_KHR, VK_PRESENT_MODE_FIFO_KHR};
+
+inline bool is_window_format(VkSurfaceFormatKHR f) {
+    return std::any_of(std::begin(window_formats), std::end(window_formats), [&](const VkSurfaceFormatKHR& w) {
+        return w.format == f.format && w.colorSpace == f.colorSpace;
+    });
+}
+
+[[noreturn]] inline void throw_no_window_format() {
+    throw std::runtime_error("--window: the surface supports neither B8G8R8A8_UNORM nor R8G8B8A8_UNORM (SRGB_NONLINEAR)");
+}
+
+inline VkSurfaceFormatKHR choose_window_format(std::span<const VkSurfaceFormatKHR> supported) {
+    if (supported.size() == 1 && supported[0].format == VK_FORMAT_UNDEFINED) return window_formats[0];  // any format
+    for (const VkSurfaceFormatKHR& wanted : window_formats)
+        for (const VkSurfaceFormatKHR& f : supported)
+            if (f.format == wanted.format && f.colorSpace == wanted.colorSpace) return f;
+    throw_no_window_format();
+}
+
+inline VkPresentModeKHR choose_present_mode(std::span<const VkPresentModeKHR> supported) {
+    for (VkPresentModeKHR wanted : window_present_modes)
+        if (std::find(supported.begin(), supported.end(), wanted) != supported.end()) return wanted;
+    return VK_PRESENT_MODE_FIFO_KHR;  // every surface supports it
+}
+
+inline std::uint32_t swapchain_image_request(const Config& config, const VkSurfaceCapabilitiesKHR& caps) {
+    std::uint32_t count = std::max(std::uint32_t(config.frames_in_flight + 1), caps.minImageCount);
+    return caps.maxImageCount ? std::min(count, caps.maxImageCount) : count;
+}
+
+inline VkExtent2D swapchain_extent(const Config& config, const VkSurfaceCapabilitiesKHR& caps) {
+    if (caps.currentExtent.width != UINT32_MAX) return caps.currentExtent;
+    return {std::clamp(config.width, caps.minImageExtent.width, caps.maxImageExtent.width),
+            std::clamp(config.height, caps.minImageExtent.height, caps.maxImageExtent.height)};
+}
+
+inline VkCompositeAlphaFlagBitsKHR composite_alpha(const VkSurfaceCapabilitiesKHR& caps) {
+    if (caps.supportedCompositeAlpha & VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR) return VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+    for (std::uint32_t bit = 1; bit != 0; bit <<= 1)
+        if (caps.supportedCompositeAlpha & bit) return VkCompositeAlphaFlagBitsKHR(bit);
+    return VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+}
+
+inline const char* present_mode_name(VkPresentModeKHR mode) {
+    switch (mode) {
+        case VK_PRESENT_MODE_IMMEDIATE_KHR: return "IMMEDIATE";
+        case VK_PRESENT_MODE_MAILBOX_KHR: return "MAILBOX";
+        case VK_PRESENT_MODE_FIFO_KHR: return "FIFO";
+        default: return "other";
+    }
+}
+
+inline const char* format_name(VkFormat format) {
+    switch (format) {
+        case VK_FORMAT_B8G8R8A8_UNORM: return "B8G8R8A8_UNORM";
+        case VK_FORMAT_R8G8B8A8_UNORM: return "R8G8B8A8_UNORM";
+        default: return "other";
+    }
+}
+
+// The presentation() text of both modes.
+inline std::string headless_presentation(std::size_t images, VkFormat format, VkExtent2D e) {
+    return "headless ring of " + std::to_string(images) + " " + format_name(format) + " images, " +
+           std::to_string(e.width) + "x" + std::to_string(e.height);
+}
+inline std::string swapchain_presentation(VkFormat format, VkPresentModeKHR mode, std::size_t images, VkExtent2D e) {
+    return std::string("swapchain ") + format_name(format) + ", " + present_mode_name(mode) + ", " +
+           std::to_string(images) + " images, " + std::to_string(e.width) + "x" + std::to_string(e.height);
+}
+
+// Read-back pixels of a reference image of this format, as RGBA.
+inline void to_rgba(std::vector<std::uint8_t>& pixels, VkFormat format) {
+    if (format != VK_FORMAT_B8G8R8A8_UNORM) return;
+    for (std::size_t p = 0; p + 3 < pixels.size(); p += 4) std::swap(pixels[p], pixels[p + 2]);
+}
 
 // The one uniform write strategy: plain copies into coherent mapped memory.
 // The compiler barrier keeps repeated identical copies from being merged, so

@@ -2,8 +2,13 @@
 // careful C programmer would; `raw-direct` makes the same device-level calls
 // through pointers from vkGetDeviceProcAddr, skipping the loader's
 // trampolines (the floor for any wrapper). One template, Direct selects the
-// dispatch at compile time so `raw` keeps plain direct calls.
+// dispatch at compile time so `raw` keeps plain direct calls. Windowed
+// (--window), both present with their own VkSurfaceKHR/VkSwapchainKHR code.
 #include "harness/variant.hpp"
+#include "harness/window.hpp"
+
+#define GLFW_INCLUDE_NONE  // Vulkan only, no OpenGL headers
+#include <GLFW/glfw3.h>
 
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
@@ -33,7 +38,9 @@ void check(VkResult result, const char* call) {
     X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) X(vkQueueSubmit2)                      \
     X(vkCmdPipelineBarrier2) X(vkCmdBeginRendering) X(vkCmdEndRendering) X(vkCmdBindPipeline)                     \
     X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdBindDescriptorSets) X(vkCmdBindVertexBuffers)                   \
-    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)
+    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)                \
+    X(vkCreateSemaphore) X(vkDestroySemaphore) X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR)                   \
+    X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) X(vkQueuePresentKHR)
 
 struct DeviceFunctions {
 #define TEAPOT_MEMBER(name) PFN_##name name = nullptr;
@@ -57,8 +64,10 @@ public:
         camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        present_to_window_ = config.window;
         create_instance();
         create_device();
+        if (config.window) create_swapchain();
         create_geometry(*scene.mesh);
         create_images();
         create_pipeline();
@@ -67,7 +76,28 @@ public:
 
     void acquire() override {
         slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
-        image_ = static_cast<std::uint32_t>(frame_ % (config_.frames_in_flight + 1));
+        if (!present_to_window_) {
+            image_ = static_cast<std::uint32_t>(frame_ % ring_.size());
+            target_ = {ring_[image_].image, ring_[image_].view, {config_.width, config_.height},
+                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+            return;
+        }
+        for (;;) {
+            if (swapchain_stale_) recreate_swapchain();
+            VkResult result = call(&DeviceFunctions::vkAcquireNextImageKHR, ::vkAcquireNextImageKHR)(
+                device_, swapchain_, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
+            if (result == VK_ERROR_OUT_OF_DATE_KHR) {
+                swapchain_stale_ = true;
+                continue;
+            }
+            if (result == VK_SUBOPTIMAL_KHR)
+                swapchain_stale_ = true;  // the image is still usable: re-created after its present
+            else
+                check(result, "vkAcquireNextImageKHR");
+            break;
+        }
+        target_ = {swapchain_images_[image_], swapchain_views_[image_], swapchain_extent_,
+                   VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
     }
 
     void uniform() override {
@@ -85,14 +115,14 @@ public:
 
         VkImageMemoryBarrier2 to_render[2]{};
         to_render[0].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-        to_render[0].srcStageMask = VK_PIPELINE_STAGE_2_NONE;
+        to_render[0].srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
         to_render[0].dstStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
         to_render[0].dstAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
         to_render[0].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
         to_render[0].newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
         to_render[0].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         to_render[0].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[0].image = ring_[image_].image;
+        to_render[0].image = target_.image;
         to_render[0].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         to_render[1].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
         to_render[1].srcStageMask =
@@ -114,7 +144,7 @@ public:
         call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &dependency);
 
         VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        colour.imageView = ring_[image_].view;
+        colour.imageView = target_.view;
         colour.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
         colour.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
         colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
@@ -126,7 +156,7 @@ public:
         depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
         depth.clearValue.depthStencil = {1.0f, 0};
         VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
-        rendering.renderArea = {{0, 0}, {config_.width, config_.height}};
+        rendering.renderArea = {{0, 0}, target_.extent};
         rendering.layerCount = 1;
         rendering.colorAttachmentCount = 1;
         rendering.pColorAttachments = &colour;
@@ -134,9 +164,9 @@ public:
         call(&DeviceFunctions::vkCmdBeginRendering, ::vkCmdBeginRendering)(cmd, &rendering);
 
         call(&DeviceFunctions::vkCmdBindPipeline, ::vkCmdBindPipeline)(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
-        VkViewport viewport{0, 0, float(config_.width), float(config_.height), 0, 1};
+        VkViewport viewport{0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1};
         call(&DeviceFunctions::vkCmdSetViewport, ::vkCmdSetViewport)(cmd, 0, 1, &viewport);
-        VkRect2D scissor{{0, 0}, {config_.width, config_.height}};
+        VkRect2D scissor{{0, 0}, target_.extent};
         call(&DeviceFunctions::vkCmdSetScissor, ::vkCmdSetScissor)(cmd, 0, 1, &scissor);
         call(&DeviceFunctions::vkCmdBindDescriptorSets, ::vkCmdBindDescriptorSets)(
             cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_layout_, 0, 1, &f.descriptor_set, 0, nullptr);
@@ -157,10 +187,10 @@ public:
         to_present.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
         to_present.dstStageMask = VK_PIPELINE_STAGE_2_NONE;
         to_present.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        to_present.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        to_present.newLayout = target_.present_layout;
         to_present.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         to_present.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_present.image = ring_[image_].image;
+        to_present.image = target_.image;
         to_present.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         VkDependencyInfo present_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
         present_dependency.imageMemoryBarrierCount = 1;
@@ -176,11 +206,36 @@ public:
         VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
         submit.commandBufferInfoCount = 1;
         submit.pCommandBufferInfos = &cmd_info;
+        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        if (present_to_window_) {
+            wait.semaphore = f.acquire_semaphore;
+            wait.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+            signal.semaphore = render_done_[image_];
+            signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+            submit.waitSemaphoreInfoCount = 1;
+            submit.pWaitSemaphoreInfos = &wait;
+            submit.signalSemaphoreInfoCount = 1;
+            submit.pSignalSemaphoreInfos = &signal;
+        }
         check(call(&DeviceFunctions::vkQueueSubmit2, ::vkQueueSubmit2)(queue_, 1, &submit, f.fence), "vkQueueSubmit2");
         f.submitted = true;
     }
 
     void present() override {
+        if (present_to_window_) {
+            VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+            info.waitSemaphoreCount = 1;
+            info.pWaitSemaphores = &render_done_[image_];
+            info.swapchainCount = 1;
+            info.pSwapchains = &swapchain_;
+            info.pImageIndices = &image_;
+            VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(queue_, &info);
+            if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
+                swapchain_stale_ = true;  // re-created at the next acquire
+            else
+                check(result, "vkQueuePresentKHR");
+        }
         presented_image_ = image_;
         ++frame_;
     }
@@ -201,11 +256,14 @@ public:
     std::vector<std::uint8_t> render_reference_frame(double t) override {
         drain();
         update(t);
+        // Offscreen in both modes, through the headless path of the stages.
+        present_to_window_ = false;
         acquire();
         uniform();
         command();
         submit();
         present();
+        present_to_window_ = config_.window;
         drain();
         // Copy the presented image to the readback buffer with a one-off
         // command buffer from the slot's pool (idle after the drain).
@@ -260,10 +318,20 @@ public:
         check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
         check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
         const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        return {pixels, pixels + std::size_t(config_.width) * config_.height * 4};
+        std::vector<std::uint8_t> image(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
+        to_rgba(image, colour_format_);
+        return image;
     }
 
     std::string device_name() const override { return device_name_; }
+
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
+    std::string presentation() const override {
+        return config_.window ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(),
+                                                       swapchain_extent_)
+                              : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
+    }
 
 private:
     struct Image {
@@ -276,7 +344,15 @@ private:
         VkCommandBuffer cmd = VK_NULL_HANDLE;
         VkFence fence = VK_NULL_HANDLE;
         VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+        VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
         bool submitted = false;
+    };
+    // What this frame renders into: a ring image or a swapchain image.
+    struct Target {
+        VkImage image = VK_NULL_HANDLE;
+        VkImageView view = VK_NULL_HANDLE;
+        VkExtent2D extent{};
+        VkImageLayout present_layout = VK_IMAGE_LAYOUT_UNDEFINED;
     };
 
     // The device-level function: the loader's export for raw, the device's
@@ -297,17 +373,28 @@ private:
         messenger.messageSeverity = validation_severities;
         messenger.messageType = validation_types;
         messenger.pfnUserCallback = validation_callback;
-        const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+        std::vector<const char*> extensions;
+        if (config_.window) {
+            // The window's extensions (VK_KHR_surface and the platform's).
+            window_ = BenchWindow(config_);
+            std::uint32_t count = 0;
+            const char** names = glfwGetRequiredInstanceExtensions(&count);
+            if (!names) throw std::runtime_error("glfwGetRequiredInstanceExtensions failed");
+            extensions.assign(names, names + count);
+        }
+        if (config_.validation) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
         VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
         info.pApplicationInfo = &app;
+        info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+        info.ppEnabledExtensionNames = extensions.data();
         if (config_.validation) {
             info.pNext = &messenger;
             info.enabledLayerCount = 1;
             info.ppEnabledLayerNames = &validation_layer;
-            info.enabledExtensionCount = 1;
-            info.ppEnabledExtensionNames = &extension;
         }
         check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
+        if (config_.window)
+            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &surface_), "glfwCreateWindowSurface");
         if (config_.validation) {
             auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
@@ -316,7 +403,8 @@ private:
     }
 
     void create_device() {
-        // The first device with a graphics queue and Vulkan 1.3.
+        // The first device with a graphics queue and Vulkan 1.3 (windowed:
+        // a graphics queue that presents to the surface).
         std::uint32_t count = 0;
         check(vkEnumeratePhysicalDevices(instance_, &count, nullptr), "vkEnumeratePhysicalDevices");
         std::vector<VkPhysicalDevice> devices(count);
@@ -329,17 +417,24 @@ private:
             vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, nullptr);
             std::vector<VkQueueFamilyProperties> families(family_count);
             vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, families.data());
-            for (std::uint32_t i = 0; i < family_count; ++i)
-                if (families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
+            for (std::uint32_t i = 0; i < family_count; ++i) {
+                VkBool32 presents = VK_TRUE;
+                if (config_.window)
+                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, surface_, &presents),
+                          "vkGetPhysicalDeviceSurfaceSupportKHR");
+                if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && presents) {
                     physical_device_ = candidate;
                     queue_family_ = i;
                     device_name_ = properties.deviceName;
                     uniform_alignment_ = properties.limits.minUniformBufferOffsetAlignment;
                     break;
                 }
+            }
             if (physical_device_) break;
         }
-        if (!physical_device_) throw std::runtime_error("no Vulkan 1.3 device with a graphics queue");
+        if (!physical_device_)
+            throw std::runtime_error(config_.window ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
+                                                    : "no Vulkan 1.3 device with a graphics queue");
         vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
 
         float priority = 1.0f;
@@ -354,6 +449,11 @@ private:
         info.pNext = &features13;
         info.queueCreateInfoCount = 1;
         info.pQueueCreateInfos = &queue_info;
+        const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
+        if (config_.window) {
+            info.enabledExtensionCount = 1;
+            info.ppEnabledExtensionNames = &swapchain_extension;
+        }
         check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
         // The pointers for raw-direct's hot path and for the untimed helpers.
 #define TEAPOT_LOAD(name) fn_.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device_, #name));
@@ -408,12 +508,23 @@ private:
                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback_);
     }
 
-    Image create_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect) {
+    VkImageView create_view(VkImage image, VkFormat format, VkImageAspectFlags aspect) {
+        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+        view.image = image;
+        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+        view.format = format;
+        view.subresourceRange = {aspect, 0, 1, 0, 1};
+        VkImageView handle;
+        check(fn_.vkCreateImageView(device_, &view, nullptr, &handle), "vkCreateImageView");
+        return handle;
+    }
+
+    Image create_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, VkExtent2D extent) {
         Image image;
         VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
         info.imageType = VK_IMAGE_TYPE_2D;
         info.format = format;
-        info.extent = {config_.width, config_.height, 1};
+        info.extent = {extent.width, extent.height, 1};
         info.mipLevels = 1;
         info.arrayLayers = 1;
         info.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -429,22 +540,115 @@ private:
         allocate.memoryTypeIndex = type;
         check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &image.memory), "vkAllocateMemory");
         check(fn_.vkBindImageMemory(device_, image.image, image.memory, 0), "vkBindImageMemory");
-        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-        view.image = image.image;
-        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-        view.format = format;
-        view.subresourceRange = {aspect, 0, 1, 0, 1};
-        check(fn_.vkCreateImageView(device_, &view, nullptr, &image.view), "vkCreateImageView");
+        image.view = create_view(image.image, format, aspect);
         return image;
     }
 
+    void destroy_image(Image& image) {
+        fn_.vkDestroyImageView(device_, image.view, nullptr);
+        fn_.vkDestroyImage(device_, image.image, nullptr);
+        fn_.vkFreeMemory(device_, image.memory, nullptr);
+        image = {};
+    }
+
+    // The ring (windowed: the one offscreen image of the reference frame)
+    // and a depth image covering every target.
     void create_images() {
-        ring_.resize(config_.frames_in_flight + 1);
+        ring_.resize(config_.window ? 1 : config_.frames_in_flight + 1);
         for (Image& image : ring_)
-            image = create_image(colour_format,
+            image = create_image(colour_format_,
                                  VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                 VK_IMAGE_ASPECT_COLOR_BIT);
-        depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT);
+                                 VK_IMAGE_ASPECT_COLOR_BIT, {config_.width, config_.height});
+        create_depth();
+    }
+
+    void create_depth() {
+        depth_extent_ = {std::max(config_.width, swapchain_extent_.width),
+                         std::max(config_.height, swapchain_extent_.height)};
+        depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+                              depth_extent_);
+    }
+
+    // The window's swapchain by the convention's rule. Format and present
+    // mode are chosen once: the pipeline is made for the format.
+    void create_swapchain() {
+        std::uint32_t count = 0;
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, nullptr),
+              "vkGetPhysicalDeviceSurfaceFormatsKHR");
+        std::vector<VkSurfaceFormatKHR> formats(count);
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, formats.data()),
+              "vkGetPhysicalDeviceSurfaceFormatsKHR");
+        surface_format_ = choose_window_format(formats);
+        colour_format_ = surface_format_.format;
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, nullptr),
+              "vkGetPhysicalDeviceSurfacePresentModesKHR");
+        std::vector<VkPresentModeKHR> modes(count);
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, modes.data()),
+              "vkGetPhysicalDeviceSurfacePresentModesKHR");
+        present_mode_ = choose_present_mode(modes);
+        while (!build_swapchain()) wait_window_events();
+    }
+
+    // A swapchain for the surface's current extent, retiring the previous
+    // one (the device is idle); false while the surface has no area.
+    bool build_swapchain() {
+        VkSurfaceCapabilitiesKHR caps;
+        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, surface_, &caps),
+              "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+        const VkExtent2D extent = swapchain_extent(config_, caps);
+        if (extent.width == 0 || extent.height == 0) return false;
+        VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+        info.surface = surface_;
+        info.minImageCount = swapchain_image_request(config_, caps);
+        info.imageFormat = surface_format_.format;
+        info.imageColorSpace = surface_format_.colorSpace;
+        info.imageExtent = extent;
+        info.imageArrayLayers = 1;
+        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+        info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+        info.preTransform = caps.currentTransform;
+        info.compositeAlpha = composite_alpha(caps);
+        info.presentMode = present_mode_;
+        info.clipped = VK_TRUE;
+        info.oldSwapchain = swapchain_;
+        VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+        const VkResult result = fn_.vkCreateSwapchainKHR(device_, &info, nullptr, &swapchain);
+        destroy_swapchain();  // retired even if the creation failed
+        check(result, "vkCreateSwapchainKHR");
+        swapchain_ = swapchain;
+        std::uint32_t count = 0;
+        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, nullptr), "vkGetSwapchainImagesKHR");
+        swapchain_images_.resize(count);
+        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, swapchain_images_.data()),
+              "vkGetSwapchainImagesKHR");
+        VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+        for (VkImage image : swapchain_images_) {
+            swapchain_views_.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
+            render_done_.push_back(VK_NULL_HANDLE);
+            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &render_done_.back()), "vkCreateSemaphore");
+        }
+        swapchain_extent_ = extent;
+        return true;
+    }
+
+    void recreate_swapchain() {
+        check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle");
+        while (!build_swapchain()) wait_window_events();
+        if (swapchain_extent_.width > depth_extent_.width || swapchain_extent_.height > depth_extent_.height) {
+            destroy_image(depth_);
+            create_depth();
+        }
+        swapchain_stale_ = false;
+    }
+
+    void destroy_swapchain() {
+        for (VkImageView view : swapchain_views_) fn_.vkDestroyImageView(device_, view, nullptr);
+        for (VkSemaphore semaphore : render_done_) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
+        swapchain_views_.clear();
+        render_done_.clear();
+        swapchain_images_.clear();
+        if (swapchain_) fn_.vkDestroySwapchainKHR(device_, swapchain_, nullptr);
+        swapchain_ = VK_NULL_HANDLE;
     }
 
     VkShaderModule create_shader(std::span<const std::uint32_t> code) {
@@ -516,7 +720,7 @@ private:
         dynamic.pDynamicStates = dynamic_states;
         VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
         rendering.colorAttachmentCount = 1;
-        rendering.pColorAttachmentFormats = &colour_format;
+        rendering.pColorAttachmentFormats = &colour_format_;
         rendering.depthAttachmentFormat = depth_format;
         VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
         info.pNext = &rendering;
@@ -559,6 +763,10 @@ private:
             check(fn_.vkAllocateCommandBuffers(device_, &allocate, &f.cmd), "vkAllocateCommandBuffers");
             VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
             check(fn_.vkCreateFence(device_, &fence, nullptr, &f.fence), "vkCreateFence");
+            if (config_.window) {
+                VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+                check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &f.acquire_semaphore), "vkCreateSemaphore");
+            }
             VkDescriptorSetAllocateInfo set{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
             set.descriptorPool = descriptor_pool_;
             set.descriptorSetCount = 1;
@@ -577,7 +785,9 @@ private:
     void destroy() {
         if (device_) {
             fn_.vkDeviceWaitIdle(device_);
+            destroy_swapchain();
             for (Frame& f : frames_) {
+                fn_.vkDestroySemaphore(device_, f.acquire_semaphore, nullptr);
                 fn_.vkDestroyFence(device_, f.fence, nullptr);
                 fn_.vkDestroyCommandPool(device_, f.pool, nullptr);
             }
@@ -585,11 +795,6 @@ private:
             fn_.vkDestroyPipeline(device_, pipeline_, nullptr);
             fn_.vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
             fn_.vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
-            auto destroy_image = [&](Image& image) {
-                fn_.vkDestroyImageView(device_, image.view, nullptr);
-                fn_.vkDestroyImage(device_, image.image, nullptr);
-                fn_.vkFreeMemory(device_, image.memory, nullptr);
-            };
             for (Image& image : ring_) destroy_image(image);
             destroy_image(depth_);
             auto destroy_buffer = [&](VkBuffer buffer, Allocation& allocation) {
@@ -603,6 +808,7 @@ private:
             destroy_buffer(readback_buffer_, readback_);
             fn_.vkDestroyDevice(device_, nullptr);
         }
+        if (surface_) vkDestroySurfaceKHR(instance_, surface_, nullptr);  // before the window (a member) goes
         if (messenger_) {
             auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -616,6 +822,7 @@ private:
     std::vector<PushConstants> draws_;
     std::uint32_t index_count_ = 0;
 
+    BenchWindow window_;  // windowed only; outlives the surface (destroy() runs first)
     VkInstance instance_ = VK_NULL_HANDLE;
     VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
     VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
@@ -636,6 +843,19 @@ private:
     Allocation readback_;
     std::vector<Image> ring_;
     Image depth_;
+    VkExtent2D depth_extent_{};
+    VkFormat colour_format_ = colour_format;  // windowed: the swapchain's
+
+    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
+    VkSurfaceFormatKHR surface_format_{};
+    VkPresentModeKHR present_mode_ = VK_PRESENT_MODE_FIFO_KHR;
+    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
+    VkExtent2D swapchain_extent_{};
+    std::vector<VkImage> swapchain_images_;
+    std::vector<VkImageView> swapchain_views_;
+    std::vector<VkSemaphore> render_done_;  // one per swapchain image
+    bool swapchain_stale_ = false;          // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
+    bool present_to_window_ = false;        // windowed, except for the reference frame
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;
@@ -646,6 +866,7 @@ private:
     std::uint32_t slot_ = 0;
     std::uint32_t image_ = 0;
     std::uint32_t presented_image_ = 0;
+    Target target_;
 };
 
 }  // namespace

@@ -1,11 +1,16 @@
 // The Vulkan-Hpp variant: vk::raii from Debian's headers, written the way
 // its samples do (its own translation unit: the header compiles slowly).
+// Windowed (--window), it presents through vk::raii::SurfaceKHR/SwapchainKHR.
 #include "harness/variant.hpp"
+#include "harness/window.hpp"
 
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
 
 #include <vulkan/vulkan_raii.hpp>
+
+#define GLFW_INCLUDE_NONE  // Vulkan only, no OpenGL headers
+#include <GLFW/glfw3.h>
 
 #include <optional>
 #include <stdexcept>
@@ -24,8 +29,10 @@ public:
         camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        present_to_window_ = config.window;
         create_instance();
         create_device();
+        if (config.window) create_swapchain();
         create_geometry(*scene.mesh);
         create_images();
         create_pipeline();
@@ -34,7 +41,25 @@ public:
 
     void acquire() override {
         slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
-        image_ = static_cast<std::uint32_t>(frame_ % (config_.frames_in_flight + 1));
+        if (!present_to_window_) {
+            image_ = static_cast<std::uint32_t>(frame_ % ring_.size());
+            target_ = {*ring_[image_].image, *ring_[image_].view, vk::Extent2D(config_.width, config_.height),
+                       vk::ImageLayout::eTransferSrcOptimal};
+            return;
+        }
+        for (;;) {
+            if (swapchain_stale_) recreate_swapchain();
+            try {
+                auto [result, index] = swapchain_.acquireNextImage(UINT64_MAX, *frames_[slot_].acquire_semaphore);
+                if (result == vk::Result::eSuboptimalKHR) swapchain_stale_ = true;  // usable; re-created after its present
+                image_ = index;
+                break;
+            } catch (const vk::OutOfDateKHRError&) {
+                swapchain_stale_ = true;
+            }
+        }
+        target_ = {swapchain_images_[image_], *swapchain_views_[image_], swapchain_extent_,
+                   vk::ImageLayout::ePresentSrcKHR};
     }
 
     void uniform() override {
@@ -48,11 +73,11 @@ public:
         const vk::raii::CommandBuffer& cmd = f.cmd;
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
         std::array<vk::ImageMemoryBarrier2, 2> to_render{
-            vk::ImageMemoryBarrier2(vk::PipelineStageFlagBits2::eNone, {},
+            vk::ImageMemoryBarrier2(vk::PipelineStageFlagBits2::eColorAttachmentOutput, {},
                                     vk::PipelineStageFlagBits2::eColorAttachmentOutput,
                                     vk::AccessFlagBits2::eColorAttachmentWrite, vk::ImageLayout::eUndefined,
                                     vk::ImageLayout::eColorAttachmentOptimal, VK_QUEUE_FAMILY_IGNORED,
-                                    VK_QUEUE_FAMILY_IGNORED, *ring_[image_].image,
+                                    VK_QUEUE_FAMILY_IGNORED, target_.image,
                                     {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}),
             vk::ImageMemoryBarrier2(
                 vk::PipelineStageFlagBits2::eEarlyFragmentTests | vk::PipelineStageFlagBits2::eLateFragmentTests,
@@ -63,7 +88,7 @@ public:
                 VK_QUEUE_FAMILY_IGNORED, *depth_.image, {vk::ImageAspectFlagBits::eDepth, 0, 1, 0, 1})};
         cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_render));
 
-        vk::RenderingAttachmentInfo colour(*ring_[image_].view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
+        vk::RenderingAttachmentInfo colour(target_.view, vk::ImageLayout::eColorAttachmentOptimal, {}, {}, {},
                                            vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eStore,
                                            vk::ClearColorValue(std::array<float, 4>{clear_colour[0], clear_colour[1],
                                                                                     clear_colour[2], clear_colour[3]}));
@@ -71,10 +96,10 @@ public:
                                           vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
                                           vk::ClearDepthStencilValue(1.0f, 0));
         cmd.beginRendering(
-            vk::RenderingInfo({}, {{0, 0}, {config_.width, config_.height}}, 1, 0, colour, &depth));
+            vk::RenderingInfo({}, {{0, 0}, target_.extent}, 1, 0, colour, &depth));
         cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline_);
-        cmd.setViewport(0, vk::Viewport(0, 0, float(config_.width), float(config_.height), 0, 1));
-        cmd.setScissor(0, vk::Rect2D({0, 0}, {config_.width, config_.height}));
+        cmd.setViewport(0, vk::Viewport(0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1));
+        cmd.setScissor(0, vk::Rect2D({0, 0}, target_.extent));
         cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout_, 0, *f.descriptor_set, {});
         cmd.bindVertexBuffers(0, {*positions_.buffer, *normals_.buffer}, {0, 0});
         cmd.bindIndexBuffer(*indices_.buffer, 0, vk::IndexType::eUint16);
@@ -85,9 +110,9 @@ public:
         cmd.endRendering();
         vk::ImageMemoryBarrier2 to_present(
             vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
-            vk::PipelineStageFlagBits2::eNone, {}, vk::ImageLayout::eColorAttachmentOptimal,
-            vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
-            *ring_[image_].image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+            vk::PipelineStageFlagBits2::eNone, {}, vk::ImageLayout::eColorAttachmentOptimal, target_.present_layout,
+            VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, target_.image,
+            {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
         cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_present));
         cmd.end();
     }
@@ -95,11 +120,26 @@ public:
     void submit() override {
         Frame& f = frames_[slot_];
         vk::CommandBufferSubmitInfo cmd_info(*f.cmd);
-        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *f.fence);
+        if (present_to_window_) {
+            vk::SemaphoreSubmitInfo wait(*f.acquire_semaphore, 0, vk::PipelineStageFlagBits2::eColorAttachmentOutput);
+            vk::SemaphoreSubmitInfo signal(*render_done_[image_], 0, vk::PipelineStageFlagBits2::eAllCommands);
+            queue_->submit2(vk::SubmitInfo2({}, wait, cmd_info, signal), *f.fence);
+        } else {
+            queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *f.fence);
+        }
         f.submitted = true;
     }
 
     void present() override {
+        if (present_to_window_) {
+            try {
+                if (queue_->presentKHR(vk::PresentInfoKHR(*render_done_[image_], *swapchain_, image_)) ==
+                    vk::Result::eSuboptimalKHR)
+                    swapchain_stale_ = true;  // re-created at the next acquire
+            } catch (const vk::OutOfDateKHRError&) {
+                swapchain_stale_ = true;
+            }
+        }
         presented_image_ = image_;
         ++frame_;
     }
@@ -120,11 +160,14 @@ public:
     std::vector<std::uint8_t> render_reference_frame(double t) override {
         drain();
         update(t);
+        // Offscreen in both modes, through the headless path of the stages.
+        present_to_window_ = false;
         acquire();
         uniform();
         command();
         submit();
         present();
+        present_to_window_ = config_.window;
         drain();
         Frame& f = frames_[slot_];
         (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
@@ -154,10 +197,20 @@ public:
         (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
         device_->resetFences(*f.fence);
         const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        return {pixels, pixels + std::size_t(config_.width) * config_.height * 4};
+        std::vector<std::uint8_t> image(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
+        to_rgba(image, VkFormat(colour_format_));
+        return image;
     }
 
     std::string device_name() const override { return device_name_; }
+
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
+    std::string presentation() const override {
+        return config_.window ? swapchain_presentation(VkFormat(colour_format_), VkPresentModeKHR(present_mode_),
+                                                       swapchain_images_.size(), swapchain_extent_)
+                              : headless_presentation(ring_.size(), VkFormat(colour_format_), {config_.width, config_.height});
+    }
 
 private:
     struct Buffer {
@@ -175,7 +228,15 @@ private:
         vk::raii::CommandBuffer cmd = nullptr;
         vk::raii::Fence fence = nullptr;
         vk::raii::DescriptorSet descriptor_set = nullptr;
+        vk::raii::Semaphore acquire_semaphore = nullptr;  // windowed only
         bool submitted = false;
+    };
+    // What this frame renders into: a ring image or a swapchain image.
+    struct Target {
+        vk::Image image;
+        vk::ImageView view;
+        vk::Extent2D extent;
+        vk::ImageLayout present_layout = vk::ImageLayout::eUndefined;
     };
 
     void create_instance() {
@@ -185,6 +246,14 @@ private:
             vk::DebugUtilsMessageTypeFlagsEXT(validation_types),
             reinterpret_cast<PFN_vkDebugUtilsMessengerCallbackEXT>(&validation_callback));
         std::vector<const char*> layers, extensions;
+        if (config_.window) {
+            // The window's extensions (VK_KHR_surface and the platform's).
+            window_ = BenchWindow(config_);
+            std::uint32_t count = 0;
+            const char** names = glfwGetRequiredInstanceExtensions(&count);
+            if (!names) throw std::runtime_error("glfwGetRequiredInstanceExtensions failed");
+            extensions.assign(names, names + count);
+        }
         if (config_.validation) {
             layers.push_back(validation_layer);
             extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -193,6 +262,12 @@ private:
         if (config_.validation) info.pNext = &messenger;
         instance_.emplace(context_, info);
         if (config_.validation) messenger_.emplace(*instance_, messenger);
+        if (config_.window) {
+            VkSurfaceKHR surface = VK_NULL_HANDLE;
+            vk::resultCheck(vk::Result(glfwCreateWindowSurface(**instance_, window_.get(), nullptr, &surface)),
+                            "glfwCreateWindowSurface");
+            surface_.emplace(*instance_, surface);
+        }
     }
 
     void create_device() {
@@ -202,7 +277,8 @@ private:
             if (properties.apiVersion < VK_API_VERSION_1_3) continue;
             auto families = candidate.getQueueFamilyProperties();
             for (std::uint32_t i = 0; i < families.size(); ++i)
-                if (families[i].queueFlags & vk::QueueFlagBits::eGraphics) {
+                if ((families[i].queueFlags & vk::QueueFlagBits::eGraphics) &&
+                    (!config_.window || candidate.getSurfaceSupportKHR(i, **surface_))) {
                     physical_device_.emplace(std::move(candidate));
                     queue_family_ = i;
                     device_name_ = properties.deviceName.data();
@@ -211,12 +287,16 @@ private:
                 }
             if (physical_device_) break;
         }
-        if (!physical_device_) throw std::runtime_error("no Vulkan 1.3 device with a graphics queue");
+        if (!physical_device_)
+            throw std::runtime_error(config_.window ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
+                                                    : "no Vulkan 1.3 device with a graphics queue");
         memory_properties_ = physical_device_->getMemoryProperties();
         float priority = 1.0f;
         vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
+        std::vector<const char*> extensions;
+        if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
         vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> chain(
-            vk::DeviceCreateInfo({}, queue_info), vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
+            vk::DeviceCreateInfo({}, queue_info, {}, extensions), vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
         device_.emplace(*physical_device_, chain.get<vk::DeviceCreateInfo>());
         queue_.emplace(*device_, queue_family_, 0);
     }
@@ -262,10 +342,10 @@ private:
                                   vk::BufferUsageFlagBits::eTransferDst);
     }
 
-    Image create_image(vk::Format format, vk::ImageUsageFlags usage, vk::ImageAspectFlags aspect) {
+    Image create_image(vk::Format format, vk::ImageUsageFlags usage, vk::ImageAspectFlags aspect, vk::Extent2D extent) {
         Image image;
         image.image = vk::raii::Image(
-            *device_, vk::ImageCreateInfo({}, vk::ImageType::e2D, format, {config_.width, config_.height, 1}, 1, 1,
+            *device_, vk::ImageCreateInfo({}, vk::ImageType::e2D, format, {extent.width, extent.height, 1}, 1, 1,
                                           vk::SampleCountFlagBits::e1, vk::ImageTiling::eOptimal, usage));
         vk::MemoryRequirements requirements = image.image.getMemoryRequirements();
         std::uint32_t type = memory_type(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal);
@@ -277,13 +357,70 @@ private:
         return image;
     }
 
+    // The ring (windowed: the one offscreen image of the reference frame)
+    // and a depth image covering every target.
     void create_images() {
-        for (int i = 0; i < config_.frames_in_flight + 1; ++i)
-            ring_.push_back(create_image(vk::Format(colour_format),
+        const int ring_size = config_.window ? 1 : config_.frames_in_flight + 1;
+        for (int i = 0; i < ring_size; ++i)
+            ring_.push_back(create_image(colour_format_,
                                          vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
-                                         vk::ImageAspectFlagBits::eColor));
+                                         vk::ImageAspectFlagBits::eColor, {config_.width, config_.height}));
+        create_depth();
+    }
+
+    void create_depth() {
+        depth_extent_ = vk::Extent2D(std::max(config_.width, swapchain_extent_.width),
+                                     std::max(config_.height, swapchain_extent_.height));
         depth_ = create_image(vk::Format(depth_format), vk::ImageUsageFlagBits::eDepthStencilAttachment,
-                              vk::ImageAspectFlagBits::eDepth);
+                              vk::ImageAspectFlagBits::eDepth, depth_extent_);
+    }
+
+    // The window's swapchain by the convention's rule. Format and present
+    // mode are chosen once: the pipeline is made for the format.
+    void create_swapchain() {
+        std::vector<VkSurfaceFormatKHR> formats;
+        for (const vk::SurfaceFormatKHR& f : physical_device_->getSurfaceFormatsKHR(**surface_)) formats.push_back(f);
+        surface_format_ = vk::SurfaceFormatKHR(choose_window_format(formats));
+        colour_format_ = surface_format_.format;
+        std::vector<VkPresentModeKHR> modes;
+        for (vk::PresentModeKHR m : physical_device_->getSurfacePresentModesKHR(**surface_))
+            modes.push_back(VkPresentModeKHR(m));
+        present_mode_ = vk::PresentModeKHR(choose_present_mode(modes));
+        while (!build_swapchain()) wait_window_events();
+    }
+
+    // A swapchain for the surface's current extent, retiring the previous
+    // one (the device is idle); false while the surface has no area.
+    bool build_swapchain() {
+        const VkSurfaceCapabilitiesKHR caps = physical_device_->getSurfaceCapabilitiesKHR(**surface_);
+        const VkExtent2D extent = swapchain_extent(config_, caps);
+        if (extent.width == 0 || extent.height == 0) return false;
+        vk::SwapchainCreateInfoKHR info({}, **surface_, swapchain_image_request(config_, caps), surface_format_.format,
+                                        surface_format_.colorSpace, vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment,
+                                        vk::SharingMode::eExclusive, {},
+                                        vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
+                                        vk::CompositeAlphaFlagBitsKHR(composite_alpha(caps)), present_mode_, true,
+                                        *swapchain_);
+        swapchain_views_.clear();
+        render_done_.clear();
+        swapchain_ = vk::raii::SwapchainKHR(*device_, info);  // destroys the retired one
+        swapchain_images_ = swapchain_.getImages();
+        for (vk::Image image : swapchain_images_) {
+            swapchain_views_.emplace_back(*device_, vk::ImageViewCreateInfo({}, image, vk::ImageViewType::e2D,
+                                                                            colour_format_, {},
+                                                                            {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}));
+            render_done_.emplace_back(*device_, vk::SemaphoreCreateInfo());
+        }
+        swapchain_extent_ = extent;
+        return true;
+    }
+
+    void recreate_swapchain() {
+        device_->waitIdle();
+        while (!build_swapchain()) wait_window_events();
+        if (swapchain_extent_.width > depth_extent_.width || swapchain_extent_.height > depth_extent_.height)
+            create_depth();
+        swapchain_stale_ = false;
     }
 
     void create_pipeline() {
@@ -319,11 +456,10 @@ private:
         vk::PipelineColorBlendStateCreateInfo blend({}, false, vk::LogicOp::eClear, blend_attachment);
         std::array<vk::DynamicState, 2> dynamic_states{vk::DynamicState::eViewport, vk::DynamicState::eScissor};
         vk::PipelineDynamicStateCreateInfo dynamic({}, dynamic_states);
-        vk::Format colour = vk::Format(colour_format);
         vk::StructureChain<vk::GraphicsPipelineCreateInfo, vk::PipelineRenderingCreateInfo> chain(
             vk::GraphicsPipelineCreateInfo({}, stages, &vertex_input, &assembly, nullptr, &viewport, &raster,
                                            &multisample, &depth, &blend, &dynamic, *pipeline_layout_),
-            vk::PipelineRenderingCreateInfo(0, colour, vk::Format(depth_format)));
+            vk::PipelineRenderingCreateInfo(0, colour_format_, vk::Format(depth_format)));
         pipeline_ = vk::raii::Pipeline(*device_, nullptr, chain.get<vk::GraphicsPipelineCreateInfo>());
     }
 
@@ -341,6 +477,7 @@ private:
             f.cmd = std::move(vk::raii::CommandBuffers(
                 *device_, vk::CommandBufferAllocateInfo(*f.pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
             f.fence = vk::raii::Fence(*device_, vk::FenceCreateInfo());
+            if (config_.window) f.acquire_semaphore = vk::raii::Semaphore(*device_, vk::SemaphoreCreateInfo());
             f.descriptor_set = std::move(
                 vk::raii::DescriptorSets(*device_, vk::DescriptorSetAllocateInfo(*descriptor_pool_, *set_layout_))[0]);
             vk::DescriptorBufferInfo buffer(*uniform_.buffer, i * uniform_stride_, sizeof(CameraUniforms));
@@ -360,9 +497,11 @@ private:
     vk::PhysicalDeviceMemoryProperties memory_properties_;
 
     // Declaration order is destruction order reversed: parents first.
+    BenchWindow window_;  // windowed only; outlives the surface
     vk::raii::Context context_;
     std::optional<vk::raii::Instance> instance_;
     std::optional<vk::raii::DebugUtilsMessengerEXT> messenger_;
+    std::optional<vk::raii::SurfaceKHR> surface_;
     std::optional<vk::raii::PhysicalDevice> physical_device_;
     std::optional<vk::raii::Device> device_;
     std::optional<vk::raii::Queue> queue_;
@@ -371,6 +510,17 @@ private:
     vk::DeviceSize uniform_stride_ = 0;
     std::vector<Image> ring_;
     Image depth_;
+    vk::Extent2D depth_extent_;
+    vk::Format colour_format_ = vk::Format(colour_format);  // windowed: the swapchain's
+    vk::SurfaceFormatKHR surface_format_;
+    vk::PresentModeKHR present_mode_ = vk::PresentModeKHR::eFifo;
+    vk::raii::SwapchainKHR swapchain_ = nullptr;
+    VkExtent2D swapchain_extent_{};
+    std::vector<vk::Image> swapchain_images_;
+    std::vector<vk::raii::ImageView> swapchain_views_;
+    std::vector<vk::raii::Semaphore> render_done_;  // one per swapchain image
+    bool swapchain_stale_ = false;                  // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
+    bool present_to_window_ = false;                // windowed, except for the reference frame
     vk::raii::DescriptorSetLayout set_layout_ = nullptr;
     vk::raii::PipelineLayout pipeline_layout_ = nullptr;
     vk::raii::Pipeline pipeline_ = nullptr;
@@ -381,6 +531,7 @@ private:
     std::uint32_t slot_ = 0;
     std::uint32_t image_ = 0;
     std::uint32_t presented_image_ = 0;
+    Target target_;
 };
 
 }  // namespace

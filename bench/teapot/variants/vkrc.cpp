@@ -4,11 +4,30 @@
 // (bench/teapot/CMakeLists.txt); TEAPOT_VKRC_FACTORY names each copy's
 // factory, and vkrc's inline namespaces keep the two copies' vkrc symbols
 // apart.
+//
+// Presentation goes through vkrc's Presenter interface in both modes, so
+// headless and windowed share one code path: a HeadlessPresenter (headless)
+// or a Swapchain on a vkrc::glfw surface (--window). Per frame they do
+// somewhat more than the convention of harness/variant.hpp, being general
+// (include/vkrc/swapchain.hpp, src/swapchain.cpp):
+//   * both: acquire returns a Frame holding the image and its view as
+//     handles (two reference-count increments, and two decrements when the
+//     previous frame is replaced; atomic under vkrc-mt), and acquire and
+//     present take the presenter's mutex (a no-op under vkrc-st). The
+//     headless presenter makes no Vulkan call and uses no semaphore.
+//   * Swapchain: its acquire semaphores are a ring of image count + 1 rather
+//     than one per frame slot, since the presenter does not see the
+//     application's fences; before reusing one, acquire waits on the queue's
+//     timeline for the frame that last used it (a vkWaitSemaphores that has
+//     normally already been reached). present also takes the queue's mutex
+//     (no-op under vkrc-st) and records the queue's last submitted value.
 #include "harness/variant.hpp"
+#include "harness/window.hpp"
 
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
 
+#include <vkrc/glfw.hpp>
 #include <vkrc/vkrc.hpp>
 
 #include <array>
@@ -25,7 +44,8 @@ class VkrcVariant final : public Variant {
 public:
     ~VkrcVariant() override {
         // The members release themselves; with the device idle first, each
-        // Vulkan object is destroyed as its handle goes (nothing deferred).
+        // Vulkan object is destroyed as its handle goes (a presented
+        // swapchain waits for one empty submission after its last present).
         if (device_) device_.wait_idle();
     }
 
@@ -35,15 +55,22 @@ public:
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         create_device();
+        create_presenters();
         create_geometry(*scene.mesh);
-        create_images();
+        create_depth(presenter_->extent());
         create_pipeline();
         create_frames();
     }
 
     void acquire() override {
-        slot_ = static_cast<std::uint32_t>(frame_ % frames_.size());
-        image_ = acquire_image();
+        slot_ = static_cast<std::uint32_t>(frame_count_ % frames_.size());
+        frame_ = presenter_->acquire();
+        while (!frame_) {  // out of date: re-created by the next acquire; zero extent: a minimised window
+            if (frame_.status == vkrc::PresentStatus::zero_extent) wait_window_events();
+            frame_ = presenter_->acquire();
+        }
+        if (frame_.extent.width > depth_extent_.width || frame_.extent.height > depth_extent_.height)
+            create_depth(frame_.extent);  // a re-created swapchain outgrew it; the old one goes after the GPU
     }
 
     void uniform() override {
@@ -56,7 +83,6 @@ public:
 
     void command() override {
         Frame& f = frames_[slot_];
-        const TargetImage& target = targets_[image_];
         f.pool.reset_commands();
         const vkrc::CommandBuffer& cmd = f.cmd;
         cmd.begin();
@@ -64,8 +90,8 @@ public:
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_render[2] = {
-            vkrc::image_barrier(target.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+            vkrc::image_barrier(frame_.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
             vkrc::image_barrier(depth_.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                                 depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depth_stages,
@@ -74,18 +100,18 @@ public:
                                 VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, to_render);
 
-        vkrc::RenderingAttachment colour{target.view.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        vkrc::RenderingAttachment colour{frame_.view.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                          VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE};
         std::memcpy(colour.clear_value.color.float32, clear_colour, sizeof clear_colour);
         vkrc::RenderingAttachment depth{depth_view_.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                                         VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
         depth.clear_value.depthStencil = {1.0f, 0};
-        cmd.begin_rendering({.render_area = {{0, 0}, extent_},
+        cmd.begin_rendering({.render_area = {{0, 0}, frame_.extent},
                              .color_attachments = {&colour, 1},
                              .depth_attachment = &depth});
 
         cmd.bind_pipeline(pipeline_);
-        cmd.set_viewport_and_scissor(extent_);
+        cmd.set_viewport_and_scissor(frame_.extent);
         cmd.bind_descriptor_set(pipeline_, 0, f.set);
         const VkBuffer vertex_buffers[2] = {positions_.vk(), normals_.vk()};
         const VkDeviceSize offsets[2] = {0, 0};
@@ -98,9 +124,9 @@ public:
         }
         cmd.end_rendering();
 
-        // Where a swapchain's image would go to PRESENT_SRC_KHR.
+        // PRESENT_SRC_KHR for a swapchain, TRANSFER_SRC_OPTIMAL headless.
         const VkImageMemoryBarrier2 to_present = vkrc::image_barrier(
-            target.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            frame_.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
             VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, {&to_present, 1});
@@ -109,17 +135,19 @@ public:
 
     void submit() override {
         Frame& f = frames_[slot_];
-        vkrc::submit(queue_, {.command_buffers = {&f.cmd, 1}}, f.fence);
+        vkrc::submit(queue_, {.waits = frame_.waits(), .command_buffers = {&f.cmd, 1}, .signals = frame_.signals()},
+                     f.fence);
         f.submitted = true;
     }
 
     void present() override {
-        present_image(image_);
-        ++frame_;
+        // Out of date or suboptimal: the next acquire re-creates the swapchain.
+        presenter_->present(frame_);
+        ++frame_count_;
     }
 
     void wait() override {
-        Frame& next = frames_[frame_ % frames_.size()];
+        Frame& next = frames_[frame_count_ % frames_.size()];
         if (!next.submitted) return;
         next.fence.wait();
         next.fence.unsignal();
@@ -133,30 +161,39 @@ public:
     std::vector<std::uint8_t> render_reference_frame(double t) override {
         drain();
         update(t);
+        // Offscreen in both modes: the same stages with the headless presenter.
+        vkrc::Presenter* const timed = presenter_;
+        presenter_ = &offscreen_;
         acquire();
         uniform();
         command();
         submit();
         present();
+        presenter_ = timed;
         drain();
         Frame& f = frames_[slot_];
         f.fence.wait();
         f.fence.unsignal();
         f.submitted = false;
-        const std::vector<std::byte> pixels =
-            vkrc::download_image(queue_, targets_[presented_image_].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+        const std::vector<std::byte> pixels = offscreen_.read_back(offscreen_.last_presented());
         const auto* bytes = reinterpret_cast<const std::uint8_t*>(pixels.data());
-        return {bytes, bytes + pixels.size()};
+        std::vector<std::uint8_t> image(bytes, bytes + pixels.size());
+        to_rgba(image, offscreen_.format());
+        return image;
     }
 
     std::string device_name() const override { return device_.physical_device().name(); }
 
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
+    std::string presentation() const override {
+        if (config_.window)
+            return swapchain_presentation(swapchain_.format(), swapchain_.present_mode(), swapchain_.image_count(),
+                                          swapchain_.extent());
+        return headless_presentation(offscreen_.image_count(), offscreen_.format(), offscreen_.extent());
+    }
+
 private:
-    // A stand-in for a swapchain image: the image and its attachment view.
-    struct TargetImage {
-        vkrc::Image image;
-        vkrc::ImageView view;
-    };
     struct Frame {
         vkrc::CommandPool pool;
         vkrc::CommandBuffer cmd;
@@ -164,12 +201,6 @@ private:
         vkrc::DescriptorSet set;
         bool submitted = false;
     };
-
-    // The headless presenter (harness/variant.hpp): the ring image of this
-    // frame, and handing it over. Bookkeeping only; a swapchain presenter
-    // replaces these two.
-    std::uint32_t acquire_image() const { return static_cast<std::uint32_t>(frame_ % targets_.size()); }
-    void present_image(std::uint32_t image) { presented_image_ = image; }
 
     void create_device() {
         vkrc::InstanceCreateInfo instance_info;
@@ -185,11 +216,49 @@ private:
             };
             instance_info.debug_severities = validation_severities;
         }
+        vkrc::DeviceRequirements requirements;
+        if (config_.window) {
+            window_ = BenchWindow(config_);
+            for (const char* name : vkrc::glfw::required_instance_extensions())
+                instance_info.enabled_extension_names.push_back(name);
+        }
         vkrc::Instance instance = vkrc::Instance::create(instance_info);
+        if (config_.window) {
+            surface_ = vkrc::glfw::create_surface(instance, window_.get());
+            requirements.present_surface = surface_.vk();
+            requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+        }
         // A Vulkan 1.3 device with a graphics and compute queue; one queue.
-        device_ = vkrc::Device::create(vkrc::PhysicalDevice::select(instance));
+        device_ = vkrc::Device::create(vkrc::PhysicalDevice::select(instance, requirements),
+                                       {.enabled_extension_names = requirements.required_extensions});
         queue_ = device_.default_queue();
-        extent_ = {config_.width, config_.height};
+    }
+
+    // Windowed: the swapchain by the convention's rule, which is vkrc's own
+    // rule given these preferences (the requested IMMEDIATE falls back to
+    // MAILBOX, then FIFO, as window_present_modes). Both modes: the
+    // headless ring, which renders every frame headless and only the
+    // reference frame windowed (one image, in the swapchain's format).
+    void create_presenters() {
+        VkFormat format = colour_format;
+        if (config_.window) {
+            vkrc::SwapchainCreateInfo info;
+            info.preferred_formats.assign(std::begin(window_formats), std::end(window_formats));
+            info.present_mode = VK_PRESENT_MODE_IMMEDIATE_KHR;
+            info.min_image_count = static_cast<std::uint32_t>(config_.frames_in_flight + 1);
+            info.extent = {config_.width, config_.height};  // where the surface leaves it to the swapchain
+            swapchain_ = vkrc::Swapchain::create(queue_, surface_, info);
+            // vkrc falls back to the surface's first format; the convention has no fallback.
+            if (!is_window_format({swapchain_.format(), swapchain_.color_space()}))
+                throw_no_window_format();
+            format = swapchain_.format();
+        }
+        offscreen_ = vkrc::HeadlessPresenter::create(
+            queue_, {.extent = {config_.width, config_.height},
+                     .format = format,
+                     .image_count = static_cast<std::uint32_t>(config_.window ? 1 : config_.frames_in_flight + 1)});
+        presenter_ = config_.window ? static_cast<vkrc::Presenter*>(&swapchain_) : &offscreen_;
+        colour_format_ = format;
     }
 
     template <typename T>
@@ -218,20 +287,12 @@ private:
         uniform_writer_ = uniforms_.allocation().write_only();
     }
 
-    vkrc::Image create_image(VkFormat format, VkImageUsageFlags usage) {
-        return vkrc::Image::create(device_, {.format = format,
-                                             .extent = {config_.width, config_.height, 1},
-                                             .usage = usage});
-    }
-
-    void create_images() {
-        targets_.resize(config_.frames_in_flight + 1);
-        for (TargetImage& target : targets_) {
-            target.image = create_image(colour_format,
-                                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-            target.view = vkrc::ImageView::create(target.image);
-        }
-        depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+    // A depth image covering the reference frame and the presenter's images.
+    void create_depth(VkExtent2D extent) {
+        depth_extent_ = {std::max(config_.width, extent.width), std::max(config_.height, extent.height)};
+        depth_ = vkrc::Image::create(device_, {.format = depth_format,
+                                               .extent = {depth_extent_.width, depth_extent_.height, 1},
+                                               .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT});
         depth_view_ = vkrc::ImageView::create(depth_);
     }
 
@@ -251,7 +312,7 @@ private:
                         .vertex_attribute(1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0)
                         .cull_mode(VK_CULL_MODE_NONE)  // the spout and lid openings show inner faces
                         .depth_test(true, true, VK_COMPARE_OP_LESS)
-                        .rendering({&colour_format, 1}, depth_format)
+                        .rendering({&colour_format_, 1}, depth_format)
                         .build();
     }
 
@@ -276,26 +337,30 @@ private:
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
     std::uint32_t index_count_ = 0;
-    VkExtent2D extent_{};
+    VkFormat colour_format_ = colour_format;  // the presenter's
 
+    BenchWindow window_;  // windowed only; destroyed last, after the surface
+    vkrc::Surface surface_;
     vkrc::Device device_;
     vkrc::Queue queue_;
     vkrc::Buffer positions_, normals_, indices_;
     vkrc::Buffer uniforms_;
     vkrc::WriteOnlyView uniform_writer_;
     VkDeviceSize uniform_stride_ = 0;
-    std::vector<TargetImage> targets_;
+    vkrc::Swapchain swapchain_;           // windowed
+    vkrc::HeadlessPresenter offscreen_;   // headless: every frame; windowed: the reference frame
+    vkrc::Presenter* presenter_ = nullptr;
+    vkrc::Frame frame_;                   // the frame between acquire and the next acquire
     vkrc::Image depth_;
     vkrc::ImageView depth_view_;
+    VkExtent2D depth_extent_{};
     vkrc::DescriptorSetLayout set_layout_;
     vkrc::GraphicsPipeline pipeline_;
     vkrc::DescriptorPool descriptor_pool_;
     std::vector<Frame> frames_;
 
-    std::uint64_t frame_ = 0;
+    std::uint64_t frame_count_ = 0;
     std::uint32_t slot_ = 0;
-    std::uint32_t image_ = 0;
-    std::uint32_t presented_image_ = 0;
 };
 
 }  // namespace
