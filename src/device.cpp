@@ -1,7 +1,10 @@
 #include "vkrc/device.hpp"
+#include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
 
 #include <algorithm>
+#include <atomic>  // std::memory_order for detail::Atomic
 #include <cstring>
+#include <string>
 
 VKRC_BEGIN_NAMESPACE
 

@@ -153,7 +153,7 @@ const char* cache_data_problem(const PhysicalDevice& physical, const std::vector
 }
 }  // namespace
 
-PipelineCache PipelineCache::load(const Device& device, const std::string& file) {
+PipelineCache PipelineCache::load(const Device& device, const char* file) {
     require(static_cast<bool>(device), "vkrc::PipelineCache::load", "the Device handle is empty");
     std::vector<std::byte> data;
     const char* problem = nullptr;
@@ -168,7 +168,7 @@ PipelineCache PipelineCache::load(const Device& device, const std::string& file)
     }
     if (problem) {
         std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n",
-                     file.c_str(), problem);
+                     file, problem);
         return create(device);
     }
     return create(device, data);
@@ -185,10 +185,10 @@ std::vector<std::byte> PipelineCache::data() const {
     return out;
 }
 
-void PipelineCache::save(const std::string& file) const {
+void PipelineCache::save(const char* file) const {
     auto bytes = data();
     // Write beside the target and rename, so a crash never leaves a torn cache.
-    auto tmp = file;
+    std::string tmp = file;
     tmp += ".tmp";
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);

@@ -86,7 +86,7 @@ const char* present_mode_name(VkPresentModeKHR mode) {
 }
 
 void log(const detail::SwapchainState& s, const std::string& message) {
-    if (s.info.log) s.info.log("vkrc::Swapchain: " + message);
+    if (s.info.log) s.info.log(("vkrc::Swapchain: " + message).c_str());
 }
 
 // Format, colour space and present mode: fixed for the swapchain's life,

@@ -6,7 +6,6 @@
 
 #include <optional>
 #include <span>
-#include <string>
 #include <vector>
 
 VKRC_BEGIN_NAMESPACE
@@ -95,14 +94,14 @@ public:
     // Primes the cache from a file written by save(). A missing, truncated,
     // corrupt or foreign (other driver/device) file is ignored with a warning
     // on stderr: the cache starts empty and loaded_from_file() is false.
-    static PipelineCache load(const Device& device, const std::string& file);
+    static PipelineCache load(const Device& device, const char* file);
 
     VkPipelineCache vk() const noexcept;
     bool loaded_from_file() const noexcept;
     // vkGetPipelineCacheData.
     std::vector<std::byte> data() const;
     // Writes data() to file (replacing it); throws std::system_error on I/O failure.
-    void save(const std::string& file) const;
+    void save(const char* file) const;
 
 private:
     using Handle::Handle;

@@ -19,7 +19,6 @@
 #include "vkrc/surface.hpp"
 #include "vkrc/sync.hpp"
 
-#include <string>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -117,7 +116,7 @@ struct SwapchainCreateInfo {
     // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
     VkExtent2D extent{};
     // Receives the choices made and why, at creation and every re-creation.
-    std::function<void(const std::string&)> log;
+    std::function<void(const char*)> log;
 };
 
 // A swapchain for one Surface, re-created in place. Keeps its Surface,

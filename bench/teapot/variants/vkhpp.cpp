@@ -7,8 +7,10 @@
 
 #include <vulkan/vulkan_raii.hpp>
 
+#include <memory>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace teapot {
 namespace {

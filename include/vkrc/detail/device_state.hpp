@@ -5,7 +5,6 @@
 #include "vkrc/device.hpp"
 
 #include <deque>
-#include <memory>  // shared_ptr of user allocators
 
 VKRC_BEGIN_NAMESPACE
 class DeviceAllocator;
@@ -18,8 +17,8 @@ struct QueueState {
     // Signalled by every vkrc submit with the next value: the only GPU-side
     // tracking vkrc does.
     VkSemaphore timeline = VK_NULL_HANDLE;
-    std::atomic<std::uint64_t> submitted{0};  // written under mutex, read by retirements
-    std::atomic<std::uint64_t> completed{0};  // last value seen reached (a cache)
+    detail::Atomic<std::uint64_t> submitted{0};  // written under mutex, read by retirements
+    detail::Atomic<std::uint64_t> completed{0};  // last value seen reached (a cache)
     mutable Mutex mutex;
 };
 
@@ -46,7 +45,7 @@ public:
     void collect() noexcept;
     // Marks the device lost: the GPU will touch nothing any more, so every
     // queued action may run.
-    void mark_lost() noexcept { lost.store(true, std::memory_order_relaxed); }
+    void mark_lost() noexcept { lost.store(true, __ATOMIC_RELAXED); }
     std::size_t deferred_count() const noexcept;
 
     // For objects a pool owns (command buffers, descriptor sets), which must
@@ -60,15 +59,15 @@ public:
     DeviceFunctions fn;
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
-    std::vector<std::string> enabled_extensions;
+    std::vector<Text> enabled_extensions;
     std::deque<QueueState> queues;  // a deque: Queue handles point into it
-    std::atomic<bool> lost{false};
+    detail::Atomic<bool> lost{false};
 
     // Memory (memory.cpp). Every allocator used with the device is kept until
     // teardown, so that deferred frees can still reach it; teardown runs them
     // all, then calls each allocator's release() before destroying the device.
     DeviceAllocator& default_allocator();  // a PoolAllocator, made on first use
-    void keep_allocator(const std::shared_ptr<DeviceAllocator>& allocator);
+    void keep_allocator(const Ref<DeviceAllocator>& allocator);
     void release_allocators() noexcept;
 
 private:
@@ -86,7 +85,7 @@ private:
     std::deque<Batch> deferred_;
     std::size_t deferred_actions_ = 0;
     Mutex allocators_mutex_;
-    std::vector<std::shared_ptr<DeviceAllocator>> allocators_;  // the default one first, once made
+    std::vector<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
     DeviceAllocator* default_allocator_ = nullptr;
 };
 
@@ -124,7 +123,7 @@ inline std::uint32_t Queue::index() const noexcept { return queue_->index; }
 inline VkSemaphore Queue::timeline_semaphore() const noexcept { return queue_->timeline; }
 inline Mutex& Queue::mutex() const noexcept { return queue_->mutex; }
 inline std::uint64_t Queue::last_submitted_value() const noexcept {
-    return queue_->submitted.load(std::memory_order_acquire);
+    return queue_->submitted.load(__ATOMIC_ACQUIRE);
 }
 
 VKRC_END_NAMESPACE
