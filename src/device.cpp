@@ -205,6 +205,8 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
 
 }  // namespace
 
+Device Device::create(const PhysicalDevice& physical) { return create(physical, DeviceCreateInfo{}); }
+
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");
     std::vector<QueueRequest> requests = info.queue_requests;

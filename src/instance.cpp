@@ -55,6 +55,8 @@ InstanceState::~InstanceState() {
 }
 }  // namespace detail
 
+Instance Instance::create() { return create(InstanceCreateInfo{}); }
+
 Instance Instance::create(const InstanceCreateInfo& info) {
     auto global = GlobalFunctions::load(info.get_instance_proc_addr);
 

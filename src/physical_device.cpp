@@ -74,6 +74,8 @@ std::vector<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& r
     return std::vector<Text>(reasons.begin(), reasons.end());
 }
 
+PhysicalDevice PhysicalDevice::select(const Instance& instance) { return select(instance, DeviceRequirements{}); }
+
 PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequirements& req) {
     auto devices = instance.physical_devices();
     std::vector<std::string> rejections;

@@ -34,6 +34,8 @@ void require(bool ok, const char* who, const char* problem) {
 }
 }  // namespace
 
+PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
+
 PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
     require(static_cast<bool>(device), "vkrc::PipelineLayout::create", "the Device handle is empty");
     std::vector<VkDescriptorSetLayout> sets;
@@ -69,7 +71,8 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
         d.colorAttachmentCount = static_cast<std::uint32_t>(sp.color_attachments.size());
         d.pColorAttachments = sp.color_attachments.data();
         d.pResolveAttachments = sp.resolve_attachments.empty() ? nullptr : sp.resolve_attachments.data();
-        d.pDepthStencilAttachment = sp.depth_stencil_attachment ? &*sp.depth_stencil_attachment : nullptr;
+        d.pDepthStencilAttachment =
+            sp.depth_stencil_attachment.attachment != VK_ATTACHMENT_UNUSED ? &sp.depth_stencil_attachment : nullptr;
         d.preserveAttachmentCount = static_cast<std::uint32_t>(sp.preserve_attachments.size());
         d.pPreserveAttachments = sp.preserve_attachments.data();
         subpasses.push_back(d);

@@ -53,7 +53,10 @@ struct InstanceCreateInfo {
 class Instance : public Handle<detail::InstanceState> {
 public:
     Instance() noexcept = default;
-    static Instance create(const InstanceCreateInfo& info = {});
+    static Instance create(const InstanceCreateInfo& info);
+    // The defaults: a separate overload so that a caller's translation unit
+    // does not build and destroy a default create-info (bench/header_cost).
+    static Instance create();
     // Wraps an instance made elsewhere. With Ownership::owned vkrc destroys it.
     static Instance adopt(VkInstance instance, Ownership ownership, std::uint32_t api_version,
                           PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
@@ -111,7 +114,10 @@ public:
     PhysicalDevice() noexcept = default;
     // Chooses the best device that meets the requirements, or throws
     // NoSuitableDeviceError naming each device and why it was rejected.
-    static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements = {});
+    static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements);
+    // The defaults: a separate overload so that a caller's translation unit
+    // does not build and destroy a default DeviceRequirements (bench/header_cost).
+    static PhysicalDevice select(const Instance& instance);
     // The reasons this device fails the requirements; empty when it meets them.
     std::vector<Text> unmet_requirements(const DeviceRequirements& requirements) const;
 

@@ -4,7 +4,6 @@
 #include "vkrc/descriptor.hpp"
 #include "vkrc/shader.hpp"
 
-#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,7 +26,8 @@ struct PipelineLayoutCreateInfo {
 class PipelineLayout : public Handle<detail::PipelineLayoutState> {
 public:
     PipelineLayout() noexcept = default;
-    static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info = {});
+    static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
+    static PipelineLayout create(const Device& device);  // no sets, no push constants
     VkPipelineLayout vk() const noexcept;
     const Device& device() const noexcept;
 
@@ -40,7 +40,8 @@ struct SubpassDescription {
     std::vector<VkAttachmentReference> input_attachments;
     std::vector<VkAttachmentReference> color_attachments;
     std::vector<VkAttachmentReference> resolve_attachments;  // empty or one per colour attachment
-    std::optional<VkAttachmentReference> depth_stencil_attachment;
+    // attachment VK_ATTACHMENT_UNUSED (the default): no depth/stencil attachment.
+    VkAttachmentReference depth_stencil_attachment{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
     std::vector<std::uint32_t> preserve_attachments;
 };
 
