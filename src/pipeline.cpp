@@ -223,7 +223,10 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Shad
     return ComputePipeline(std::move(s));
 }
 
-GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout) : layout_(std::move(layout)) {}
+// The default dynamic states are set here rather than by a default member
+// initialiser, which would build a vector in every includer (header cost).
+GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout)
+    : layout_(std::move(layout)), dynamic_states_{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR} {}
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                                          const char* entry_point) {

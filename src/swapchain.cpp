@@ -493,6 +493,9 @@ void HeadlessPresenter::resize(VkExtent2D extent) {
     s.needs_resize = true;
 }
 
+std::span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
+std::span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
+
 // ---------------------------------------------------------------- handle members
 // Out of line: the states are not in the public header.
 

@@ -199,7 +199,7 @@ private:
                                                VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                                    VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
     VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
-    std::vector<VkDynamicState> dynamic_states_{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    std::vector<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
     RenderPass render_pass_;
     std::uint32_t subpass_ = 0;
     std::vector<VkFormat> color_formats_;

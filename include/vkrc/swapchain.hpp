@@ -63,8 +63,10 @@ public:
     explicit operator bool() const noexcept { return static_cast<bool>(image); }
     // For the submission that renders the image: it waits until the image is
     // free and signals when rendering is done. Empty spans headless.
-    std::span<const SemaphoreSubmit> waits() const noexcept { return {&wait_, sync_count_}; }
-    std::span<const SemaphoreSubmit> signals() const noexcept { return {&signal_, sync_count_}; }
+    // Out of line: building a std::span in a header makes every includer
+    // check the span constructors' range concepts (bench/header_cost).
+    std::span<const SemaphoreSubmit> waits() const noexcept;
+    std::span<const SemaphoreSubmit> signals() const noexcept;
 
 private:
     friend class Swapchain;
