@@ -1,7 +1,10 @@
 #include "vkrc/device.hpp"
+#include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
 
 #include <algorithm>
+#include <atomic>  // std::memory_order for detail::Atomic
 #include <cstring>
+#include <string>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -104,7 +107,7 @@ void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
                     deferred_.push_back(Batch{std::move(values), {}});
                 }
                 deferred_.back().actions.push_back(action);
-                ++deferred_actions_;
+                deferred_actions_.fetch_add(1, std::memory_order_relaxed);
                 queued = true;
                 take_ready(ready);
             } catch (...) {
@@ -143,7 +146,7 @@ void DeviceState::take_ready(std::vector<DeferredAction>& out) {
     for (; batches > 0; --batches) {
         auto& batch = deferred_.front();
         out.insert(out.end(), batch.actions.begin(), batch.actions.end());
-        deferred_actions_ -= batch.actions.size();
+        deferred_actions_.fetch_sub(batch.actions.size(), std::memory_order_relaxed);
         deferred_.pop_front();
     }
 }
@@ -181,7 +184,7 @@ bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
 
 std::size_t DeviceState::deferred_count() const noexcept {
     LockGuard lock(deferred_mutex_);
-    return deferred_actions_;
+    return deferred_actions_.load(std::memory_order_relaxed);
 }
 
 }  // namespace detail
@@ -223,6 +226,8 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
 }
 
 }  // namespace
+
+Device Device::create(const PhysicalDevice& physical) { return create(physical, DeviceCreateInfo{}); }
 
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");

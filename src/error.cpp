@@ -1,5 +1,8 @@
 #include "vkrc/error.hpp"
 
+#include <cstdint>
+#include <cstring>
+#include <new>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -47,28 +50,45 @@ const char* to_string(VkResult result) noexcept {
     }
 }
 
-namespace {
-class VkResultCategory final : public std::error_category {
-public:
-    const char* name() const noexcept override { return "VkResult"; }
-    std::string message(int value) const override {
-        const char* name = vkrc::to_string(static_cast<VkResult>(value));
-        return name ? name : "VkResult(" + std::to_string(value) + ")";
-    }
+Error::Error(VkResult result, const char* call) : result_(result), call_(call) {
+    const char* name = vkrc::to_string(result);
+    std::string message = std::string(call) + " failed: " +
+                          (name ? std::string(name) : "VkResult(" + std::to_string(int(result)) + ")");
+    what_ = Text(message.data(), message.size());
+}
+
+// The characters follow the block; the count is atomic under both policies
+// because an exception may be copied on another thread (std::exception_ptr).
+struct Text::Block {
+    std::uint32_t refs;
+    std::size_t size;
+    char* chars() noexcept { return reinterpret_cast<char*>(this + 1); }
 };
-}  // namespace
 
-const std::error_category& vk_result_category() noexcept {
-    static const VkResultCategory category;
-    return category;
+Text::Text(const char* text) : Text(text, text ? std::strlen(text) : 0) {}
+
+Text::Text(const char* data, std::size_t size) {
+    void* memory = ::operator new(sizeof(Block) + size + 1);
+    block_ = new (memory) Block{1, size};
+    if (size) std::memcpy(block_->chars(), data, size);
+    block_->chars()[size] = '\0';
 }
 
-std::error_code make_error_code(VkResult result) noexcept {
-    return {static_cast<int>(result), vk_result_category()};
+Text::Text(const Text& other) noexcept : block_(other.block_) {
+    if (block_) __atomic_fetch_add(&block_->refs, 1, __ATOMIC_RELAXED);
 }
 
-Error::Error(VkResult result, const char* call)
-    : std::system_error(make_error_code(result), std::string(call) + " failed"), call_(call) {}
+Text::~Text() {
+    if (block_ && __atomic_fetch_sub(&block_->refs, 1, __ATOMIC_ACQ_REL) == 1) {
+        block_->~Block();
+        ::operator delete(block_);
+    }
+}
+
+const char* Text::c_str() const noexcept { return block_ ? block_->chars() : ""; }
+std::size_t Text::size() const noexcept { return block_ ? block_->size : 0; }
+bool Text::contains(const char* part) const noexcept { return std::strstr(c_str(), part) != nullptr; }
+bool operator==(const Text& a, const char* b) noexcept { return std::strcmp(a.c_str(), b ? b : "") == 0; }
 
 namespace detail {
 void throw_vk_error(VkResult result, const char* call) {

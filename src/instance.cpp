@@ -55,6 +55,8 @@ InstanceState::~InstanceState() {
 }
 }  // namespace detail
 
+Instance Instance::create() { return create(InstanceCreateInfo{}); }
+
 Instance Instance::create(const InstanceCreateInfo& info) {
     auto global = GlobalFunctions::load(info.get_instance_proc_addr);
 
@@ -135,24 +137,24 @@ bool Instance::extension_enabled(const char* name) const noexcept {
     return std::find(e.begin(), e.end(), name) != e.end();
 }
 
-std::vector<std::string> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = enumerate<VkLayerProperties>(
         [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
         "vkEnumerateInstanceLayerProperties");
-    std::vector<std::string> names;
+    std::vector<Text> names;
     for (const auto& p : props) names.emplace_back(p.layerName);
     return names;
 }
 
-std::vector<std::string> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = enumerate<VkExtensionProperties>(
         [&](std::uint32_t* n, VkExtensionProperties* p) {
             return global.vkEnumerateInstanceExtensionProperties(nullptr, n, p);
         },
         "vkEnumerateInstanceExtensionProperties");
-    std::vector<std::string> names;
+    std::vector<Text> names;
     for (const auto& p : props) names.emplace_back(p.extensionName);
     return names;
 }

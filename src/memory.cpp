@@ -238,7 +238,7 @@ void AllocationState::on_last_release() noexcept {
 // ---------------------------------------------------------------- Allocation
 
 Allocation Allocation::create(const Device& device, const AllocationRequest& request,
-                              const std::shared_ptr<DeviceAllocator>& allocator) {
+                              const SharedAllocator& allocator) {
     if (!device) throw UsageError("vkrc::Allocation::create: the Device handle is empty");
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
@@ -374,16 +374,17 @@ namespace detail {
 DeviceAllocator& DeviceState::default_allocator() {
     LockGuard lock(allocators_mutex_);
     if (!default_allocator_) {
-        auto pool = std::make_shared<PoolAllocator>();
+        auto pool = make_allocator<PoolAllocator>();
         allocators_.insert(allocators_.begin(), pool);
         default_allocator_ = pool.get();
     }
     return *default_allocator_;
 }
 
-void DeviceState::keep_allocator(const std::shared_ptr<DeviceAllocator>& allocator) {
+void DeviceState::keep_allocator(const Ref<DeviceAllocator>& allocator) {
     LockGuard lock(allocators_mutex_);
-    if (std::find(allocators_.begin(), allocators_.end(), allocator) == allocators_.end()) {
+    auto same = [&](const Ref<DeviceAllocator>& a) { return a.get() == allocator.get(); };
+    if (std::find_if(allocators_.begin(), allocators_.end(), same) == allocators_.end()) {
         allocators_.push_back(allocator);
     }
 }

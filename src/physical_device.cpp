@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -34,7 +35,7 @@ int PhysicalDevice::find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_s
     return -1;
 }
 
-std::vector<std::string> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
+std::vector<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
     std::vector<std::string> reasons;
     const auto& props = properties();
     if (props.apiVersion < req.min_api_version) {
@@ -45,8 +46,8 @@ std::vector<std::string> PhysicalDevice::unmet_requirements(const DeviceRequirem
         req.preferred_types.end()) {
         reasons.push_back("device type " + std::to_string(props.deviceType) + " is not among the accepted types");
     }
-    if (!req.name_contains.empty() && std::strstr(props.deviceName, req.name_contains.c_str()) == nullptr) {
-        reasons.push_back("name does not contain \"" + req.name_contains + "\"");
+    if (req.name_contains && std::strstr(props.deviceName, req.name_contains) == nullptr) {
+        reasons.push_back("name does not contain \"" + std::string(req.name_contains) + "\"");
     }
     for (const char* ext : req.required_extensions) {
         if (!supports_extension(ext)) reasons.push_back(std::string("lacks extension ") + ext);
@@ -70,8 +71,10 @@ std::vector<std::string> PhysicalDevice::unmet_requirements(const DeviceRequirem
         if (!f13.synchronization2) reasons.push_back("lacks feature synchronization2");
         if (!f13.dynamicRendering) reasons.push_back("lacks feature dynamicRendering");
     }
-    return reasons;
+    return std::vector<Text>(reasons.begin(), reasons.end());
 }
+
+PhysicalDevice PhysicalDevice::select(const Instance& instance) { return select(instance, DeviceRequirements{}); }
 
 PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequirements& req) {
     auto devices = instance.physical_devices();
@@ -82,7 +85,7 @@ PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequ
         auto reasons = device.unmet_requirements(req);
         if (!reasons.empty()) {
             std::string line = std::string(device.name()) + ": ";
-            for (std::size_t i = 0; i < reasons.size(); ++i) line += (i ? "; " : "") + reasons[i];
+            for (std::size_t i = 0; i < reasons.size(); ++i) line += (i ? "; " : "") + std::string(reasons[i].c_str());
             rejections.push_back(std::move(line));
             continue;
         }
@@ -98,7 +101,7 @@ PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequ
     std::string message = devices.empty() ? "vkrc: no Vulkan physical device found (is a Vulkan driver installed?)"
                                           : "vkrc: no suitable Vulkan physical device";
     for (const auto& r : rejections) message += "\n  rejected " + r;
-    throw NoSuitableDeviceError(std::move(message), std::move(rejections));
+    throw NoSuitableDeviceError(Text(message), std::vector<Text>(rejections.begin(), rejections.end()));
 }
 
 VKRC_END_NAMESPACE

@@ -34,6 +34,8 @@ void require(bool ok, const char* who, const char* problem) {
 }
 }  // namespace
 
+PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
+
 PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
     require(static_cast<bool>(device), "vkrc::PipelineLayout::create", "the Device handle is empty");
     std::vector<VkDescriptorSetLayout> sets;
@@ -69,7 +71,8 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
         d.colorAttachmentCount = static_cast<std::uint32_t>(sp.color_attachments.size());
         d.pColorAttachments = sp.color_attachments.data();
         d.pResolveAttachments = sp.resolve_attachments.empty() ? nullptr : sp.resolve_attachments.data();
-        d.pDepthStencilAttachment = sp.depth_stencil_attachment ? &*sp.depth_stencil_attachment : nullptr;
+        d.pDepthStencilAttachment =
+            sp.depth_stencil_attachment.attachment != VK_ATTACHMENT_UNUSED ? &sp.depth_stencil_attachment : nullptr;
         d.preserveAttachmentCount = static_cast<std::uint32_t>(sp.preserve_attachments.size());
         d.pPreserveAttachments = sp.preserve_attachments.data();
         subpasses.push_back(d);
@@ -153,7 +156,7 @@ const char* cache_data_problem(const PhysicalDevice& physical, const std::vector
 }
 }  // namespace
 
-PipelineCache PipelineCache::load(const Device& device, const std::string& file) {
+PipelineCache PipelineCache::load(const Device& device, const char* file) {
     require(static_cast<bool>(device), "vkrc::PipelineCache::load", "the Device handle is empty");
     std::vector<std::byte> data;
     const char* problem = nullptr;
@@ -168,7 +171,7 @@ PipelineCache PipelineCache::load(const Device& device, const std::string& file)
     }
     if (problem) {
         std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n",
-                     file.c_str(), problem);
+                     file, problem);
         return create(device);
     }
     return create(device, data);
@@ -185,10 +188,10 @@ std::vector<std::byte> PipelineCache::data() const {
     return out;
 }
 
-void PipelineCache::save(const std::string& file) const {
+void PipelineCache::save(const char* file) const {
     auto bytes = data();
     // Write beside the target and rename, so a crash never leaves a torn cache.
-    auto tmp = file;
+    std::string tmp = file;
     tmp += ".tmp";
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
@@ -220,7 +223,10 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Shad
     return ComputePipeline(std::move(s));
 }
 
-GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout) : layout_(std::move(layout)) {}
+// The default dynamic states are set here rather than by a default member
+// initialiser, which would build a vector in every includer (header cost).
+GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout)
+    : layout_(std::move(layout)), dynamic_states_{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR} {}
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                                          const char* entry_point) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -272,16 +273,18 @@ void PoolAllocator::Impl::free_block(DeviceView d, Pool& pool, Block& block) noe
     delete &block;
 }
 
-PoolAllocator::PoolAllocator(const PoolAllocatorCreateInfo& info) : impl_(std::make_unique<Impl>()) {
+PoolAllocator::PoolAllocator(const PoolAllocatorCreateInfo& info) : impl_(nullptr) {
     if (info.min_block_size == 0 || info.max_block_size < info.min_block_size) {
         throw UsageError("vkrc::PoolAllocator: min_block_size must be non-zero and at most max_block_size");
     }
+    impl_ = new Impl;  // nothing below throws
     impl_->info = info;
     if (impl_->info.dedicated_threshold == 0) impl_->info.dedicated_threshold = info.max_block_size / 2;
 }
 
 PoolAllocator::~PoolAllocator() {
     if (impl_->device) release(DeviceView(*impl_->device));
+    delete impl_;
 }
 
 AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& request) {

@@ -58,14 +58,14 @@ ShaderModule ShaderModule::create(const Device& device, std::span<const std::byt
     return ShaderModule(std::move(s));
 }
 
-ShaderModule ShaderModule::load(const Device& device, const std::string& spv_file) {
+ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {
     std::ifstream in(spv_file, std::ios::binary);
-    if (!in) throw UsageError("vkrc::ShaderModule::load: cannot open " + spv_file);
+    if (!in) throw UsageError("vkrc::ShaderModule::load: cannot open " + std::string(spv_file));
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::vector<std::uint32_t> words((bytes.size() + 3) / 4);
     if (!bytes.empty()) std::memcpy(words.data(), bytes.data(), bytes.size());
     detail::Ref<detail::ShaderModuleState> s;
-    make(device, words.data(), bytes.size(), ("vkrc::ShaderModule::load: " + spv_file).c_str(), s);
+    make(device, words.data(), bytes.size(), ("vkrc::ShaderModule::load: " + std::string(spv_file)).c_str(), s);
     return ShaderModule(std::move(s));
 }
 

@@ -1,8 +1,10 @@
 #include "vkrc/swapchain.hpp"
 
+#include "swapchain_state.hpp"
 #include "vkrc/upload.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -88,7 +90,7 @@ const char* present_mode_name(VkPresentModeKHR mode) {
 }
 
 void log(const detail::SwapchainState& s, const std::string& message) {
-    if (s.info.log) s.info.log("vkrc::Swapchain: " + message);
+    if (s.info.log) s.info.log(("vkrc::Swapchain: " + message).c_str());
 }
 
 // Format, colour space and present mode: fixed for the swapchain's life,
@@ -274,6 +276,10 @@ void wait_for_queue(const Queue& queue, std::uint64_t value) {
 }
 
 }  // namespace
+
+Swapchain Swapchain::create(const Queue& queue, const Surface& surface) {
+    return create(queue, surface, SwapchainCreateInfo{});
+}
 
 Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info) {
     if (!queue) throw UsageError("vkrc::Swapchain::create: the Queue is empty");
@@ -495,5 +501,43 @@ void HeadlessPresenter::resize(VkExtent2D extent) {
     s.info.extent = extent;
     s.needs_resize = true;
 }
+
+std::span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
+std::span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
+
+// ---------------------------------------------------------------- handle members
+// Out of line: the states are not in the public header.
+
+Swapchain::Swapchain() noexcept = default;
+Swapchain::~Swapchain() = default;
+Swapchain::Swapchain(const Swapchain& other) noexcept = default;
+Swapchain::Swapchain(Swapchain&& other) noexcept = default;
+Swapchain& Swapchain::operator=(const Swapchain& other) noexcept = default;
+Swapchain& Swapchain::operator=(Swapchain&& other) noexcept = default;
+void Swapchain::reset() noexcept { Handle::reset(); }
+std::uint32_t Swapchain::use_count() const noexcept { return Handle::use_count(); }
+
+HeadlessPresenter::HeadlessPresenter() noexcept = default;
+HeadlessPresenter::~HeadlessPresenter() = default;
+HeadlessPresenter::HeadlessPresenter(const HeadlessPresenter& other) noexcept = default;
+HeadlessPresenter::HeadlessPresenter(HeadlessPresenter&& other) noexcept = default;
+HeadlessPresenter& HeadlessPresenter::operator=(const HeadlessPresenter& other) noexcept = default;
+HeadlessPresenter& HeadlessPresenter::operator=(HeadlessPresenter&& other) noexcept = default;
+void HeadlessPresenter::reset() noexcept { Handle::reset(); }
+std::uint32_t HeadlessPresenter::use_count() const noexcept { return Handle::use_count(); }
+
+VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
+VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
+std::uint32_t Swapchain::image_count() const noexcept { return static_cast<std::uint32_t>(state_->images.size()); }
+VkSwapchainKHR Swapchain::vk() const noexcept { return state_->chain ? state_->chain->swapchain : VK_NULL_HANDLE; }
+const Surface& Swapchain::surface() const noexcept { return state_->surface; }
+const Queue& Swapchain::queue() const noexcept { return state_->queue; }
+VkColorSpaceKHR Swapchain::color_space() const noexcept { return state_->surface_format.colorSpace; }
+VkPresentModeKHR Swapchain::present_mode() const noexcept { return state_->present_mode; }
+
+VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }
+VkFormat HeadlessPresenter::format() const noexcept { return state_->info.format; }
+std::uint32_t HeadlessPresenter::image_count() const noexcept { return state_->info.image_count; }
+std::uint32_t HeadlessPresenter::last_presented() const noexcept { return state_->last_presented; }
 
 VKRC_END_NAMESPACE

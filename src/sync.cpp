@@ -1,5 +1,7 @@
 #include "vkrc/sync.hpp"
 
+#include <string>
+
 VKRC_BEGIN_NAMESPACE
 
 namespace {

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -141,7 +142,7 @@ private:
 TEST(FaultInjection, EveryAllocationOfAUserAllocatorFailsCleanly) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     const auto info = vkrc_test::validated_instance_info(log);
-    auto counting = std::make_shared<FailingAllocator>(0, AllocatorFailure::bad_alloc);
+    auto counting = vkrc::make_allocator<FailingAllocator>(0, AllocatorFailure::bad_alloc);
     vkrc_test::run_teapot_scenario(info, {.allocator = counting});
     const std::uint64_t points = counting->calls();
     counting.reset();
@@ -150,7 +151,7 @@ TEST(FaultInjection, EveryAllocationOfAUserAllocatorFailsCleanly) {
 
     for (auto how : {AllocatorFailure::bad_alloc, AllocatorFailure::vk_error, AllocatorFailure::no_memory}) {
         for (std::uint64_t k = 1; k <= points; ++k) {
-            auto failing = std::make_shared<FailingAllocator>(k, how);
+            auto failing = vkrc::make_allocator<FailingAllocator>(k, how);
             try {
                 vkrc_test::run_teapot_scenario(info, {.allocator = failing});
                 ADD_FAILURE() << "allocation " << k << " failed and nothing was thrown";
@@ -162,7 +163,7 @@ TEST(FaultInjection, EveryAllocationOfAUserAllocatorFailsCleanly) {
             } catch (const std::exception& e) {
                 ADD_FAILURE() << "allocation " << k << ": unexpected exception " << e.what();
             }
-            EXPECT_EQ(failing.use_count(), 1) << "the device that kept the allocator is gone";
+            EXPECT_EQ(failing->use_count(), 1u) << "the device that kept the allocator is gone";
             auto messages = log->take();
             EXPECT_TRUE(messages.empty()) << "allocation " << k << ": " << messages.size()
                                           << " validation message(s), first: " << messages.front();

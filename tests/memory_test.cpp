@@ -7,7 +7,9 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -124,11 +126,11 @@ protected:
                 vkrc::PoolAllocatorCreateInfo info;
                 info.min_block_size = 1 * MiB;
                 info.max_block_size = 4 * MiB;
-                allocator = std::make_shared<vkrc::PoolAllocator>(info);
+                allocator = vkrc::make_allocator<vkrc::PoolAllocator>(info);
                 break;
             }
-            case Kind::dedicated: allocator = std::make_shared<vkrc::DedicatedAllocator>(); break;
-            case Kind::user: allocator = std::make_shared<ArenaAllocator>(16 * MiB); break;
+            case Kind::dedicated: allocator = vkrc::make_allocator<vkrc::DedicatedAllocator>(); break;
+            case Kind::user: allocator = vkrc::make_allocator<ArenaAllocator>(16 * MiB); break;
         }
     }
     void TearDown() override {
@@ -152,7 +154,7 @@ protected:
         return r;
     }
 
-    std::shared_ptr<vkrc::DeviceAllocator> allocator;
+    vkrc::SharedAllocator allocator;
 };
 
 TEST_P(AllocatorTest, BufferWriteReadAtAnyAlignment) {
@@ -261,7 +263,7 @@ TEST_P(AllocatorTest, MissingMemoryTypeIsAClearError) {
 }
 
 TEST_P(AllocatorTest, FreeIntoTheWrongAllocatorThrows) {
-    auto other = std::make_shared<vkrc::DedicatedAllocator>();
+    auto other = vkrc::make_allocator<vkrc::DedicatedAllocator>();
     auto mine = allocator->allocate(view(), request(512));
     EXPECT_EQ(mine.allocator, allocator.get());
     EXPECT_THROW(other->free(view(), mine), vkrc::UsageError);
@@ -341,13 +343,13 @@ TEST_P(AllocatorTest, MemoryOutlivesPendingGpuWork) {
 // The device keeps every allocator used with it, and calls release() at teardown.
 TEST_P(AllocatorTest, DeviceReleasesItsAllocatorsAtTeardown) {
     auto buffer = make_buffer(4096, vkrc::MemoryUsage::upload);
-    std::weak_ptr<vkrc::DeviceAllocator> weak = allocator;
+    vkrc::SharedAllocator observer = allocator;
     allocator.reset();
-    EXPECT_FALSE(weak.expired());  // the device holds it
+    EXPECT_EQ(observer->use_count(), 2u);  // the device holds it
     release_all();
     EXPECT_TRUE(buffer);
     buffer.reset();  // the last handle: the device goes, after its deferred frees
-    EXPECT_TRUE(weak.expired());
+    EXPECT_EQ(observer->use_count(), 1u);
 }
 
 TEST_P(AllocatorTest, StatisticsAndBudget) {
@@ -702,7 +704,7 @@ TEST_F(PoolTest, ConcurrentAllocateAndFree) {
     vkrc::PoolAllocatorCreateInfo info;
     info.min_block_size = 1 * MiB;
     info.max_block_size = 4 * MiB;
-    auto pool = std::make_shared<vkrc::PoolAllocator>(info);
+    auto pool = vkrc::make_allocator<vkrc::PoolAllocator>(info);
     std::vector<std::thread> threads;
     for (int t = 0; t < 8; ++t) {
         threads.emplace_back([&, t] {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 namespace {
 
@@ -69,10 +70,10 @@ TEST_F(VulkanTest, PipelineCacheRoundTripsThroughAFile) {
         EXPECT_FALSE(cache.loaded_from_file());
         auto pipeline = vkrc::ComputePipeline::create(layout, module, "main", cache);
         EXPECT_EQ(pipeline.bind_point(), VK_PIPELINE_BIND_POINT_COMPUTE);
-        cache.save(file);
+        cache.save(file.c_str());
     }
     ASSERT_TRUE(std::filesystem::exists(file));
-    auto loaded = vkrc::PipelineCache::load(device, file);
+    auto loaded = vkrc::PipelineCache::load(device, file.c_str());
     EXPECT_TRUE(loaded.loaded_from_file());
     EXPECT_FALSE(loaded.data().empty());
 
@@ -84,7 +85,7 @@ TEST_F(VulkanTest, PipelineCacheRoundTripsThroughAFile) {
         out.write(junk.data(), static_cast<std::streamsize>(junk.size()));
     }
     ::testing::internal::CaptureStderr();
-    auto from_corrupt = vkrc::PipelineCache::load(device, corrupt);
+    auto from_corrupt = vkrc::PipelineCache::load(device, corrupt.c_str());
     std::string warning = ::testing::internal::GetCapturedStderr();
     EXPECT_FALSE(from_corrupt.loaded_from_file());
     EXPECT_NE(warning.find("vkrc warning: PipelineCache::load"), std::string::npos) << warning;
@@ -101,13 +102,13 @@ TEST_F(VulkanTest, PipelineCacheRoundTripsThroughAFile) {
         out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     }
     ::testing::internal::CaptureStderr();
-    auto from_foreign = vkrc::PipelineCache::load(device, foreign);
+    auto from_foreign = vkrc::PipelineCache::load(device, foreign.c_str());
     warning = ::testing::internal::GetCapturedStderr();
     EXPECT_FALSE(from_foreign.loaded_from_file());
     EXPECT_NE(warning.find("another driver or device"), std::string::npos) << warning;
 
     ::testing::internal::CaptureStderr();
-    auto from_missing = vkrc::PipelineCache::load(device, dir / "missing.bin");
+    auto from_missing = vkrc::PipelineCache::load(device, (dir / "missing.bin").c_str());
     ::testing::internal::GetCapturedStderr();
     EXPECT_FALSE(from_missing.loaded_from_file());
     // An ignored file still leaves a working (empty) cache.

@@ -18,8 +18,10 @@
 #include <array>
 #include <cstring>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -154,7 +156,7 @@ protected:
 
     vkrc::Swapchain make_swapchain(VkImageUsageFlags usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) {
         return vkrc::Swapchain::create(queue, window.surface,
-                                       {.image_usage = usage, .log = [this](const std::string& m) { choices.push_back(m); }});
+                                       {.image_usage = usage, .log = [this](const char* m) { choices.push_back(m); }});
     }
 
     std::shared_ptr<ValidationLog> log = std::make_shared<ValidationLog>();

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <vector>
 
 namespace {
@@ -52,19 +53,19 @@ TEST_F(VulkanTest, ShaderModuleFromFile) {
         auto bytes = std::as_bytes(vkrc_shaders::fill_pattern_comp);
         out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
     }
-    EXPECT_TRUE(vkrc::ShaderModule::load(device, good));
+    EXPECT_TRUE(vkrc::ShaderModule::load(device, good.c_str()));
     auto odd = dir / "odd.spv";
     {
         std::ofstream out(odd, std::ios::binary);
         out.write("\x03\x02\x23\x07\x00", 5);
     }
-    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, odd); }),
+    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, odd.c_str()); }),
               "vkrc::ShaderModule::load: " + odd.string() + ": the SPIR-V size (5 bytes) is not a multiple of 4");
     auto empty = dir / "empty.spv";
     std::ofstream(empty).close();
-    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, empty); }),
+    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, empty.c_str()); }),
               "vkrc::ShaderModule::load: " + empty.string() + ": the SPIR-V module is empty");
-    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, dir / "missing.spv"); }),
+    EXPECT_EQ(usage_error_of([&] { vkrc::ShaderModule::load(device, (dir / "missing.spv").c_str()); }),
               "vkrc::ShaderModule::load: cannot open " + (dir / "missing.spv").string());
     std::filesystem::remove_all(dir);
 }

@@ -21,7 +21,7 @@ int main(int argc, char** argv) try {
 
     // 1. The allocator is shared: every resource made with it, and the device
     //    (until its teardown, so that deferred frees find it), hold a reference.
-    auto arena = std::make_shared<ArenaAllocator>(VkDeviceSize{16} << 20);
+    auto arena = vkrc::make_allocator<ArenaAllocator>(VkDeviceSize{16} << 20);
     {
         // 2. Resources name it in their create-info; everything else is as usual.
         auto buffer = vkrc::Buffer::create(device, {.size = 4096,

@@ -48,7 +48,7 @@ int run(const Options& options) {
     if (options.headless)
         headless = vkrc::HeadlessPresenter::create(queue, {.extent = {256, 256}, .format = VK_FORMAT_R8G8B8A8_UNORM});
     else
-        swapchain = vkrc::Swapchain::create(queue, window.surface, {.log = [](auto& m) { std::puts(m.c_str()); }});
+        swapchain = vkrc::Swapchain::create(queue, window.surface, {.log = [](const char* m) { std::puts(m); }});
     vkrc::Presenter& presenter = options.headless ? static_cast<vkrc::Presenter&>(headless) : swapchain;
 
     // 2. Three vertices (red top, green bottom left, blue bottom right) in a buffer

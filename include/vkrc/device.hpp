@@ -42,7 +42,10 @@ class Queue;
 class Device : public Handle<detail::DeviceState> {
 public:
     Device() noexcept = default;
-    static Device create(const PhysicalDevice& physical_device, const DeviceCreateInfo& info = {});
+    static Device create(const PhysicalDevice& physical_device, const DeviceCreateInfo& info);
+    // The defaults: a separate overload so that a caller's translation unit
+    // does not build and destroy a default create-info (bench/header_cost).
+    static Device create(const PhysicalDevice& physical_device);
     // Wraps a device made elsewhere; queues lists what it was created with.
     // Its functions are loaded with vkGetDeviceProcAddr either way.
     static Device adopt(const PhysicalDevice& physical_device, VkDevice device, Ownership ownership,

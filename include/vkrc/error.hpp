@@ -1,31 +1,69 @@
 // Errors: failed Vulkan calls throw; statuses that are not failures return.
+//
+// vkrc's exceptions derive from std::exception and keep their messages in a
+// vkrc::Text, so this header needs only <exception>: <stdexcept> and
+// <system_error> bring in <string>, which every translation unit that
+// includes vkrc would parse (bench/header_cost).
 #pragma once
 
 #include "vkrc/config.hpp"
 
 #include <vulkan/vulkan_core.h>
 
-#include <stdexcept>
-#include <string>
-#include <system_error>
+#include <cstddef>
+#include <exception>
+#include <utility>
 
 VKRC_BEGIN_NAMESPACE
 
-// The std::error_category of VkResult values.
-const std::error_category& vk_result_category() noexcept;
-std::error_code make_error_code(VkResult result) noexcept;
+// An immutable, shared, null-terminated string: the messages and reports vkrc
+// hands out (error messages, rejection reasons, layer and extension names).
+// Copying shares the characters and cannot throw, as exceptions require.
+class Text {
+public:
+    Text() noexcept = default;
+    Text(const char* text);  // copies; null means empty
+    Text(const char* data, std::size_t size);
+    // Any string type with c_str() (std::string), without <string> here.
+    template <class String, class = decltype(std::declval<const String&>().c_str())>
+    explicit Text(const String& text) : Text(text.c_str()) {}
+    Text(const Text& other) noexcept;
+    Text(Text&& other) noexcept : block_(std::exchange(other.block_, nullptr)) {}
+    Text& operator=(Text other) noexcept {
+        std::swap(block_, other.block_);
+        return *this;
+    }
+    ~Text();
+
+    const char* c_str() const noexcept;
+    std::size_t size() const noexcept;
+    bool empty() const noexcept { return size() == 0; }
+    // Whether part occurs in the text.
+    bool contains(const char* part) const noexcept;
+    friend bool operator==(const Text& a, const char* b) noexcept;
+    friend bool operator==(const Text& a, const Text& b) noexcept { return a == b.c_str(); }
+
+private:
+    struct Block;
+    Block* block_ = nullptr;
+};
+
 // "VK_ERROR_DEVICE_LOST"; nullptr for a value this build does not know.
 const char* to_string(VkResult result) noexcept;
 
-// A Vulkan call returned a negative VkResult. what() names the call and the result.
-class Error : public std::system_error {
+// A Vulkan call returned a negative VkResult. what() names the call and the
+// result: "vkAllocateMemory failed: VK_ERROR_OUT_OF_DEVICE_MEMORY".
+class Error : public std::exception {
 public:
     Error(VkResult result, const char* call);
-    VkResult result() const noexcept { return static_cast<VkResult>(code().value()); }
+    VkResult result() const noexcept { return result_; }
     const char* call() const noexcept { return call_; }
+    const char* what() const noexcept override { return what_.c_str(); }
 
 private:
+    VkResult result_;
     const char* call_;  // a string literal naming the Vulkan function
+    Text what_;
 };
 
 // VK_ERROR_DEVICE_LOST: the device is gone; every handle can still be dropped.
@@ -36,9 +74,16 @@ public:
 
 // The application passed something vkrc can tell is wrong before Vulkan sees
 // it (bad SPIR-V, an overflowing size, a write past a mapping, ...).
-class UsageError : public std::invalid_argument {
+class UsageError : public std::exception {
 public:
-    using std::invalid_argument::invalid_argument;
+    explicit UsageError(const char* message) : what_(message) {}
+    // Any string type with c_str() (std::string), without <string> here.
+    template <class String, class = decltype(std::declval<const String&>().c_str())>
+    explicit UsageError(const String& message) : what_(message.c_str()) {}
+    const char* what() const noexcept override { return what_.c_str(); }
+
+private:
+    Text what_;
 };
 
 namespace detail {

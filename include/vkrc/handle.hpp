@@ -7,9 +7,9 @@
 #pragma once
 
 #include "vkrc/config.hpp"
-#include "vkrc/detail/light_std.hpp"  // std::mutex, std::lock_guard
 
-#include <atomic>
+#include <pthread.h>
+
 #include <cstdint>
 #include <utility>
 
@@ -31,16 +31,86 @@ struct SingleThreadPolicy {
     static std::uint32_t load(const Count& c) noexcept { return c; }
 };
 
+namespace detail {
+
+// A word accessed atomically, with the subset of std::atomic's interface vkrc
+// uses (memory orders are std::memory_order values, or __ATOMIC_* constants).
+// GCC/Clang builtins instead of <atomic>: with C++20, libstdc++'s <atomic>
+// brings in the atomic-wait machinery, <system_error> and <string>, which
+// every translation unit that includes vkrc would parse (bench/header_cost).
+template <class T>
+class Atomic {
+public:
+    constexpr Atomic(T value = T{}) noexcept : value_(value) {}
+    Atomic(const Atomic&) = delete;
+    Atomic& operator=(const Atomic&) = delete;
+
+    template <class Order = int>
+    T load(Order order = Order(__ATOMIC_SEQ_CST)) const noexcept {
+        return __atomic_load_n(&value_, static_cast<int>(order));
+    }
+    template <class Order = int>
+    void store(T value, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        __atomic_store_n(&value_, value, static_cast<int>(order));
+    }
+    template <class Order = int>
+    T exchange(T value, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        return __atomic_exchange_n(&value_, value, static_cast<int>(order));
+    }
+    template <class Order = int>
+    T fetch_add(T delta, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        return __atomic_fetch_add(&value_, delta, static_cast<int>(order));
+    }
+    template <class Order = int>
+    T fetch_sub(T delta, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        return __atomic_fetch_sub(&value_, delta, static_cast<int>(order));
+    }
+    // On failure the order of the load is the weaker of order and acquire.
+    template <class Order = int>
+    bool compare_exchange_weak(T& expected, T desired, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        return __atomic_compare_exchange_n(&value_, &expected, desired, true, static_cast<int>(order),
+                                           failure_order(static_cast<int>(order)));
+    }
+    template <class Order = int>
+    bool compare_exchange_strong(T& expected, T desired, Order order = Order(__ATOMIC_SEQ_CST)) noexcept {
+        return __atomic_compare_exchange_n(&value_, &expected, desired, false, static_cast<int>(order),
+                                           failure_order(static_cast<int>(order)));
+    }
+
+private:
+    static constexpr int failure_order(int order) noexcept {
+        return order == __ATOMIC_ACQ_REL ? __ATOMIC_ACQUIRE : order == __ATOMIC_RELEASE ? __ATOMIC_RELAXED : order;
+    }
+    T value_;
+};
+
+}  // namespace detail
+
 // Atomic count and a real mutex. Increments are relaxed (a new reference can
 // only come from an existing one); the decrement is acq_rel so that the thread
 // that destroys the object sees every write made through the other references.
 struct MultiThreadPolicy {
-    using Count = std::atomic<std::uint32_t>;
-    using Mutex = std::mutex;
+    using Count = detail::Atomic<std::uint32_t>;
+    // A pthread mutex, as std::mutex is on this platform (std::mutex's header
+    // brings in <system_error> and <string>). lock() cannot fail on a default
+    // mutex used correctly, so it reports nothing.
+    class Mutex {
+    public:
+        Mutex() noexcept = default;
+        Mutex(const Mutex&) = delete;
+        Mutex& operator=(const Mutex&) = delete;
+        ~Mutex() { pthread_mutex_destroy(&m_); }
+        void lock() noexcept { pthread_mutex_lock(&m_); }
+        bool try_lock() noexcept { return pthread_mutex_trylock(&m_) == 0; }
+        void unlock() noexcept { pthread_mutex_unlock(&m_); }
+
+    private:
+        pthread_mutex_t m_ = PTHREAD_MUTEX_INITIALIZER;
+    };
     static constexpr bool multi_thread = true;
-    static void increment(Count& c) noexcept { c.fetch_add(1, std::memory_order_relaxed); }
-    static bool decrement(Count& c) noexcept { return c.fetch_sub(1, std::memory_order_acq_rel) == 1; }
-    static std::uint32_t load(const Count& c) noexcept { return c.load(std::memory_order_relaxed); }
+    static void increment(Count& c) noexcept { c.fetch_add(1, __ATOMIC_RELAXED); }
+    static bool decrement(Count& c) noexcept { return c.fetch_sub(1, __ATOMIC_ACQ_REL) == 1; }
+    static std::uint32_t load(const Count& c) noexcept { return c.load(__ATOMIC_RELAXED); }
 };
 
 #if VKRC_IS_MULTI_THREAD
@@ -49,7 +119,18 @@ using ThreadPolicy = MultiThreadPolicy;
 using ThreadPolicy = SingleThreadPolicy;
 #endif
 using Mutex = ThreadPolicy::Mutex;
-using LockGuard = std::lock_guard<Mutex>;
+
+// Holds a Mutex locked for its scope (std::lock_guard without <mutex>).
+class LockGuard {
+public:
+    explicit LockGuard(Mutex& mutex) noexcept : mutex_(mutex) { mutex_.lock(); }
+    LockGuard(const LockGuard&) = delete;
+    LockGuard& operator=(const LockGuard&) = delete;
+    ~LockGuard() { mutex_.unlock(); }
+
+private:
+    Mutex& mutex_;
+};
 
 namespace detail {
 
@@ -101,8 +182,10 @@ public:
         std::swap(p_, other.p_);
         return *this;
     }
+    // Through RefCounted: a state type may declare a release() of its own
+    // (DeviceAllocator::release(DeviceView) hides the base's).
     ~Ref() {
-        if (p_) p_->release();
+        if (p_) static_cast<const RefCounted*>(p_)->release();
     }
 
     // Takes an extra reference to an object already owned elsewhere.

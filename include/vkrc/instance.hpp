@@ -6,7 +6,6 @@
 #include "vkrc/handle.hpp"
 #include "vkrc/detail/light_std.hpp"  // std::function
 
-#include <string>
 #include <vector>
 
 VKRC_BEGIN_NAMESPACE
@@ -54,7 +53,10 @@ struct InstanceCreateInfo {
 class Instance : public Handle<detail::InstanceState> {
 public:
     Instance() noexcept = default;
-    static Instance create(const InstanceCreateInfo& info = {});
+    static Instance create(const InstanceCreateInfo& info);
+    // The defaults: a separate overload so that a caller's translation unit
+    // does not build and destroy a default create-info (bench/header_cost).
+    static Instance create();
     // Wraps an instance made elsewhere. With Ownership::owned vkrc destroys it.
     static Instance adopt(VkInstance instance, Ownership ownership, std::uint32_t api_version,
                           PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
@@ -68,8 +70,8 @@ public:
     std::vector<PhysicalDevice> physical_devices() const;
 
     // Names of the available instance layers / extensions (for choosing what to enable).
-    static std::vector<std::string> available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
-    static std::vector<std::string> available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+    static std::vector<Text> available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+    static std::vector<Text> available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
 
 private:
     using Handle::Handle;
@@ -88,20 +90,22 @@ struct DeviceRequirements {
         VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
         VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_CPU, VK_PHYSICAL_DEVICE_TYPE_OTHER};
     // Only a device whose name contains this text (e.g. from an environment variable).
-    std::string name_contains;
+    const char* name_contains = nullptr;
 };
 
 // Thrown when no physical device meets the requirements; what() lists every
 // device with the reasons it was rejected.
-class NoSuitableDeviceError : public std::runtime_error {
+class NoSuitableDeviceError : public std::exception {
 public:
-    NoSuitableDeviceError(std::string message, std::vector<std::string> rejections)
-        : std::runtime_error(std::move(message)), rejections_(std::move(rejections)) {}
+    NoSuitableDeviceError(Text message, std::vector<Text> rejections)
+        : what_(std::move(message)), rejections_(std::move(rejections)) {}
+    const char* what() const noexcept override { return what_.c_str(); }
     // One line per rejected device: "<name>: <reason>; <reason>".
-    const std::vector<std::string>& rejections() const noexcept { return rejections_; }
+    const std::vector<Text>& rejections() const noexcept { return rejections_; }
 
 private:
-    std::vector<std::string> rejections_;
+    Text what_;
+    std::vector<Text> rejections_;
 };
 
 // A physical device; keeps its Instance alive. Properties are read once.
@@ -110,9 +114,12 @@ public:
     PhysicalDevice() noexcept = default;
     // Chooses the best device that meets the requirements, or throws
     // NoSuitableDeviceError naming each device and why it was rejected.
-    static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements = {});
+    static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements);
+    // The defaults: a separate overload so that a caller's translation unit
+    // does not build and destroy a default DeviceRequirements (bench/header_cost).
+    static PhysicalDevice select(const Instance& instance);
     // The reasons this device fails the requirements; empty when it meets them.
-    std::vector<std::string> unmet_requirements(const DeviceRequirements& requirements) const;
+    std::vector<Text> unmet_requirements(const DeviceRequirements& requirements) const;
 
     VkPhysicalDevice vk() const noexcept;
     const Instance& instance() const noexcept;

@@ -14,7 +14,6 @@
 #include <cstddef>
 #include <cstring>
 #include <limits>
-#include <memory>
 #include <span>
 #include <type_traits>
 
@@ -111,7 +110,9 @@ struct AllocatorStatistics {
 // calls them on cold paths only. The device keeps every allocator used with
 // it until its own teardown (so that deferred frees can run), then calls
 // release(). Thread safety under the multi-thread policy is the allocator's.
-class DeviceAllocator {
+// Allocators are shared through SharedAllocator (make one with
+// make_allocator), reference-counted like every vkrc object.
+class DeviceAllocator : public detail::RefCounted {
 public:
     virtual ~DeviceAllocator() = default;
     // Returns a range with info.allocator == this, or throws (vkrc::Error,
@@ -125,6 +126,16 @@ public:
     virtual void release(DeviceView device) noexcept { (void)device; }
     virtual AllocatorStatistics statistics(DeviceView device) const;
 };
+
+// Shared ownership of an allocator; empty means the device's default.
+using SharedAllocator = detail::Ref<DeviceAllocator>;
+
+// Makes an allocator of type A, owned by the returned reference (which
+// converts to SharedAllocator).
+template <class A, class... Args>
+detail::Ref<A> make_allocator(Args&&... args) {
+    return detail::Ref<A>(new A(std::forward<Args>(args)...));
+}
 
 // The memory type for type_bits and intent: the lowest index with every
 // required flag and the most preferred (and fewest avoided) flags; -1 if none.
@@ -179,7 +190,7 @@ public:
     struct Impl;
 
 private:
-    std::unique_ptr<Impl> impl_;
+    Impl* impl_;  // owned; defined in pool_allocator.cpp
 };
 
 // Adds VK_EXT_memory_budget's budget and usage (or the heap sizes) to stats.
@@ -295,7 +306,7 @@ public:
     Allocation() noexcept = default;
     // Allocates for request from allocator (null: the device's default).
     static Allocation create(const Device& device, const AllocationRequest& request,
-                             const std::shared_ptr<DeviceAllocator>& allocator = nullptr);
+                             const SharedAllocator& allocator = {});
 
     const AllocationInfo& info() const noexcept { return state_->info; }
     VkDeviceMemory memory() const noexcept { return state_->info.memory; }

@@ -4,9 +4,7 @@
 #include "vkrc/descriptor.hpp"
 #include "vkrc/shader.hpp"
 
-#include <optional>
 #include <span>
-#include <string>
 #include <vector>
 
 VKRC_BEGIN_NAMESPACE
@@ -28,7 +26,8 @@ struct PipelineLayoutCreateInfo {
 class PipelineLayout : public Handle<detail::PipelineLayoutState> {
 public:
     PipelineLayout() noexcept = default;
-    static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info = {});
+    static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
+    static PipelineLayout create(const Device& device);  // no sets, no push constants
     VkPipelineLayout vk() const noexcept;
     const Device& device() const noexcept;
 
@@ -41,7 +40,8 @@ struct SubpassDescription {
     std::vector<VkAttachmentReference> input_attachments;
     std::vector<VkAttachmentReference> color_attachments;
     std::vector<VkAttachmentReference> resolve_attachments;  // empty or one per colour attachment
-    std::optional<VkAttachmentReference> depth_stencil_attachment;
+    // attachment VK_ATTACHMENT_UNUSED (the default): no depth/stencil attachment.
+    VkAttachmentReference depth_stencil_attachment{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
     std::vector<std::uint32_t> preserve_attachments;
 };
 
@@ -95,14 +95,14 @@ public:
     // Primes the cache from a file written by save(). A missing, truncated,
     // corrupt or foreign (other driver/device) file is ignored with a warning
     // on stderr: the cache starts empty and loaded_from_file() is false.
-    static PipelineCache load(const Device& device, const std::string& file);
+    static PipelineCache load(const Device& device, const char* file);
 
     VkPipelineCache vk() const noexcept;
     bool loaded_from_file() const noexcept;
     // vkGetPipelineCacheData.
     std::vector<std::byte> data() const;
     // Writes data() to file (replacing it); throws std::system_error on I/O failure.
-    void save(const std::string& file) const;
+    void save(const char* file) const;
 
 private:
     using Handle::Handle;
@@ -199,7 +199,7 @@ private:
                                                VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                                    VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
     VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
-    std::vector<VkDynamicState> dynamic_states_{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    std::vector<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
     RenderPass render_pass_;
     std::uint32_t subpass_ = 0;
     std::vector<VkFormat> color_formats_;

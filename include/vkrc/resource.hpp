@@ -24,7 +24,7 @@ struct BufferCreateInfo {
     std::vector<std::uint32_t> queue_family_indices;
     MemoryIntent memory;
     // Null: the device's default allocator (a PoolAllocator).
-    std::shared_ptr<DeviceAllocator> allocator;
+    SharedAllocator allocator;
     const void* next = nullptr;
 };
 
@@ -65,7 +65,7 @@ struct ImageCreateInfo {
     std::vector<std::uint32_t> queue_family_indices;
     VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
     MemoryIntent memory;
-    std::shared_ptr<DeviceAllocator> allocator;
+    SharedAllocator allocator;
     const void* next = nullptr;
 };
 

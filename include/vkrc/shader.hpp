@@ -5,7 +5,6 @@
 
 #include <cstddef>
 #include <span>
-#include <string>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -20,7 +19,7 @@ public:
     static ShaderModule create(const Device& device, std::span<const std::uint32_t> spirv);
     // Bytes of a .spv file; also rejects a size that is not a multiple of 4.
     static ShaderModule create(const Device& device, std::span<const std::byte> spirv);
-    static ShaderModule load(const Device& device, const std::string& spv_file);
+    static ShaderModule load(const Device& device, const char* spv_file);
 
     VkShaderModule vk() const noexcept;
     const Device& device() const noexcept;

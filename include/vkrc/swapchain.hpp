@@ -19,7 +19,6 @@
 #include "vkrc/surface.hpp"
 #include "vkrc/sync.hpp"
 
-#include <string>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -64,8 +63,10 @@ public:
     explicit operator bool() const noexcept { return static_cast<bool>(image); }
     // For the submission that renders the image: it waits until the image is
     // free and signals when rendering is done. Empty spans headless.
-    std::span<const SemaphoreSubmit> waits() const noexcept { return {&wait_, sync_count_}; }
-    std::span<const SemaphoreSubmit> signals() const noexcept { return {&signal_, sync_count_}; }
+    // Out of line: building a std::span in a header makes every includer
+    // check the span constructors' range concepts (bench/header_cost).
+    std::span<const SemaphoreSubmit> waits() const noexcept;
+    std::span<const SemaphoreSubmit> signals() const noexcept;
 
 private:
     friend class Swapchain;
@@ -117,7 +118,7 @@ struct SwapchainCreateInfo {
     // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
     VkExtent2D extent{};
     // Receives the choices made and why, at creation and every re-creation.
-    std::function<void(const std::string&)> log;
+    std::function<void(const char*)> log;
 };
 
 // A swapchain for one Surface, re-created in place. Keeps its Surface,
@@ -126,7 +127,16 @@ struct SwapchainCreateInfo {
 // until every frame that used it is dropped and its work has completed.
 class Swapchain : public Handle<detail::SwapchainState>, public Presenter {
 public:
-    Swapchain() noexcept = default;
+    Swapchain() noexcept;
+    // Out of line, with the state (src/swapchain_state.hpp), which the
+    // public header does not include.
+    ~Swapchain() override;
+    Swapchain(const Swapchain& other) noexcept;
+    Swapchain(Swapchain&& other) noexcept;
+    Swapchain& operator=(const Swapchain& other) noexcept;
+    Swapchain& operator=(Swapchain&& other) noexcept;
+    void reset() noexcept;
+    std::uint32_t use_count() const noexcept;
     // Creates the swapchain and takes the surface: a second live Swapchain
     // for the same surface is a UsageError. After a previous Swapchain of the
     // surface was dropped, waits for the device to be idle so that its Vulkan
@@ -135,7 +145,8 @@ public:
     // VK_KHR_swapchain, and the queue's family must present to the surface.
     // A surface with zero extent (minimised) gets its swapchain at the first
     // acquire after it has an area again.
-    static Swapchain create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info = {});
+    static Swapchain create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info);
+    static Swapchain create(const Queue& queue, const Surface& surface);  // the defaults
 
     Frame acquire() override;
     PresentStatus present(const Frame& frame) override;
@@ -183,7 +194,16 @@ struct HeadlessPresenterCreateInfo {
 // being rewritten while the GPU still renders into it.
 class HeadlessPresenter : public Handle<detail::HeadlessPresenterState>, public Presenter {
 public:
-    HeadlessPresenter() noexcept = default;
+    HeadlessPresenter() noexcept;
+    // Out of line, with the state (src/swapchain_state.hpp), which the
+    // public header does not include.
+    ~HeadlessPresenter() override;
+    HeadlessPresenter(const HeadlessPresenter& other) noexcept;
+    HeadlessPresenter(HeadlessPresenter&& other) noexcept;
+    HeadlessPresenter& operator=(const HeadlessPresenter& other) noexcept;
+    HeadlessPresenter& operator=(HeadlessPresenter&& other) noexcept;
+    void reset() noexcept;
+    std::uint32_t use_count() const noexcept;
     static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
 
     Frame acquire() override;
@@ -204,75 +224,5 @@ public:
 private:
     using Handle::Handle;
 };
-
-namespace detail {
-
-// One Vulkan swapchain (current or retired) and its per-image semaphores.
-class SwapchainChainState final : public RefCounted {
-public:
-    // Queues the swapchain's destruction after everything submitted on the
-    // queue so far, including (by an empty submission) its last present;
-    // see the Presentation section of docs/design.md.
-    ~SwapchainChainState() override;
-    Queue queue;
-    Surface surface;
-    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
-    // Signalled by the rendering of image i, waited by its present; reused
-    // only when image i is acquired again.
-    std::vector<Semaphore> render_done;
-    bool presented = false;  // under the owning SwapchainState's mutex
-    // Not retired when its Swapchain went: its destruction ends the surface's
-    // SurfaceState::releasing.
-    bool last = false;
-};
-
-class SwapchainState final : public RefCounted {
-public:
-    ~SwapchainState() override;  // gives the surface back
-    Queue queue;
-    Surface surface;
-    SwapchainCreateInfo info;
-    Ref<SwapchainChainState> chain;  // null until the surface has an area
-    std::vector<Image> images;
-    std::vector<ImageView> views;
-    // Ring of acquire semaphores, each reused once the queue has reached the
-    // value recorded when the frame that waited on it was presented.
-    std::vector<Semaphore> acquire_semaphores;
-    std::vector<std::uint64_t> acquire_done_values;
-    std::uint32_t next_acquire = 0;
-    VkSurfaceFormatKHR surface_format{};
-    VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
-    VkExtent2D extent{};
-    bool needs_recreate = false;
-    Mutex mutex;
-};
-
-class HeadlessPresenterState final : public RefCounted {
-public:
-    Queue queue;
-    HeadlessPresenterCreateInfo info;
-    std::vector<Image> images;
-    std::vector<ImageView> views;
-    std::uint64_t frame = 0;
-    std::uint32_t last_presented = UINT32_MAX;
-    bool needs_resize = false;
-    mutable Mutex mutex;
-};
-
-}  // namespace detail
-
-inline VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
-inline VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
-inline std::uint32_t Swapchain::image_count() const noexcept { return static_cast<std::uint32_t>(state_->images.size()); }
-inline VkSwapchainKHR Swapchain::vk() const noexcept { return state_->chain ? state_->chain->swapchain : VK_NULL_HANDLE; }
-inline const Surface& Swapchain::surface() const noexcept { return state_->surface; }
-inline const Queue& Swapchain::queue() const noexcept { return state_->queue; }
-inline VkColorSpaceKHR Swapchain::color_space() const noexcept { return state_->surface_format.colorSpace; }
-inline VkPresentModeKHR Swapchain::present_mode() const noexcept { return state_->present_mode; }
-
-inline VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }
-inline VkFormat HeadlessPresenter::format() const noexcept { return state_->info.format; }
-inline std::uint32_t HeadlessPresenter::image_count() const noexcept { return state_->info.image_count; }
-inline std::uint32_t HeadlessPresenter::last_presented() const noexcept { return state_->last_presented; }
 
 VKRC_END_NAMESPACE

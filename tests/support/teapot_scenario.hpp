@@ -14,7 +14,7 @@ namespace vkrc_test {
 
 struct TeapotScenarioOptions {
     // The allocator of every buffer and image (null: the device's default).
-    std::shared_ptr<vkrc::DeviceAllocator> allocator;
+    vkrc::SharedAllocator allocator;
     int frames = 3;
 };
 

@@ -1,6 +1,9 @@
 #include "vk_test.hpp"
 
 #include <cstdlib>
+#include <memory>
+#include <mutex>
+#include <string>
 
 namespace vkrc_test {
 

@@ -12,8 +12,10 @@
 #define GLFW_INCLUDE_NONE  // Vulkan only, no OpenGL headers
 #include <GLFW/glfw3.h>
 
+#include <memory>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace teapot {
 namespace {

@@ -32,6 +32,8 @@
 
 #include <array>
 #include <cstdio>
+#include <memory>
+#include <string>
 
 #ifndef TEAPOT_VKRC_FACTORY
 #error "TEAPOT_VKRC_FACTORY must name this copy's factory (make_vkrc_st_variant or make_vkrc_mt_variant)"

@@ -5,7 +5,6 @@
 #include "vkrc/device.hpp"
 
 #include <deque>
-#include <memory>  // shared_ptr of user allocators
 
 VKRC_BEGIN_NAMESPACE
 class DeviceAllocator;
@@ -22,13 +21,13 @@ struct QueueState {
     VkSemaphore timeline = VK_NULL_HANDLE;
     // The number of the last submit, and of the last one that signalled.
     // Written under mutex.
-    std::atomic<std::uint64_t> submitted{0};
-    std::atomic<std::uint64_t> signalled{0};
-    std::atomic<bool> signal_wanted{false};
+    detail::Atomic<std::uint64_t> submitted{0};
+    detail::Atomic<std::uint64_t> signalled{0};
+    detail::Atomic<bool> signal_wanted{false};
     // The highest submit number known to have completed: read from the
     // timeline, or that of a vkrc-submitted fence seen signalled (a fence
     // signal covers all earlier work on its queue).
-    std::atomic<std::uint64_t> completed{0};
+    detail::Atomic<std::uint64_t> completed{0};
     mutable Mutex mutex;
 
     // The number whose completion means all work submitted so far has
@@ -36,14 +35,14 @@ struct QueueState {
     // (until then only a vkrc fence of that submit or a later one, or a wait
     // for idle, can show it complete).
     std::uint64_t covering_value() noexcept {
-        const std::uint64_t last = submitted.load(std::memory_order_acquire);
-        if (signalled.load(std::memory_order_acquire) < last) signal_wanted.store(true, std::memory_order_relaxed);
+        const std::uint64_t last = submitted.load(__ATOMIC_ACQUIRE);
+        if (signalled.load(__ATOMIC_ACQUIRE) < last) signal_wanted.store(true, __ATOMIC_RELAXED);
         return last;
     }
     // Raises the completed cache to value (several threads may refresh it).
     void note_completed(std::uint64_t value) noexcept {
-        std::uint64_t seen = completed.load(std::memory_order_relaxed);
-        while (seen < value && !completed.compare_exchange_weak(seen, value, std::memory_order_relaxed)) {
+        std::uint64_t seen = completed.load(__ATOMIC_RELAXED);
+        while (seen < value && !completed.compare_exchange_weak(seen, value, __ATOMIC_RELAXED)) {
         }
     }
 };
@@ -71,7 +70,7 @@ public:
     void collect() noexcept;
     // Marks the device lost: the GPU will touch nothing any more, so every
     // queued action may run.
-    void mark_lost() noexcept { lost.store(true, std::memory_order_relaxed); }
+    void mark_lost() noexcept { lost.store(true, __ATOMIC_RELAXED); }
     std::size_t deferred_count() const noexcept;
     // Under the queue's lock: when submits since the last timeline signal
     // carried none, submits an empty batch that signals. value receives a
@@ -90,15 +89,15 @@ public:
     DeviceFunctions fn;
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
-    std::vector<std::string> enabled_extensions;
+    std::vector<Text> enabled_extensions;
     std::deque<QueueState> queues;  // a deque: Queue handles point into it
-    std::atomic<bool> lost{false};
+    detail::Atomic<bool> lost{false};
 
     // Memory (memory.cpp). Every allocator used with the device is kept until
     // teardown, so that deferred frees can still reach it; teardown runs them
     // all, then calls each allocator's release() before destroying the device.
     DeviceAllocator& default_allocator();  // a PoolAllocator, made on first use
-    void keep_allocator(const std::shared_ptr<DeviceAllocator>& allocator);
+    void keep_allocator(const Ref<DeviceAllocator>& allocator);
     void release_allocators() noexcept;
 
 private:
@@ -117,9 +116,9 @@ private:
     mutable Mutex deferred_mutex_;
     std::deque<Batch> deferred_;
     // Read without the lock by collect() to skip it when nothing is queued.
-    std::atomic<std::size_t> deferred_actions_{0};
+    detail::Atomic<std::size_t> deferred_actions_{0};
     Mutex allocators_mutex_;
-    std::vector<std::shared_ptr<DeviceAllocator>> allocators_;  // the default one first, once made
+    std::vector<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
     DeviceAllocator* default_allocator_ = nullptr;
 };
 

@@ -15,7 +15,7 @@ public:
     std::uint32_t api_version = 0;
     GlobalFunctions global_fn;
     InstanceFunctions fn;
-    std::vector<std::string> enabled_extensions;
+    std::vector<Text> enabled_extensions;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     DebugCallback debug_callback;  // the messengers' user data: the state never moves
 };
@@ -27,7 +27,7 @@ public:
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory_properties{};
     std::vector<VkQueueFamilyProperties> queue_families;
-    std::vector<std::string> extensions;
+    std::vector<Text> extensions;
 };
 
 }  // namespace detail
