@@ -458,7 +458,7 @@ Frame HeadlessPresenter::acquire() {
         }
         make_ring(s);
     }
-    const auto index = static_cast<std::uint32_t>(s.frame % s.info.image_count);
+    const auto index = static_cast<std::uint32_t>(s.acquired++ % s.info.image_count);
     frame.status = PresentStatus::success;
     frame.image_index = index;
     frame.image = s.images[index];
@@ -466,17 +466,16 @@ Frame HeadlessPresenter::acquire() {
     frame.extent = s.info.extent;
     frame.format = s.info.format;
     frame.present_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    frame.source_ = &s;
     return frame;
 }
 
 PresentStatus HeadlessPresenter::present(const Frame& frame) {
     auto& s = *state_;
-    if (!frame.image || frame.chain_ || frame.image_index >= s.info.image_count) {
+    if (!frame.image || frame.source_ != &s) {
         throw UsageError("vkrc::HeadlessPresenter::present: the frame was not acquired from this presenter");
     }
-    LockGuard lock(s.mutex);
-    s.last_presented = frame.image_index;
-    ++s.frame;
+    s.last_presented.store(frame.image_index, std::memory_order_relaxed);
     return PresentStatus::success;
 }
 
@@ -538,6 +537,8 @@ VkPresentModeKHR Swapchain::present_mode() const noexcept { return state_->prese
 VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }
 VkFormat HeadlessPresenter::format() const noexcept { return state_->info.format; }
 std::uint32_t HeadlessPresenter::image_count() const noexcept { return state_->info.image_count; }
-std::uint32_t HeadlessPresenter::last_presented() const noexcept { return state_->last_presented; }
+std::uint32_t HeadlessPresenter::last_presented() const noexcept {
+    return state_->last_presented.load(std::memory_order_relaxed);
+}
 
 VKRC_END_NAMESPACE

@@ -54,8 +54,10 @@ public:
     HeadlessPresenterCreateInfo info;
     std::vector<Image> images;
     std::vector<ImageView> views;
-    std::uint64_t frame = 0;
-    std::uint32_t last_presented = UINT32_MAX;
+    std::uint64_t acquired = 0;  // under mutex
+    // Written by present without the lock: present then touches no state it
+    // must read first (its frame is checked against the frame's own fields).
+    Atomic<std::uint32_t> last_presented{UINT32_MAX};
     bool needs_resize = false;
     mutable Mutex mutex;
 };

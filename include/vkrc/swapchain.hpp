@@ -76,6 +76,7 @@ private:
     std::uint32_t sync_count_ = 0;
     std::uint32_t acquire_slot_ = 0;
     detail::SwapchainChainState* chain_ = nullptr;  // kept alive by image
+    const void* source_ = nullptr;  // the headless presenter's state that made it
 };
 
 // The interface the frame loop uses; Swapchain and HeadlessPresenter
@@ -186,9 +187,10 @@ struct HeadlessPresenterCreateInfo {
     VkImageUsageFlags image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
 };
 
-// The Presenter for machines without a display: frame n renders into ring
-// image n % image_count; acquire and present are bookkeeping only (no
-// semaphores, no Vulkan call), as in the teapot benchmark's convention
+// The Presenter for machines without a display: the n-th acquire returns
+// ring image n % image_count; acquire and present are bookkeeping only (no
+// semaphores, no Vulkan call; present records the last presented image and
+// takes no lock), as in the teapot benchmark's convention
 // (bench/teapot/harness/variant.hpp). Like a swapchain image, a ring image
 // is reused image_count frames later: the frame loop's fences keep it from
 // being rewritten while the GPU still renders into it.
