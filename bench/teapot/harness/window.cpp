@@ -56,4 +56,11 @@ void BenchWindow::raise() const { glfwFocusWindow(window_); }
 void poll_window_events() { glfwPollEvents(); }
 void wait_window_events() { glfwWaitEvents(); }
 
+std::vector<const char*> window_instance_extensions() {
+    std::uint32_t count = 0;
+    const char** names = glfwGetRequiredInstanceExtensions(&count);
+    if (!names) throw std::runtime_error("glfwGetRequiredInstanceExtensions failed");
+    return std::vector<const char*>(names, names + count);
+}
+
 }  // namespace teapot

@@ -48,6 +48,10 @@ private:
     GLFWwindow* window_ = nullptr;
 };
 
+// The instance extensions a window surface needs (VK_KHR_surface and the
+// platform's), from glfwGetRequiredInstanceExtensions; throws when GLFW has none.
+std::vector<const char*> window_instance_extensions();
+
 // glfwPollEvents: the harness calls it between blocks (untimed), so that the
 // windows stay responsive. Before each variant's block it also raises that
 // variant's window: the windows overlap, and presenting to the visible one

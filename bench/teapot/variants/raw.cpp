@@ -376,12 +376,8 @@ private:
         messenger.pfnUserCallback = validation_callback;
         std::vector<const char*> extensions;
         if (config_.window) {
-            // The window's extensions (VK_KHR_surface and the platform's).
             window_ = BenchWindow(config_);
-            std::uint32_t count = 0;
-            const char** names = glfwGetRequiredInstanceExtensions(&count);
-            if (!names) throw std::runtime_error("glfwGetRequiredInstanceExtensions failed");
-            extensions.assign(names, names + count);
+            extensions = window_instance_extensions();
         }
         if (config_.validation) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
         VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};

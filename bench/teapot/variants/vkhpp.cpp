@@ -249,12 +249,8 @@ private:
             reinterpret_cast<PFN_vkDebugUtilsMessengerCallbackEXT>(&validation_callback));
         std::vector<const char*> layers, extensions;
         if (config_.window) {
-            // The window's extensions (VK_KHR_surface and the platform's).
             window_ = BenchWindow(config_);
-            std::uint32_t count = 0;
-            const char** names = glfwGetRequiredInstanceExtensions(&count);
-            if (!names) throw std::runtime_error("glfwGetRequiredInstanceExtensions failed");
-            extensions.assign(names, names + count);
+            extensions = window_instance_extensions();
         }
         if (config_.validation) {
             layers.push_back(validation_layer);
