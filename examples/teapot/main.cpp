@@ -1,6 +1,6 @@
 // The teapot benchmark's scene in a resizable window: 25 lit teapots, animated.
-//     teapot [--frames N] [--validation]            a window (closes after N frames)
-//     teapot --headless [--frames N] [--out teapot.png]
+//     teapot [--frames N] [--validation]                          a window (closes after N frames)
+//     teapot --headless [--frames N] [--validation] [--out teapot.png]
 // Read top to bottom: device and presenter, geometry, pipeline, per-frame
 // resources, frame loop. The scene (mesh, animation, camera) is bench/teapot/scene.
 #include <vkrc/glfw.hpp>
@@ -9,27 +9,15 @@
 #include "scene/teapot_scene.hpp"
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
-#include "support/png.hpp"
+#include "support/window_or_headless.hpp"
 
 #include <array>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <exception>
-#include <string>
 
 namespace {
 
 constexpr int teapot_count = 25;
 constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;  // every device can render depth into it
-
-struct Options {
-    bool headless = false;
-    bool validation = false;
-    long frames = -1;  // -1: until the window closes (one frame headless)
-    std::string out_file = "teapot.png";
-};
 
 // A buffer the GPU reads, filled once through a staging copy.
 template <typename T>
@@ -40,7 +28,7 @@ vkrc::Buffer device_buffer(const vkrc::Queue& queue, const std::vector<T>& data,
     return buffer;
 }
 
-int run(const Options& options) {
+int run(const vkrc_examples::WindowOrHeadless& options) {
     // 1. Instance, device and presenter (a window's swapchain or, headless,
     //    a ring of offscreen images), as in examples/triangle.
     vkrc::InstanceCreateInfo instance_info{.application_name = "vkrc teapot", .validation = options.validation};
@@ -118,7 +106,7 @@ int run(const Options& options) {
 
     // 5. The frame loop: acquire, animate, record, submit, present.
     const auto start = std::chrono::steady_clock::now();
-    const long frames = options.frames >= 0 ? options.frames : options.headless ? 1 : -1;
+    const long frames = options.frame_limit();
     for (long n = 0; frames < 0 || n < frames;) {
         if (!options.headless) vkrc::glfw::Window::poll_events();
         if (window.window && window.window.should_close()) break;
@@ -189,34 +177,10 @@ int run(const Options& options) {
     device.wait_idle();
 
     // 6. Headless: read the last image back and write the PNG.
-    if (options.headless && headless.last_presented() != UINT32_MAX) {
-        auto pixels = headless.read_back(headless.last_presented());
-        vkrc_examples::write_png(options.out_file, headless.extent().width, headless.extent().height,
-                                 std::span(reinterpret_cast<const std::uint8_t*>(pixels.data()), pixels.size()));
-        std::printf("wrote %s\n", options.out_file.c_str());
-    }
+    if (options.headless) vkrc_examples::save_last_frame(headless, options.out_file);
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    Options options;
-    for (int i = 1; i < argc; ++i) {
-        const bool has_value = i + 1 < argc;
-        if (std::strcmp(argv[i], "--headless") == 0) options.headless = true;
-        else if (std::strcmp(argv[i], "--validation") == 0) options.validation = true;
-        else if (std::strcmp(argv[i], "--out") == 0 && has_value) options.out_file = argv[++i];
-        else if (std::strcmp(argv[i], "--frames") == 0 && has_value) options.frames = std::strtol(argv[++i], nullptr, 10);
-        else {
-            std::fprintf(stderr, "usage: %s [--headless [--out FILE.png]] [--frames N] [--validation]\n", argv[0]);
-            return 2;
-        }
-    }
-    try {
-        return run(options);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "teapot: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return vkrc_examples::run_example(argc, argv, "teapot", run); }

@@ -1,5 +1,5 @@
 // Draws one coloured triangle in a window, or headless into a PNG, with one frame loop:
-//     triangle [--frames N]                                 a window (closes after N frames)
+//     triangle [--frames N] [--validation]                        a window (closes after N frames)
 //     triangle --headless [--frames N] [--out triangle.png]
 // Read top to bottom: instance and presenter, vertex data, pipeline, frame loop.
 #include <vkrc/glfw.hpp>
@@ -7,14 +7,10 @@
 
 #include "shaders/triangle.frag.h"
 #include "shaders/triangle.vert.h"
-#include "support/png.hpp"
+#include "support/window_or_headless.hpp"
 
 #include <array>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <exception>
-#include <string>
 
 namespace {
 
@@ -22,16 +18,10 @@ struct Vertex {
     float position[2];  // normalised device coordinates, y down
     float color[3];
 };
-struct Options {
-    bool headless = false;
-    long frames = -1;  // -1: until the window closes (one frame headless)
-    std::string out_file = "triangle.png";
-};
-
-int run(const Options& options) {
+int run(const vkrc_examples::WindowOrHeadless& options) {
     // 1. An instance, a device and a presenter: a window's swapchain, or a
     //    ring of offscreen images. The rest of the program does not know which.
-    vkrc::InstanceCreateInfo instance_info{.application_name = "vkrc triangle"};
+    vkrc::InstanceCreateInfo instance_info{.application_name = "vkrc triangle", .validation = options.validation};
     vkrc::DeviceRequirements requirements;
     vkrc::glfw::WindowSurface window;
     if (!options.headless) {
@@ -76,7 +66,7 @@ int run(const Options& options) {
 
     // 5. The frame loop. acquire() re-creates a resized window's swapchain
     //    and returns no image while it is minimised.
-    const long frames = options.frames >= 0 ? options.frames : options.headless ? 1 : -1;
+    const long frames = options.frame_limit();
     for (long n = 0; frames < 0 || n < frames;) {
         if (!options.headless) vkrc::glfw::Window::poll_events();
         if (window.window && window.window.should_close()) break;
@@ -117,33 +107,10 @@ int run(const Options& options) {
     device.wait_idle();
 
     // 6. Headless: read the last image back and write the PNG.
-    if (options.headless && headless.last_presented() != UINT32_MAX) {
-        auto pixels = headless.read_back(headless.last_presented());
-        vkrc_examples::write_png(options.out_file, headless.extent().width, headless.extent().height,
-                                 std::span(reinterpret_cast<const std::uint8_t*>(pixels.data()), pixels.size()));
-        std::printf("wrote %s\n", options.out_file.c_str());
-    }
+    if (options.headless) vkrc_examples::save_last_frame(headless, options.out_file);
     return 0;
 }
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    Options options;
-    for (int i = 1; i < argc; ++i) {
-        const bool has_value = i + 1 < argc;
-        if (std::strcmp(argv[i], "--headless") == 0) options.headless = true;
-        else if (std::strcmp(argv[i], "--out") == 0 && has_value) options.out_file = argv[++i];
-        else if (std::strcmp(argv[i], "--frames") == 0 && has_value) options.frames = std::strtol(argv[++i], nullptr, 10);
-        else {
-            std::fprintf(stderr, "usage: %s [--headless [--out FILE.png]] [--frames N]\n", argv[0]);
-            return 2;
-        }
-    }
-    try {
-        return run(options);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "triangle: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return vkrc_examples::run_example(argc, argv, "triangle", run); }
