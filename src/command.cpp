@@ -84,6 +84,9 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
 }
 }  // namespace
 
+CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept
+    : Handle(std::move(state)), fn_(state_->fn) {}
+
 void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
         throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
