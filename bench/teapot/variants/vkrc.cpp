@@ -12,15 +12,16 @@
 // (include/vkrc/swapchain.hpp, src/swapchain.cpp):
 //   * both: acquire returns a Frame holding the image and its view as
 //     handles (two reference-count increments, and two decrements when the
-//     previous frame is replaced; atomic under vkrc-mt), and acquire and
-//     present take the presenter's mutex (a no-op under vkrc-st). The
-//     headless presenter makes no Vulkan call and uses no semaphore.
+//     previous frame is replaced; atomic under vkrc-mt), and acquire takes
+//     the presenter's mutex (a no-op under vkrc-st). The headless presenter
+//     makes no Vulkan call and uses no semaphore; its present takes no lock.
 //   * Swapchain: its acquire semaphores are a ring of image count + 1 rather
 //     than one per frame slot, since the presenter does not see the
-//     application's fences; before reusing one, acquire waits on the queue's
-//     timeline for the frame that last used it (a vkWaitSemaphores that has
-//     normally already been reached). present also takes the queue's mutex
-//     (no-op under vkrc-st) and records the queue's last submitted value.
+//     application's fences; before reusing one, acquire checks that the
+//     submission that waited on it has completed (normally already known
+//     from this loop's fence waits; otherwise it waits on the queue's
+//     timeline). present also takes the queue's mutex (no-op under vkrc-st)
+//     and records the queue's last submission number.
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
