@@ -256,6 +256,25 @@ inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t
     if (offset > size || bytes > size - offset) [[unlikely]] throw_out_of_range(who, offset, count, element, size);
 }
 
+// The one mapped write, for Allocation and WriteOnlyView: the range check
+// (with VKRC_RUNTIME_CHECKS), the copy, and a flush on non-coherent memory.
+// The caller passes the mapping's fields it already holds, so the view's
+// copies are used without a pointer chase.
+template <class T>
+inline void write_mapped(const char* who, const AllocationState* s, std::byte* mapped, VkDeviceSize size,
+                         bool coherent, VkDeviceSize offset, const T* data, std::size_t count) {
+    static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
+#if VKRC_RUNTIME_CHECKS
+    check_mapped_range(who, offset, count, sizeof(T), size);
+#else
+    (void)who;
+    (void)size;
+#endif
+    if (count == 0) return;
+    std::memcpy(mapped + offset, data, count * sizeof(T));
+    if (!coherent) [[unlikely]] s->flush(offset, count * sizeof(T));
+}
+
 }  // namespace detail
 
 // Writes to upload memory. Reading write-combined memory is slow, so this
@@ -270,13 +289,7 @@ public:
     WriteOnlyView() noexcept = default;
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
-        static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
-#if VKRC_RUNTIME_CHECKS
-        detail::check_mapped_range("vkrc::WriteOnlyView::write", offset, count, sizeof(T), size_);
-#endif
-        if (count == 0) return;
-        std::memcpy(mapped_ + offset, data, count * sizeof(T));
-        if (!coherent_) [[unlikely]] s_->flush(offset, count * sizeof(T));
+        detail::write_mapped("vkrc::WriteOnlyView::write", s_, mapped_, size_, coherent_, offset, data, count);
     }
     template <class T>
     void write(VkDeviceSize offset, std::span<const T> data) const {
@@ -325,15 +338,9 @@ public:
     // do not fit or count * sizeof(T) overflows.
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
-        static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
         auto& s = *state_;
         if (!s.info.mapped) [[unlikely]] detail::throw_not_host_visible("vkrc::Allocation::write");
-#if VKRC_RUNTIME_CHECKS
-        detail::check_mapped_range("vkrc::Allocation::write", offset, count, sizeof(T), s.info.size);
-#endif
-        if (count == 0) return;
-        std::memcpy(s.info.mapped + offset, data, count * sizeof(T));
-        if (!s.coherent) [[unlikely]] s.flush(offset, count * sizeof(T));
+        detail::write_mapped("vkrc::Allocation::write", &s, s.info.mapped, s.info.size, s.coherent, offset, data, count);
     }
     template <class T>
     void write(VkDeviceSize offset, std::span<const T> data) const {
