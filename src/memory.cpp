@@ -184,20 +184,26 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
     return memory;
 }
 
-void AllocationState::flush(VkDeviceSize offset, VkDeviceSize size) const {
-    if (coherent) return;
-    const MemoryRange r = mapped_range(info.offset, info.size, info.memory_size, atom, offset, size);
+namespace {
+// vkFlushMappedMemoryRanges or vkInvalidateMappedMemoryRanges (one signature)
+// over the atom-aligned range that covers the bytes, within the allocation.
+void sync_mapped_range(const AllocationState& s, PFN_vkFlushMappedMemoryRanges DeviceFunctions::*call,
+                       const char* name, VkDeviceSize offset, VkDeviceSize size) {
+    if (s.coherent) return;
+    const MemoryRange r = mapped_range(s.info.offset, s.info.size, s.info.memory_size, s.atom, offset, size);
     if (r.size == 0) return;
-    VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, info.memory, r.offset, r.size};
-    check(device->fn.vkFlushMappedMemoryRanges(device->device, 1, &range), "vkFlushMappedMemoryRanges");
+    VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, s.info.memory, r.offset, r.size};
+    check((s.device->fn.*call)(s.device->device, 1, &range), name);
+}
+}  // namespace
+
+void AllocationState::flush(VkDeviceSize offset, VkDeviceSize size) const {
+    sync_mapped_range(*this, &DeviceFunctions::vkFlushMappedMemoryRanges, "vkFlushMappedMemoryRanges", offset, size);
 }
 
 void AllocationState::invalidate(VkDeviceSize offset, VkDeviceSize size) const {
-    if (coherent) return;
-    const MemoryRange r = mapped_range(info.offset, info.size, info.memory_size, atom, offset, size);
-    if (r.size == 0) return;
-    VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, info.memory, r.offset, r.size};
-    check(device->fn.vkInvalidateMappedMemoryRanges(device->device, 1, &range), "vkInvalidateMappedMemoryRanges");
+    sync_mapped_range(*this, &DeviceFunctions::vkInvalidateMappedMemoryRanges, "vkInvalidateMappedMemoryRanges",
+                      offset, size);
 }
 
 void AllocationState::on_last_release() noexcept {
