@@ -19,15 +19,7 @@ DeviceState::~DeviceState() {
     if (idle != VK_SUCCESS && !lost.load(std::memory_order_relaxed)) {
         // Out of memory while waiting: vkrc's own timelines still say when
         // its submissions are done.
-        for (auto& q : queues) {
-            std::uint64_t value = 0;
-            if (signal_submitted_work(q, value) != VK_SUCCESS) continue;
-            VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-            wait.semaphoreCount = 1;
-            wait.pSemaphores = &q.timeline;
-            wait.pValues = &value;
-            fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
-        }
+        for (auto& q : queues) wait_for_submission(q, q.submitted.load(std::memory_order_acquire));
     }
     for (auto& batch : deferred_) {
         for (auto& action : batch.actions) action.run(*this, action.handle, action.context);
@@ -61,6 +53,29 @@ bool DeviceState::idle_now() noexcept {
         }
     }
     return idle || lost.load(std::memory_order_relaxed);
+}
+
+VkResult DeviceState::wait_for_submission(QueueState& q, std::uint64_t number, const char** failed_call) noexcept {
+    if (q.completed.load(std::memory_order_relaxed) >= number) return VK_SUCCESS;
+    // Waits for a value some submit signals, at or after that submission (the
+    // validation layer of 1.3.239 reports a timeout for values between signals).
+    std::uint64_t value = q.signalled.load(std::memory_order_acquire);
+    if (value < number) {
+        VkResult r = signal_submitted_work(q, value);
+        if (r != VK_SUCCESS) {
+            if (failed_call) *failed_call = "vkQueueSubmit2";
+            return r;
+        }
+    }
+    VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
+    wait.semaphoreCount = 1;
+    wait.pSemaphores = &q.timeline;
+    wait.pValues = &value;
+    VkResult r = fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
+    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+    if (r == VK_SUCCESS) q.note_completed(value);
+    if (r != VK_SUCCESS && failed_call) *failed_call = "vkWaitSemaphores";
+    return r;
 }
 
 VkResult DeviceState::signal_submitted_work(QueueState& q, std::uint64_t& value) noexcept {
@@ -101,8 +116,7 @@ void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
                 // Needs the values of work submitted so far; a batch queued
                 // while the same work was pending is shared.
                 std::vector<std::uint64_t> values;
-                values.reserve(queues.size());
-                for (auto& q : queues) values.push_back(q.covering_value());
+                submitted_snapshot(values);
                 if (deferred_.empty() || deferred_.back().wait_values != values) {
                     deferred_.push_back(Batch{std::move(values), {}});
                 }

@@ -257,22 +257,11 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     return PresentStatus::success;
 }
 
-// Waits until the queue's submission number value has completed (0: nothing
-// to wait for): at once when a fence or the timeline has shown it, otherwise
-// on the timeline, first submitting a signal if no submit has made one yet.
-void wait_for_queue(const Queue& queue, std::uint64_t value) {
-    auto& q = *queue.state();
-    if (q.completed.load(std::memory_order_relaxed) >= value) return;
-    if (q.signalled.load(std::memory_order_acquire) < value) value = queue.completion_value();
-    const Device& device = queue.device();
-    VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
-    wait.semaphoreCount = 1;
-    wait.pSemaphores = &q.timeline;
-    wait.pValues = &value;
-    VkResult r = device.fn().vkWaitSemaphores(device.vk(), &wait, UINT64_MAX);
-    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
-    check(r, "vkWaitSemaphores");
-    q.note_completed(value);
+// Waits until the queue's submission number has completed (0: nothing to wait for).
+void wait_for_queue(const Queue& queue, std::uint64_t number) {
+    const char* failed_call = nullptr;
+    VkResult r = queue.device().state()->wait_for_submission(*queue.state(), number, &failed_call);
+    if (r != VK_SUCCESS) check(r, failed_call);
 }
 
 }  // namespace
@@ -490,7 +479,7 @@ std::vector<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) c
         }
         image = s.images[image_index];
     }
-    wait_for_queue(s.queue, s.queue.completion_value());
+    wait_for_queue(s.queue, s.queue.state()->submitted.load(std::memory_order_acquire));
     return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
 }
 

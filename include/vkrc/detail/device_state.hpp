@@ -77,6 +77,12 @@ public:
     // timeline value, signalled or on its way, that covers all work submitted
     // so far.
     VkResult signal_submitted_work(QueueState& queue, std::uint64_t& value) noexcept;
+    // Waits until the queue's submission number has completed (at once when
+    // a fence or the timeline has already shown it), signalling the timeline
+    // first when no submit has; failed_call, if given, receives the name of
+    // the call that failed.
+    VkResult wait_for_submission(QueueState& queue, std::uint64_t number,
+                                 const char** failed_call = nullptr) noexcept;
 
     // For objects a pool owns (command buffers, descriptor sets), which must
     // be freed under their pool's lock rather than by a DeferredAction: the
