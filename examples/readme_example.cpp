@@ -5,8 +5,9 @@ int main() {
     auto device = vkrc::Device::create(vkrc::PhysicalDevice::select(instance));
     auto queue = device.default_queue();
     instance.reset();  // fine: the device keeps its instance alive
-    auto buffer = vkrc::Buffer::create(device, {.size = 1024, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto buffer = vkrc::Buffer::create(
+        device,
+        {.size = 1024, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
     auto cmd = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}).allocate();
     cmd.begin();
     cmd.fill_buffer(buffer, 0, buffer.size(), 42);

@@ -7,8 +7,8 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 void throw_too_many_color_attachments(std::size_t count) {
-    throw UsageError("vkrc::CommandBuffer::begin_rendering: " + std::to_string(count) + " colour attachments; at most " +
-                     std::to_string(RenderingInfo::max_color_attachments));
+    throw UsageError("vkrc::CommandBuffer::begin_rendering: " + std::to_string(count) +
+                     " colour attachments; at most " + std::to_string(RenderingInfo::max_color_attachments));
 }
 
 CommandPoolState::~CommandPoolState() {
@@ -96,7 +96,8 @@ void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
     begin_with(*state_, info);
 }
 
-void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance, VkCommandBufferUsageFlags flags) const {
+void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
+                                    VkCommandBufferUsageFlags flags) const {
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
         throw UsageError("vkrc::CommandBuffer::begin_secondary: the command buffer is primary");
     }

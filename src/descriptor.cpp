@@ -141,7 +141,8 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, c
                                  VkDeviceSize offset, VkDeviceSize range, std::uint32_t array_element) const {
     constexpr const char* who = "vkrc::DescriptorSet::write_buffer";
     if (!buffer) throw UsageError(std::string(who) + ": the Buffer handle is empty");
-    if (!(buffer.device() == pool().device())) throw UsageError(std::string(who) + ": the buffer belongs to another device");
+    if (!(buffer.device() == pool().device()))
+        throw UsageError(std::string(who) + ": the buffer belongs to another device");
     const VkBufferUsageFlags needs =
         type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC
             ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
@@ -160,7 +161,8 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, co
     if (view && !(view.image().device() == device)) {
         throw UsageError(std::string(who) + ": the image view belongs to another device");
     }
-    if (sampler && !(sampler.device() == device)) throw UsageError(std::string(who) + ": the sampler belongs to another device");
+    if (sampler && !(sampler.device() == device))
+        throw UsageError(std::string(who) + ": the sampler belongs to another device");
     write_image(binding, type, view ? view.vk() : VK_NULL_HANDLE, layout, sampler ? sampler.vk() : VK_NULL_HANDLE,
                 array_element);
 }

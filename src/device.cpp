@@ -227,8 +227,8 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
 }
 
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership,
-                   std::span<const QueueRequest> queues, std::span<const char* const> extensions,
-                   detail::Ref<detail::DeviceState>& state) {
+                 std::span<const QueueRequest> queues, std::span<const char* const> extensions,
+                 detail::Ref<detail::DeviceState>& state) {
     state = detail::Ref<detail::DeviceState>(new detail::DeviceState);
     auto& s = *state;
     s.device = raw;
@@ -255,13 +255,13 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     for (const auto& r : requests) {
         if (r.queue_family_index >= physical.queue_families().size()) {
             throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) +
-                             " does not exist (the device has " +
-                             std::to_string(physical.queue_families().size()) + ")");
+                             " does not exist (the device has " + std::to_string(physical.queue_families().size()) +
+                             ")");
         }
         if (r.queue_priorities.empty() ||
             r.queue_priorities.size() > physical.queue_families()[r.queue_family_index].queueCount) {
-            throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) +
-                             " has " + std::to_string(physical.queue_families()[r.queue_family_index].queueCount) +
+            throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) + " has " +
+                             std::to_string(physical.queue_families()[r.queue_family_index].queueCount) +
                              " queues; asked for " + std::to_string(r.queue_priorities.size()));
         }
         VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -403,7 +403,8 @@ std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fenc
                 tail.pSignalSemaphoreInfos = &timeline;
             }
             r = VK_SUCCESS;
-            if (head > 0) r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
+            if (head > 0)
+                r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
             const bool head_went_in = head > 0 && r == VK_SUCCESS;
             if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
             if (r == VK_SUCCESS) {

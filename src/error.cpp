@@ -10,8 +10,7 @@ VKRC_BEGIN_NAMESPACE
 const char* to_string(VkResult result) noexcept {
     switch (result) {
 #define VKRC_RESULT(name) \
-    case name:            \
-        return #name;
+  case name: return #name;
         VKRC_RESULT(VK_SUCCESS)
         VKRC_RESULT(VK_NOT_READY)
         VKRC_RESULT(VK_TIMEOUT)
@@ -45,15 +44,14 @@ const char* to_string(VkResult result) noexcept {
         VKRC_RESULT(VK_ERROR_INVALID_SHADER_NV)
         VKRC_RESULT(VK_ERROR_FULL_SCREEN_EXCLUSIVE_MODE_LOST_EXT)
 #undef VKRC_RESULT
-        default:
-            return nullptr;
+        default: return nullptr;
     }
 }
 
 Error::Error(VkResult result, const char* call) : result_(result), call_(call) {
     const char* name = vkrc::to_string(result);
-    std::string message = std::string(call) + " failed: " +
-                          (name ? std::string(name) : "VkResult(" + std::to_string(int(result)) + ")");
+    std::string message =
+        std::string(call) + " failed: " + (name ? std::string(name) : "VkResult(" + std::to_string(int(result)) + ")");
     what_ = Text(message.data(), message.size());
 }
 

@@ -8,7 +8,7 @@ GlobalFunctions GlobalFunctions::load(PFN_vkGetInstanceProcAddr get_instance_pro
     GlobalFunctions f;
     f.vkGetInstanceProcAddr = get_instance_proc_addr ? get_instance_proc_addr : ::vkGetInstanceProcAddr;
 #define VKRC_GLOBAL_FUNCTION(name) \
-    f.name = reinterpret_cast<PFN_##name>(f.vkGetInstanceProcAddr(VK_NULL_HANDLE, #name));
+  f.name = reinterpret_cast<PFN_##name>(f.vkGetInstanceProcAddr(VK_NULL_HANDLE, #name));
 #include "vkrc/detail/function_list.inl"
     if (!f.vkCreateInstance) {
         throw Error(VK_ERROR_INITIALIZATION_FAILED, "vkGetInstanceProcAddr(vkCreateInstance)");
@@ -18,8 +18,7 @@ GlobalFunctions GlobalFunctions::load(PFN_vkGetInstanceProcAddr get_instance_pro
 
 InstanceFunctions InstanceFunctions::load(PFN_vkGetInstanceProcAddr get_instance_proc_addr, VkInstance instance) {
     InstanceFunctions f;
-#define VKRC_INSTANCE_FUNCTION(name) \
-    f.name = reinterpret_cast<PFN_##name>(get_instance_proc_addr(instance, #name));
+#define VKRC_INSTANCE_FUNCTION(name) f.name = reinterpret_cast<PFN_##name>(get_instance_proc_addr(instance, #name));
 #include "vkrc/detail/function_list.inl"
     return f;
 }

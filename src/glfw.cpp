@@ -18,8 +18,8 @@ int live_windows = 0;  // main thread only (GLFW's rule)
 [[noreturn]] void throw_glfw(const char* call) {
     const char* description = nullptr;
     glfwGetError(&description);
-    throw std::runtime_error(std::string(call) + " failed: " +
-                             (description ? description : "no GLFW error description"));
+    throw std::runtime_error(std::string(call) +
+                             " failed: " + (description ? description : "no GLFW error description"));
 }
 
 void init() {

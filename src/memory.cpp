@@ -35,7 +35,8 @@ void fill_budget(DeviceView device, AllocatorStatistics& stats) noexcept {
     const auto& props = device.memory_properties();
     stats.heap_count = props.memoryHeapCount;
     if (device.extension_enabled(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
-        VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+        VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
         VkPhysicalDeviceMemoryProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2, &budget};
         const auto& physical = device.physical_device();
         physical.fn().vkGetPhysicalDeviceMemoryProperties2(physical.vk(), &props2);
@@ -100,8 +101,7 @@ int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::ui
                      const MemoryIntent& intent) noexcept {
     const auto [required, preferred, avoided] = flags_of(intent);
     // Memory only special resources may use is never chosen unless required.
-    const VkMemoryPropertyFlags special = VK_MEMORY_PROPERTY_PROTECTED_BIT |
-                                          VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT |
+    const VkMemoryPropertyFlags special = VK_MEMORY_PROPERTY_PROTECTED_BIT | VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT |
                                           VK_MEMORY_PROPERTY_DEVICE_COHERENT_BIT_AMD;
     int best = -1;
     int best_score = 0;
@@ -187,8 +187,8 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 namespace {
 // vkFlushMappedMemoryRanges or vkInvalidateMappedMemoryRanges (one signature)
 // over the atom-aligned range that covers the bytes, within the allocation.
-void sync_mapped_range(const AllocationState& s, PFN_vkFlushMappedMemoryRanges DeviceFunctions::*call,
-                       const char* name, VkDeviceSize offset, VkDeviceSize size) {
+void sync_mapped_range(const AllocationState& s, PFN_vkFlushMappedMemoryRanges DeviceFunctions::*call, const char* name,
+                       VkDeviceSize offset, VkDeviceSize size) {
     if (s.coherent) return;
     const MemoryRange r = mapped_range(s.info.offset, s.info.size, s.info.memory_size, s.atom, offset, size);
     if (r.size == 0) return;
@@ -202,8 +202,8 @@ void AllocationState::flush(VkDeviceSize offset, VkDeviceSize size) const {
 }
 
 void AllocationState::invalidate(VkDeviceSize offset, VkDeviceSize size) const {
-    sync_mapped_range(*this, &DeviceFunctions::vkInvalidateMappedMemoryRanges, "vkInvalidateMappedMemoryRanges",
-                      offset, size);
+    sync_mapped_range(*this, &DeviceFunctions::vkInvalidateMappedMemoryRanges, "vkInvalidateMappedMemoryRanges", offset,
+                      size);
 }
 
 void AllocationState::on_last_release() noexcept {
@@ -270,7 +270,8 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
     }
     st->device = detail::Ref<detail::DeviceState>::share(&s);
     st->allocator = a;
-    const VkMemoryPropertyFlags flags = device.physical_device().memory_properties().memoryTypes[info.memory_type].propertyFlags;
+    const VkMemoryPropertyFlags flags =
+        device.physical_device().memory_properties().memoryTypes[info.memory_type].propertyFlags;
     st->coherent = (flags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) || !(flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT);
     st->atom = std::max<VkDeviceSize>(1, device.physical_device().properties().limits.nonCoherentAtomSize);
     // GPU-only memory is not for the host even where the type is mappable,
@@ -325,10 +326,9 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
     }
     AllocationInfo info;
     try {
-        info.memory = detail::allocate_device_memory(device, request.requirements.size, type,
-                                                     dedicated_info ? request.dedicated_buffer : VK_NULL_HANDLE,
-                                                     dedicated_info ? request.dedicated_image : VK_NULL_HANDLE,
-                                                     &info.mapped);
+        info.memory = detail::allocate_device_memory(
+            device, request.requirements.size, type, dedicated_info ? request.dedicated_buffer : VK_NULL_HANDLE,
+            dedicated_info ? request.dedicated_image : VK_NULL_HANDLE, &info.mapped);
     } catch (...) {
         LockGuard lock(mutex_);
         --memory_objects_;

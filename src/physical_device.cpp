@@ -90,8 +90,8 @@ PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequ
             continue;
         }
         auto type = device.properties().deviceType;
-        auto rank = static_cast<std::size_t>(
-            std::find(req.preferred_types.begin(), req.preferred_types.end(), type) - req.preferred_types.begin());
+        auto rank = static_cast<std::size_t>(std::find(req.preferred_types.begin(), req.preferred_types.end(), type) -
+                                             req.preferred_types.begin());
         if (rank < best_rank) {
             best_rank = rank;
             best = device;

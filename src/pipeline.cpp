@@ -41,7 +41,8 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
     std::vector<VkDescriptorSetLayout> sets;
     for (const auto& l : info.set_layouts) {
         require(static_cast<bool>(l), "vkrc::PipelineLayout::create", "a DescriptorSetLayout handle is empty");
-        require(l.device() == device, "vkrc::PipelineLayout::create", "a DescriptorSetLayout belongs to another device");
+        require(l.device() == device, "vkrc::PipelineLayout::create",
+                "a DescriptorSetLayout belongs to another device");
         sets.push_back(l.vk());
     }
     VkPipelineLayoutCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -170,8 +171,7 @@ PipelineCache PipelineCache::load(const Device& device, const char* file) {
         problem = cache_data_problem(device.physical_device(), data);
     }
     if (problem) {
-        std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n",
-                     file, problem);
+        std::fprintf(stderr, "vkrc warning: PipelineCache::load: %s %s; starting with an empty cache\n", file, problem);
         return create(device);
     }
     return create(device, data);
@@ -182,7 +182,8 @@ std::vector<std::byte> PipelineCache::data() const {
     std::size_t size = 0;
     check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, nullptr), "vkGetPipelineCacheData");
     std::vector<std::byte> out(size);
-    VkResult r = check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, out.data()), "vkGetPipelineCacheData");
+    VkResult r =
+        check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, out.data()), "vkGetPipelineCacheData");
     out.resize(size);
     (void)r;  // VK_INCOMPLETE only if the cache grew in between: the prefix is a valid cache
     return out;

@@ -220,7 +220,8 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
     VkDeviceSize size = std::min(info.min_block_size, max_size);
     while (size < max_size && size * 2 <= reserved / 4) size *= 2;
     size = std::max(size, at_least);
-    if (memory_objects >= d.limits().maxMemoryAllocationCount) throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
+    if (memory_objects >= d.limits().maxMemoryAllocationCount)
+        throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
     auto block = std::make_unique<Block>();
     Node* node = nodes.make();
     try {

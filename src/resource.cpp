@@ -13,10 +13,12 @@ namespace detail {
 // members (the allocation, then the parents) are released after, so FIFO
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
-    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
+    if (device && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
 }
 ImageState::~ImageState() {
-    if (device && ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
+    if (device && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
 }
 ImageViewState::~ImageViewState() {
     if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view);
@@ -32,8 +34,8 @@ SamplerState::~SamplerState() {
 
 namespace {
 
-AllocationRequest make_request(const VkMemoryRequirements2& requirements, const VkMemoryDedicatedRequirements& dedicated,
-                               const MemoryIntent& intent) {
+AllocationRequest make_request(const VkMemoryRequirements2& requirements,
+                               const VkMemoryDedicatedRequirements& dedicated, const MemoryIntent& intent) {
     AllocationRequest request;
     request.requirements = requirements.memoryRequirements;
     request.intent = intent;
@@ -54,7 +56,8 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
         // an out-of-memory from the allocator's alignment arithmetic.
         const auto& memory = device.physical_device().memory_properties();
         VkDeviceSize largest = 0;
-        for (std::uint32_t i = 0; i < memory.memoryHeapCount; ++i) largest = std::max(largest, memory.memoryHeaps[i].size);
+        for (std::uint32_t i = 0; i < memory.memoryHeapCount; ++i)
+            largest = std::max(largest, memory.memoryHeaps[i].size);
         if (info.size > largest) {
             throw UsageError("vkrc::Buffer::create: size " + std::to_string(info.size) +
                              " is larger than every memory heap of the device (the largest has " +
@@ -203,19 +206,22 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
         return base < total && (count == VK_REMAINING_MIP_LEVELS || (count != 0 && count <= total - base));
     };
     if (!range_fits(r.baseMipLevel, r.levelCount, image.mip_levels())) {
-        throw UsageError(std::string(who) + ": mip levels " + std::to_string(r.baseMipLevel) + "+" +
-                         (r.levelCount == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(r.levelCount)) +
-                         " are outside the image's " + std::to_string(image.mip_levels()) + " levels");
+        throw UsageError(
+            std::string(who) + ": mip levels " + std::to_string(r.baseMipLevel) + "+" +
+            (r.levelCount == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(r.levelCount)) +
+            " are outside the image's " + std::to_string(image.mip_levels()) + " levels");
     }
     if (!range_fits(r.baseArrayLayer, r.layerCount, image.array_layers())) {
-        throw UsageError(std::string(who) + ": array layers " + std::to_string(r.baseArrayLayer) + "+" +
-                         (r.layerCount == VK_REMAINING_ARRAY_LAYERS ? std::string("remaining") : std::to_string(r.layerCount)) +
-                         " are outside the image's " + std::to_string(image.array_layers()) + " layers");
+        throw UsageError(
+            std::string(who) + ": array layers " + std::to_string(r.baseArrayLayer) + "+" +
+            (r.layerCount == VK_REMAINING_ARRAY_LAYERS ? std::string("remaining") : std::to_string(r.layerCount)) +
+            " are outside the image's " + std::to_string(image.array_layers()) + " layers");
     }
     if (create.format != image.format()) {
         if (!(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT)) {
-            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) + " differs from the image's " +
-                             std::to_string(image.format()) + " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
+            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) +
+                             " differs from the image's " + std::to_string(image.format()) +
+                             " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
         }
         const std::uint32_t view_texel = format_texel_size(create.format);
         const std::uint32_t image_texel = format_texel_size(image.format());

@@ -19,7 +19,7 @@ namespace {
 constexpr std::uint32_t spirv_magic = 0x07230203;
 
 void make(const Device& device, const void* code, std::size_t bytes, const char* who,
-                  detail::Ref<detail::ShaderModuleState>& s) {
+          detail::Ref<detail::ShaderModuleState>& s) {
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
     if (bytes == 0) throw UsageError(std::string(who) + ": the SPIR-V module is empty");
     if (bytes % 4 != 0) {
@@ -39,7 +39,6 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
     s = detail::Ref<detail::ShaderModuleState>(new detail::ShaderModuleState);
     s->device = device;
     check(device.fn().vkCreateShaderModule(device.vk(), &info, nullptr, &s->module), "vkCreateShaderModule");
-
 }
 }  // namespace
 

@@ -35,7 +35,8 @@ SwapchainChainState::~SwapchainChainState() {
     s->add_ref();
     if (last) {
         device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
-                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits),
+                                                                 nullptr);
                                       auto* surface_state = static_cast<SurfaceState*>(context);
                                       {
                                           LockGuard lock(surface_state->mutex);
@@ -46,7 +47,8 @@ SwapchainChainState::~SwapchainChainState() {
                                   handle_bits(swapchain), s});
     } else {
         device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
-                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits),
+                                                                 nullptr);
                                       static_cast<SurfaceState*>(context)->release();
                                   },
                                   handle_bits(swapchain), s});
@@ -166,8 +168,8 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     }
     if ((caps.supportedUsageFlags & s.info.image_usage) != s.info.image_usage) {
         throw UsageError("vkrc::Swapchain: the surface does not support image_usage " +
-                         std::to_string(s.info.image_usage) + " (supported: " +
-                         std::to_string(caps.supportedUsageFlags) + ")");
+                         std::to_string(s.info.image_usage) +
+                         " (supported: " + std::to_string(caps.supportedUsageFlags) + ")");
     }
     std::uint32_t count = std::max(s.info.min_image_count, caps.minImageCount);
     if (caps.maxImageCount != 0) count = std::min(count, caps.maxImageCount);
@@ -214,7 +216,8 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     std::vector<ImageView> views;
     try {
         std::uint32_t n = 0;
-        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, nullptr), "vkGetSwapchainImagesKHR");
+        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, nullptr),
+              "vkGetSwapchainImagesKHR");
         std::vector<VkImage> raw(n);
         check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, raw.data()),
               "vkGetSwapchainImagesKHR");
@@ -291,7 +294,8 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const Sw
         {
             LockGuard lock(surface_state.mutex);
             if (surface_state.taken) {
-                throw UsageError("vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
+                throw UsageError(
+                    "vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
             }
             if (!surface_state.releasing) {
                 surface_state.taken = true;
@@ -299,8 +303,9 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const Sw
             }
         }
         if (waited) {
-            throw UsageError("vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
-                             "Image holds one of its images, or another device has not destroyed it)");
+            throw UsageError(
+                "vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
+                "Image holds one of its images, or another device has not destroyed it)");
         }
         // The previous Swapchain's Vulkan swapchain is not retired: its
         // destruction must run before a new one can be made for the surface.

@@ -91,7 +91,7 @@ void Fence::unsignal() const {
 
 namespace {
 void make_semaphore(const Device& device, SemaphoreType type, std::uint64_t initial,
-                         detail::Ref<detail::SemaphoreState>& s) {
+                    detail::Ref<detail::SemaphoreState>& s) {
     VkSemaphoreTypeCreateInfo type_info{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type_info.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     type_info.initialValue = initial;
@@ -130,7 +130,8 @@ Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, Semaphor
 
 namespace {
 void require_timeline(const Semaphore& s, const char* who) {
-    if (s.type() != SemaphoreType::timeline) throw UsageError(std::string(who) + ": the semaphore is binary, not timeline");
+    if (s.type() != SemaphoreType::timeline)
+        throw UsageError(std::string(who) + ": the semaphore is binary, not timeline");
 }
 }  // namespace
 

@@ -89,9 +89,9 @@ public:
         device_.collect_garbage();
     }
 
-    void image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
-                       VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                       const VkImageSubresourceRange& range) const {
+    void image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
+                       VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
+                       VkAccessFlags2 dst_access, const VkImageSubresourceRange& range) const {
         VkImageMemoryBarrier2 b = vkrc::image_barrier(image, old_layout, new_layout, src_stage, src_access, dst_stage,
                                                       dst_access, range.aspectMask);
         b.subresourceRange = range;
@@ -167,7 +167,8 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
     }
     if (offset > buffer.size() || data.size() > buffer.size() - offset) {
         throw UsageError(std::string(who) + ": " + std::to_string(data.size()) + " bytes at offset " +
-                         std::to_string(offset) + " do not fit in the " + std::to_string(buffer.size()) + "-byte buffer");
+                         std::to_string(offset) + " do not fit in the " + std::to_string(buffer.size()) +
+                         "-byte buffer");
     }
     if (data.empty()) return;
     Buffer staging = staging_buffer(buffer.device(), data.size(), MemoryUsage::upload);
@@ -177,11 +178,13 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
     commands.fn().vkCmdCopyBuffer(commands.cmd(), staging.vk(), buffer.vk(), 1, &region);
     // Later submissions see the copy (their commands are in the second scope).
     commands.memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+                            VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                            VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
     commands.submit_and_wait();
 }
 
-std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) {
+std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset,
+                                       VkDeviceSize size) {
     constexpr const char* who = "vkrc::download_buffer";
     if (!buffer) throw UsageError(std::string(who) + ": the Buffer is empty");
     check_queue(queue, buffer.device(), who);
@@ -214,13 +217,15 @@ VkDeviceSize image_data_size(const Image& image) {
     for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
         const VkDeviceSize level_bytes = checked_mul(level_size(image, level, texel, "vkrc::image_data_size"),
                                                      image.array_layers(), "vkrc::image_data_size");
-        if (total + level_bytes < total) throw UsageError("vkrc::image_data_size: the image's size in bytes overflows 64 bits");
+        if (total + level_bytes < total)
+            throw UsageError("vkrc::image_data_size: the image's size in bytes overflows 64 bits");
         total += level_bytes;
     }
     return total;
 }
 
-void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info) {
+void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
+                  const ImageUploadInfo& info) {
     constexpr const char* who = "vkrc::upload_image";
     if (!image) throw UsageError(std::string(who) + ": the Image is empty");
     check_queue(queue, image.device(), who);
@@ -230,8 +235,8 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
     const std::uint32_t texel = checked_texel_size(image, who);
     const VkDeviceSize expected = image_data_size(image);
     if (data.size() != expected) {
-        throw UsageError(std::string(who) + ": " + std::to_string(data.size()) + " bytes given; every level and layer of " +
-                         "the image takes " + std::to_string(expected));
+        throw UsageError(std::string(who) + ": " + std::to_string(data.size()) +
+                         " bytes given; every level and layer of " + "the image takes " + std::to_string(expected));
     }
     if (info.new_layout == VK_IMAGE_LAYOUT_UNDEFINED || info.new_layout == VK_IMAGE_LAYOUT_PREINITIALIZED) {
         throw UsageError(std::string(who) + ": new_layout must be a layout an image can be transitioned to");
@@ -261,8 +266,8 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
     // From the copy to whatever later work does with the image.
     commands.image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, info.new_layout,
                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
-                           all);
+                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                           VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, all);
     commands.submit_and_wait();
 }
 
@@ -284,13 +289,14 @@ std::vector<std::byte> download_image(const Queue& queue, const Image& image, Vk
     Buffer readback = staging_buffer(image.device(), size, MemoryUsage::readback);
     const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, mip_level, 1, array_layer, 1};
     OneTimeCommands commands(queue);
-    commands.image_barrier(image.vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                           VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, range);
+    commands.image_barrier(image.vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, range);
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip_level, array_layer, 1};
     region.imageExtent = image.extent(mip_level);
-    commands.fn().vkCmdCopyImageToBuffer(commands.cmd(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.vk(),
-                                         1, &region);
+    commands.fn().vkCmdCopyImageToBuffer(commands.cmd(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                         readback.vk(), 1, &region);
     commands.image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout, VK_PIPELINE_STAGE_2_COPY_BIT,
                            VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                            VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, range);

@@ -43,7 +43,8 @@ TEST_F(VulkanTest, ZeroAndOverflowingBufferSizesAreRejected) {
 }
 
 TEST_F(VulkanTest, ImageSizeThatOverflowsInStagingIsRejected) {
-    auto real = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    auto real =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     // An adopted image is described by the application; a description whose
     // byte size wraps 64 bits must not turn into a small staging buffer.
     auto huge = vkrc::Image::adopt(device, real.vk(),
@@ -66,15 +67,17 @@ TEST_F(VulkanTest, MappingMemoryThatIsNotHostVisibleIsRejected) {
 
 #if VKRC_RUNTIME_CHECKS
 TEST_F(VulkanTest, WritingPastTheEndOfAMappingIsRejected) {
-    auto upload = vkrc::Buffer::create(device, {.size = 16,
-                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                                                .memory = {.usage = vkrc::MemoryUsage::upload}});
+    auto upload = vkrc::Buffer::create(
+        device,
+        {.size = 16, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::upload}});
     const std::size_t size = upload.allocation().size();
     std::vector<std::uint32_t> words(size / 4 + 1);
     expect_usage_error([&] { upload.allocation().write(0, std::span<const std::uint32_t>(words)); },
                        {"vkrc::Allocation::write"});
-    expect_usage_error([&] { upload.allocation().write_value(size - 2, std::uint32_t{7}); }, {"vkrc::Allocation::write"});
-    expect_usage_error([&] { upload.allocation().write(UINT64_MAX - 1, words.data(), 1); }, {"vkrc::Allocation::write"});
+    expect_usage_error([&] { upload.allocation().write_value(size - 2, std::uint32_t{7}); },
+                       {"vkrc::Allocation::write"});
+    expect_usage_error([&] { upload.allocation().write(UINT64_MAX - 1, words.data(), 1); },
+                       {"vkrc::Allocation::write"});
 }
 #endif
 
@@ -85,8 +88,8 @@ TEST_F(VulkanTest, ObjectsOfOneDeviceAreRejectedByAnother) {
         device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}}});
     auto other_layout = vkrc::DescriptorSetLayout::create(
         other, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}}});
-    auto other_pool = vkrc::DescriptorPool::create(
-        other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1}}});
+    auto other_pool =
+        vkrc::DescriptorPool::create(other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1}}});
     auto other_set = other_pool.allocate(other_layout);
 
     expect_usage_error([&] { other_set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer); },
@@ -100,11 +103,14 @@ TEST_F(VulkanTest, ObjectsOfOneDeviceAreRejectedByAnother) {
     auto view = vkrc::ImageView::create(image);
     auto other_image_layout = vkrc::DescriptorSetLayout::create(
         other, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE}}});
-    auto other_image_pool = vkrc::DescriptorPool::create(
-        other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1}}});
+    auto other_image_pool =
+        vkrc::DescriptorPool::create(other, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 1}}});
     auto other_image_set = other_image_pool.allocate(other_image_layout);
     expect_usage_error(
-        [&] { other_image_set.write_image(0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL); },
+        [&] {
+            other_image_set.write_image(0, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, view,
+                                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        },
         {"vkrc::DescriptorSet::write_image", "another device"});
 #if VKRC_RUNTIME_CHECKS
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
@@ -115,20 +121,23 @@ TEST_F(VulkanTest, ObjectsOfOneDeviceAreRejectedByAnother) {
     expect_usage_error([&] { vkrc::submit(other.default_queue(), {.command_buffers = cmds}); },
                        {"vkrc::submit", "another device"});
     auto fence = vkrc::Fence::create(device);
-    expect_usage_error([&] { vkrc::submit(other.default_queue(), vkrc::SubmitBatch{}, fence); }, {"vkrc::submit", "another device"});
+    expect_usage_error([&] { vkrc::submit(other.default_queue(), vkrc::SubmitBatch{}, fence); },
+                       {"vkrc::submit", "another device"});
 #endif
 }
 
 TEST_F(VulkanTest, DescriptorWritesMustMatchTheLayout) {
     auto layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptor_count = 2}}});
-    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2}}});
+        device,
+        {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptor_count = 2}}});
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2}}});
     auto set = pool.allocate(layout);
-    auto buffer = vkrc::Buffer::create(device, {.size = 256,
-                                                .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT |
-                                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
-    expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer); },
-                       {"vkrc::DescriptorSet::write_buffer", "binding 0 has descriptor type 6", "the write has type 7"});
+    auto buffer = vkrc::Buffer::create(
+        device, {.size = 256, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+    expect_usage_error(
+        [&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer); },
+        {"vkrc::DescriptorSet::write_buffer", "binding 0 has descriptor type 6", "the write has type 7"});
     expect_usage_error([&] { set.write_buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer); },
                        {"vkrc::DescriptorSet::write_buffer", "no binding 3"});
     expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer, 0, VK_WHOLE_SIZE, 2); },
@@ -148,12 +157,21 @@ TEST_F(VulkanTest, ImageViewsMustFitTheirImage) {
                                               .mip_levels = 2,
                                               .array_layers = 2,
                                               .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
-    expect_usage_error([&] { vkrc::ImageView::create(image, {.subresource_range = {0, 2, 1, 0, 1}}); },
-                       {"vkrc::ImageView::create", "mip levels 2+1", "2 levels"});
-    expect_usage_error([&] { vkrc::ImageView::create(image, {.subresource_range = {0, 1, 2, 0, 1}}); },
-                       {"vkrc::ImageView::create", "mip levels 1+2"});
     expect_usage_error(
-        [&] { vkrc::ImageView::create(image, {.view_type = VK_IMAGE_VIEW_TYPE_2D_ARRAY, .subresource_range = {0, 0, 1, 1, 5}}); },
+        [&] {
+            vkrc::ImageView::create(image, {.subresource_range = {0, 2, 1, 0, 1}});
+        },
+        {"vkrc::ImageView::create", "mip levels 2+1", "2 levels"});
+    expect_usage_error(
+        [&] {
+            vkrc::ImageView::create(image, {.subresource_range = {0, 1, 2, 0, 1}});
+        },
+        {"vkrc::ImageView::create", "mip levels 1+2"});
+    expect_usage_error(
+        [&] {
+            vkrc::ImageView::create(image,
+                                    {.view_type = VK_IMAGE_VIEW_TYPE_2D_ARRAY, .subresource_range = {0, 0, 1, 1, 5}});
+        },
         {"vkrc::ImageView::create", "array layers 1+5", "2 layers"});
     expect_usage_error([&] { vkrc::ImageView::create(image, {.format = VK_FORMAT_R32_SFLOAT}); },
                        {"vkrc::ImageView::create", "MUTABLE_FORMAT_BIT"});
@@ -174,8 +192,11 @@ TEST_F(VulkanTest, MoreThanEightColourAttachmentsAreRejected) {
     auto cmd = pool.allocate();
     cmd.begin();
     std::array<vkrc::RenderingAttachment, 9> colors{};
-    expect_usage_error([&] { cmd.begin_rendering({.render_area = {{0, 0}, {8, 8}}, .color_attachments = colors}); },
-                       {"vkrc::CommandBuffer::begin_rendering", "9 colour attachments", "at most 8"});
+    expect_usage_error(
+        [&] {
+            cmd.begin_rendering({.render_area = {{0, 0}, {8, 8}}, .color_attachments = colors});
+        },
+        {"vkrc::CommandBuffer::begin_rendering", "9 colour attachments", "at most 8"});
     cmd.end();
 }
 #endif

@@ -37,15 +37,16 @@ TEST_F(VulkanTest, DroppingEverythingAfterSubmitDefersDestruction) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     {
         auto set_layout = vkrc::DescriptorSetLayout::create(
-            device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            device, {.bindings = {{.binding = 0,
+                                   .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                    .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
         auto layout = vkrc::PipelineLayout::create(
-            device, {.set_layouts = {set_layout},
-                     .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
+            device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
         auto descriptors = vkrc::DescriptorPool::create(
             device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
         auto set = descriptors.allocate(set_layout);
-        auto pipeline = vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        auto pipeline =
+            vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
         auto cmd = pool.allocate();
         cmd.begin();
         cmd.bind_pipeline(pipeline);
@@ -89,8 +90,8 @@ TEST_F(VulkanTest, DescriptorSetsOfAPoolWithoutFreeBit) {
 TEST_F(VulkanTest, FreedDescriptorSetsReturnToTheirPool) {
     auto set_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
-    auto pool = vkrc::DescriptorPool::create(
-        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
     // A pool of one set serves any number of allocate/drop rounds.
     for (int i = 0; i < 4; ++i) {
         auto set = pool.allocate(set_layout);
@@ -103,7 +104,8 @@ TEST_F(VulkanTest, FreedDescriptorSetsReturnToTheirPool) {
 TEST_F(VulkanTest, SecondariesFromFourThreads) {
     constexpr int threads = 4;
     constexpr std::uint32_t per_thread = 2;
-    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE) GTEST_SKIP() << "the device lacks timestampComputeAndGraphics (lavapipe has it)";
+    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE)
+        GTEST_SKIP() << "the device lacks timestampComputeAndGraphics (lavapipe has it)";
     auto queries = vkrc::QueryPool::create(device, {.query_count = threads * per_thread});
     std::vector<vkrc::CommandPool> pools;
     for (int t = 0; t < threads; ++t) {

@@ -51,15 +51,13 @@ struct World {
         physical_device = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
         device = vkrc::Device::create(physical_device);
         queue = device.default_queue();
-        buffer = vkrc::Buffer::create(device, {.size = 1 << 16,
-                                               .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                                        VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT});
-        mapped = vkrc::Buffer::create(device, {.size = 256,
-                                               .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                               .memory = {.usage = vkrc::MemoryUsage::upload}});
-        image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
-                                             .extent = {16, 16, 1},
-                                             .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+        buffer = vkrc::Buffer::create(
+            device, {.size = 1 << 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT});
+        mapped = vkrc::Buffer::create(
+            device,
+            {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT, .memory = {.usage = vkrc::MemoryUsage::upload}});
+        image = vkrc::Image::create(
+            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {16, 16, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
         view = vkrc::ImageView::create(image);
         sampler = vkrc::Sampler::create(device);
         command_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
@@ -96,16 +94,26 @@ struct World {
 
     // Every handle, each with a way to drop it.
     std::vector<std::function<void()>> droppers() {
-        return {[this] { instance.reset(); },   [this] { physical_device.reset(); },
-                [this] { device.reset(); },     [this] { queue = {}; },
-                [this] { buffer.reset(); },     [this] { mapped.reset(); },
-                [this] { image.reset(); },      [this] { view.reset(); },
-                [this] { sampler.reset(); },    [this] { command_pool.reset(); },
-                [this] { cmd.reset(); },        [this] { fence.reset(); },
-                [this] { idle_fence.reset(); }, [this] { timeline.reset(); },
-                [this] { binary.reset(); },     [this] { event.reset(); },
-                [this] { queries.reset(); },    [this] { set_layout.reset(); },
-                [this] { descriptor_pool.reset(); }, [this] { set.reset(); }};
+        return {[this] { instance.reset(); },
+                [this] { physical_device.reset(); },
+                [this] { device.reset(); },
+                [this] { queue = {}; },
+                [this] { buffer.reset(); },
+                [this] { mapped.reset(); },
+                [this] { image.reset(); },
+                [this] { view.reset(); },
+                [this] { sampler.reset(); },
+                [this] { command_pool.reset(); },
+                [this] { cmd.reset(); },
+                [this] { fence.reset(); },
+                [this] { idle_fence.reset(); },
+                [this] { timeline.reset(); },
+                [this] { binary.reset(); },
+                [this] { event.reset(); },
+                [this] { queries.reset(); },
+                [this] { set_layout.reset(); },
+                [this] { descriptor_pool.reset(); },
+                [this] { set.reset(); }};
     }
 };
 
@@ -146,8 +154,7 @@ void lose_and_drop(Observer how, unsigned seed) {
     EXPECT_THROW(w.timeline.wait(1000), vkrc::DeviceLostError);
     EXPECT_THROW(w.queue.wait_idle(), vkrc::DeviceLostError);
     EXPECT_THROW(w.device.wait_idle(), vkrc::DeviceLostError);
-    EXPECT_THROW(vkrc::upload_buffer(w.queue, w.buffer, 0, std::as_bytes(std::span("data", 4))),
-                 vkrc::DeviceLostError);
+    EXPECT_THROW(vkrc::upload_buffer(w.queue, w.buffer, 0, std::as_bytes(std::span("data", 4))), vkrc::DeviceLostError);
     // The pools' pending lists count as done.
     auto another = w.command_pool.allocate();
     EXPECT_EQ(w.command_pool.pending_free_count(), 0u);

@@ -120,8 +120,10 @@ TEST_F(VulkanTest, AdoptedBorrowedDeviceIsNotDestroyed) {
         borrowed.default_queue().wait_idle();
     }
     // Still valid after the wrapper went; the test destroys it itself.
-    auto destroy = reinterpret_cast<PFN_vkDestroyDevice>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDestroyDevice"));
-    auto wait = reinterpret_cast<PFN_vkDeviceWaitIdle>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDeviceWaitIdle"));
+    auto destroy =
+        reinterpret_cast<PFN_vkDestroyDevice>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDestroyDevice"));
+    auto wait =
+        reinterpret_cast<PFN_vkDeviceWaitIdle>(physical_device.fn().vkGetDeviceProcAddr(raw, "vkDeviceWaitIdle"));
     EXPECT_EQ(wait(raw), VK_SUCCESS);
     destroy(raw, nullptr);
 }

@@ -65,7 +65,8 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
             if (!all_errors() && e != k % injected_errors.size()) continue;
             const VkResult error = injected_errors[e];
             ++runs;
-            if (first) std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
+            if (first)
+                std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
             faults::arm(k, error);
             try {
                 vkrc_test::run_teapot_scenario(info);
@@ -86,17 +87,18 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
                 EXPECT_LT(faults::failable_calls(), k) << "call " << k << " was made but the failure not returned";
             }
             auto messages = log->take();
-            EXPECT_TRUE(messages.empty()) << "injecting " << vkrc::to_string(error) << " into call " << k << " ("
-                                          << faults::fired_in() << "): " << messages.size()
-                                          << " validation message(s), first: " << messages.front();
+            EXPECT_TRUE(messages.empty())
+                << "injecting " << vkrc::to_string(error) << " into call " << k << " (" << faults::fired_in()
+                << "): " << messages.size() << " validation message(s), first: " << messages.front();
         }
     }
     faults::arm(0, VK_SUCCESS);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("fault injection: %llu injection points exercised in %llu runs (%.1f s), %llu ended in vkrc::Error, "
-                "%llu not reached (fewer timeline polls)\n",
-                static_cast<unsigned long long>(points), static_cast<unsigned long long>(runs), seconds,
-                static_cast<unsigned long long>(thrown), static_cast<unsigned long long>(not_reached));
+    std::printf(
+        "fault injection: %llu injection points exercised in %llu runs (%.1f s), %llu ended in vkrc::Error, "
+        "%llu not reached (fewer timeline polls)\n",
+        static_cast<unsigned long long>(points), static_cast<unsigned long long>(runs), seconds,
+        static_cast<unsigned long long>(thrown), static_cast<unsigned long long>(not_reached));
     for (const auto& [name, count] : absorbed) std::printf("  absorbed by vkrc: %s x%d\n", name.c_str(), count);
     EXPECT_GT(thrown, runs / 2);
 }

@@ -51,7 +51,8 @@ TEST(MappedRange, RoundsOutToTheAtomAndClamps) {
         {"first byte of memory", 0, 64, 4096, 64, 0, 1, {0, 64}},
     };
     for (const auto& c : cases) {
-        const MemoryRange r = mapped_range(c.allocation_offset, c.allocation_size, c.memory_size, c.atom, c.offset, c.size);
+        const MemoryRange r =
+            mapped_range(c.allocation_offset, c.allocation_size, c.memory_size, c.atom, c.offset, c.size);
         EXPECT_EQ(r.offset, c.expected.offset) << c.name;
         EXPECT_EQ(r.size, c.expected.size) << c.name;
         // Vulkan's rule for VkMappedMemoryRange, and coverage of the bytes.
@@ -79,9 +80,9 @@ VkPhysicalDeviceMemoryProperties fake_properties() {
     p.memoryTypeCount = 4;
     p.memoryTypes[0] = {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0};
     p.memoryTypes[1] = {VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, 1};
-    p.memoryTypes[2] = {VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT |
-                            VK_MEMORY_PROPERTY_HOST_CACHED_BIT,
-                        1};
+    p.memoryTypes[2] = {
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT | VK_MEMORY_PROPERTY_HOST_CACHED_BIT,
+        1};
     p.memoryTypes[3] = {VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_PROTECTED_BIT, 0};
     return p;
 }
@@ -250,7 +251,8 @@ TEST_P(AllocatorTest, MissingMemoryTypeIsAClearError) {
     vkrc::BufferCreateInfo info;
     info.size = 64;
     info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    info.memory = {vkrc::MemoryUsage::custom, VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT};
+    info.memory = {vkrc::MemoryUsage::custom,
+                   VK_MEMORY_PROPERTY_LAZILY_ALLOCATED_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT};
     info.allocator = allocator;
     try {
         vkrc::Buffer::create(device, info);
@@ -311,7 +313,8 @@ TEST_P(AllocatorTest, BufferViewsAndSamplers) {
 
 // Memory is returned only after the GPU work submitted before the drop completes.
 TEST_P(AllocatorTest, MemoryOutlivesPendingGpuWork) {
-    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE, 0};
+    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE,
+                                   0};
     VkSemaphoreCreateInfo sem_info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
     VkSemaphore gate = VK_NULL_HANDLE;
     ASSERT_EQ(device.fn().vkCreateSemaphore(device.vk(), &sem_info, nullptr, &gate), VK_SUCCESS);
@@ -403,13 +406,15 @@ TEST_P(AllocatorTest, ImageUploadEveryLevelAndLayer) {
         for (std::uint32_t layer = 0; layer < 3; ++layer) {
             auto got = vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, level, layer);
             ASSERT_EQ(got.size(), layer_size);
-            EXPECT_TRUE(std::equal(got.begin(), got.end(), data.begin() + offset)) << "level " << level << " layer " << layer;
+            EXPECT_TRUE(std::equal(got.begin(), got.end(), data.begin() + offset))
+                << "level " << level << " layer " << layer;
             offset += layer_size;
         }
     }
     // A second upload from the layout the first left.
     std::fill(data.begin(), data.end(), std::byte{0x5a});
-    vkrc::upload_image(queue, image, data, {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
+    vkrc::upload_image(queue, image, data,
+                       {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
     auto last = vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 3, 2);
     EXPECT_EQ(last, std::vector<std::byte>(4 * 2 * 4, std::byte{0x5a}));
     EXPECT_THROW(vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 4, 0), vkrc::UsageError);

@@ -21,26 +21,31 @@ struct RectPush {
 
 vkrc::PipelineLayout rect_layout(const vkrc::Device& device) {
     return vkrc::PipelineLayout::create(
-        device, {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                           sizeof(RectPush)}}});
+        device,
+        {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(RectPush)}}});
 }
 
 TEST_F(VulkanTest, GraphicsPipelineForARenderPass) {
-    VkAttachmentDescription color{0, VK_FORMAT_R8G8B8A8_UNORM, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                  VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                                  VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+    VkAttachmentDescription color{0,
+                                  VK_FORMAT_R8G8B8A8_UNORM,
+                                  VK_SAMPLE_COUNT_1_BIT,
+                                  VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                  VK_ATTACHMENT_STORE_OP_STORE,
+                                  VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                  VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                  VK_IMAGE_LAYOUT_UNDEFINED,
                                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
     auto render_pass = vkrc::RenderPass::create(
         device, {.attachments = {color},
                  .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}}});
     EXPECT_EQ(render_pass.color_attachment_count(0), 1u);
     EXPECT_THROW((void)render_pass.color_attachment_count(1), vkrc::UsageError);
-    auto pipeline = vkrc::GraphicsPipelineBuilder(rect_layout(device))
-                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::rect_vert))
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT,
-                                vkrc::ShaderModule::create(device, vkrc_shaders::push_color_frag))
-                        .render_pass(render_pass)
-                        .build();
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(rect_layout(device))
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::rect_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::push_color_frag))
+            .render_pass(render_pass)
+            .build();
     EXPECT_EQ(pipeline.bind_point(), VK_PIPELINE_BIND_POINT_GRAPHICS);
     EXPECT_TRUE(pipeline.layout());
 }

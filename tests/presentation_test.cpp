@@ -43,14 +43,15 @@ struct Renderer {
                                                       .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                                                       .memory = {.usage = vkrc::MemoryUsage::upload}});
         vertex_buffer.allocation().write(0, vertices, 3);
-        pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
-                       .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
-                       .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
-                       .vertex_binding(0, sizeof(Vertex))
-                       .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
-                       .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
-                       .rendering(std::array{format})
-                       .build();
+        pipeline =
+            vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+                .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+                .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+                .vertex_binding(0, sizeof(Vertex))
+                .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+                .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+                .rendering(std::array{format})
+                .build();
         for (auto& slot : slots) {
             slot.pool = vkrc::CommandPool::create(device, {.queue_family_index = q.family_index()});
             slot.cmd = slot.pool.allocate();
@@ -68,7 +69,8 @@ struct Renderer {
         if (!frame) return frame.status;
         slot.fence.unsignal();
         record(slot.cmd, frame, readback);
-        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1), .signals = frame.signals()},
+        vkrc::submit(queue,
+                     {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1), .signals = frame.signals()},
                      slot.fence);
         ++count;
         auto status = presenter.present(frame);
@@ -77,10 +79,10 @@ struct Renderer {
 
     void record(const vkrc::CommandBuffer& cmd, const vkrc::Frame& frame, const vkrc::Buffer* readback) {
         cmd.begin();
-        auto to_attachment = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED,
-                                                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, vkrc::Frame::acquire_stage, 0,
-                                                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        auto to_attachment =
+            vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
         cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
         vkrc::RenderingAttachment target{.image_view = frame.view.vk()};
         target.clear_value.color = {{0.1f, 0.2f, 0.3f, 1.0f}};
@@ -100,7 +102,8 @@ struct Renderer {
             VkBufferImageCopy region{};
             region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
             region.imageExtent = {frame.extent.width, frame.extent.height, 1};
-            cmd.copy_image_to_buffer(frame.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, *readback, std::span(&region, 1));
+            cmd.copy_image_to_buffer(frame.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, *readback,
+                                     std::span(&region, 1));
             auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                                 VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
             cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
@@ -265,9 +268,10 @@ TEST_F(PresentationTest, OneLiveSwapchainPerSurface) {
     Renderer renderer(queue, swapchain.format());
     renderer.record(renderer.slots[0].cmd, frame, nullptr);
     renderer.slots[0].fence.unsignal();
-    vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1),
-                         .signals = frame.signals()},
-                 renderer.slots[0].fence);
+    vkrc::submit(
+        queue,
+        {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1), .signals = frame.signals()},
+        renderer.slots[0].fence);
     EXPECT_EQ(swapchain.present(frame), vkrc::PresentStatus::success);
     swapchain.reset();
     EXPECT_THROW(make_swapchain(), vkrc::UsageError);
@@ -283,9 +287,10 @@ TEST_F(PresentationTest, RetiredSwapchainLivesWhileAFrameHoldsItsImage) {
     ASSERT_TRUE(frame);
     renderer.record(renderer.slots[0].cmd, frame, nullptr);
     renderer.slots[0].fence.unsignal();
-    vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1),
-                         .signals = frame.signals()},
-                 renderer.slots[0].fence);
+    vkrc::submit(
+        queue,
+        {.waits = frame.waits(), .command_buffers = std::span(&renderer.slots[0].cmd, 1), .signals = frame.signals()},
+        renderer.slots[0].fence);
     const VkSwapchainKHR old = swapchain.vk();
     ASSERT_EQ(swapchain.recreate(), vkrc::PresentStatus::success);
     EXPECT_NE(swapchain.vk(), old);
@@ -302,8 +307,9 @@ TEST_F(PresentationTest, HeadlessRendersTheSamePixelsAsTheWindow) {
     auto swapchain = make_swapchain(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     const VkExtent2D extent = swapchain.extent();
     const VkDeviceSize size = VkDeviceSize{extent.width} * extent.height * 4;
-    auto readback = vkrc::Buffer::create(device, {.size = size, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                  .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto readback = vkrc::Buffer::create(
+        device,
+        {.size = size, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
     Renderer renderer(queue, swapchain.format());
     ASSERT_EQ(renderer.frame(swapchain, &readback), vkrc::PresentStatus::success);
     renderer.wait();
@@ -369,8 +375,8 @@ void lose_while_presenting(LossObserver how, unsigned seed, const vkrc::glfw::Wi
         ASSERT_TRUE(frame);
         slot.fence.unsignal();
         renderer->record(slot.cmd, frame, nullptr);
-        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1),
-                             .signals = frame.signals()},
+        vkrc::submit(queue,
+                     {.waits = frame.waits(), .command_buffers = std::span(&slot.cmd, 1), .signals = frame.signals()},
                      slot.fence);
     }
     faults::lose_device();

@@ -37,7 +37,8 @@ struct RectPush {
 };
 
 vkrc::Buffer readback_buffer(const vkrc::Device& device, VkDeviceSize bytes, VkBufferUsageFlags usage) {
-    return vkrc::Buffer::create(device, {.size = bytes, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    return vkrc::Buffer::create(device,
+                                {.size = bytes, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::readback}});
 }
 
 vkrc::Image attachment_image(const vkrc::Device& device, VkFormat format, VkImageUsageFlags usage) {
@@ -53,13 +54,16 @@ struct Fill {
 
     Fill(const vkrc::Device& device, const vkrc::Buffer& target) {
         set_layout = vkrc::DescriptorSetLayout::create(
-            device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            device, {.bindings = {{.binding = 0,
+                                   .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                    .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
         auto layout = vkrc::PipelineLayout::create(
             device, {.set_layouts = {set_layout},
                      .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(FillParams)}}});
-        pipeline = vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
-        pool = vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+        pipeline =
+            vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        pool = vkrc::DescriptorPool::create(device,
+                                            {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
         set = pool.allocate(set_layout);
         set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, target);
     }
@@ -124,35 +128,47 @@ TEST_F(VulkanTest, TriangleThroughARenderPass) {
     };
     // Counter-clockwise on screen (y points down in Vulkan's framebuffer).
     const Vertex vertices[] = {{{0.0f, -0.5f}, {1, 0, 0}}, {{-0.5f, 0.5f}, {1, 0, 0}}, {{0.5f, 0.5f}, {1, 0, 0}}};
-    auto vertex_buffer = vkrc::Buffer::create(
-        device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                 .memory = {.usage = vkrc::MemoryUsage::upload}});
+    auto vertex_buffer = vkrc::Buffer::create(device, {.size = sizeof vertices,
+                                                       .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                                                       .memory = {.usage = vkrc::MemoryUsage::upload}});
     vertex_buffer.allocation().write(0, vertices, 3);
 
-    auto image = attachment_image(device, color_format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    auto image =
+        attachment_image(device, color_format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    VkAttachmentDescription color{0, color_format, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                  VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                                  VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+    VkAttachmentDescription color{0,
+                                  color_format,
+                                  VK_SAMPLE_COUNT_1_BIT,
+                                  VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                  VK_ATTACHMENT_STORE_OP_STORE,
+                                  VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                  VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                  VK_IMAGE_LAYOUT_UNDEFINED,
                                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
     // The copy after the pass waits for the attachment writes.
-    VkSubpassDependency to_copy{0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                                VK_ACCESS_TRANSFER_READ_BIT, 0};
+    VkSubpassDependency to_copy{0,
+                                VK_SUBPASS_EXTERNAL,
+                                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                                VK_ACCESS_TRANSFER_READ_BIT,
+                                0};
     auto render_pass = vkrc::RenderPass::create(
         device, {.attachments = {color},
                  .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
                  .dependencies = {to_copy}});
     auto framebuffer = vkrc::Framebuffer::create(
-        device, {.render_pass = render_pass, .attachments = {vkrc::ImageView::create(image)}, .width = size, .height = size});
-    auto pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
-                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
-                        .vertex_binding(0, sizeof(Vertex))
-                        .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
-                        .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
-                        .render_pass(render_pass)
-                        .build();
+        device,
+        {.render_pass = render_pass, .attachments = {vkrc::ImageView::create(image)}, .width = size, .height = size});
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+            .vertex_binding(0, sizeof(Vertex))
+            .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+            .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+            .render_pass(render_pass)
+            .build();
 
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = pool.allocate();
@@ -190,7 +206,8 @@ struct DepthTarget {
 
 vkrc::GraphicsPipeline rect_pipeline(const vkrc::Device& device) {
     auto layout = vkrc::PipelineLayout::create(
-        device, {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(RectPush)}}});
+        device,
+        {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(RectPush)}}});
     return vkrc::GraphicsPipelineBuilder(layout)
         .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::rect_vert))
         .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::push_color_frag))
@@ -204,11 +221,12 @@ void begin_target(const vkrc::CommandBuffer& cmd, const DepthTarget& target, VkR
         vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
-        vkrc::image_barrier(target.depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                            VK_PIPELINE_STAGE_2_NONE, 0,
-                            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                            VK_IMAGE_ASPECT_DEPTH_BIT)};
+        vkrc::image_barrier(
+            target.depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+            VK_PIPELINE_STAGE_2_NONE, 0,
+            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+            VK_IMAGE_ASPECT_DEPTH_BIT)};
     cmd.pipeline_barrier({}, {}, in);
     vkrc::RenderingAttachment color{.image_view = target.color_view.vk()};
     color.clear_value.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
@@ -224,14 +242,15 @@ void begin_target(const vkrc::CommandBuffer& cmd, const DepthTarget& target, VkR
 
 void end_target(const vkrc::CommandBuffer& cmd, const DepthTarget& target) {
     cmd.end_rendering();
-    auto out = vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                   VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                                   VK_ACCESS_2_TRANSFER_READ_BIT);
+    auto out = vkrc::image_barrier(
+        target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     cmd.pipeline_barrier({}, {}, std::span(&out, 1));
 }
 
-void draw_quads(const vkrc::CommandBuffer& cmd, const vkrc::GraphicsPipeline& pipeline, std::span<const RectPush> quads) {
+void draw_quads(const vkrc::CommandBuffer& cmd, const vkrc::GraphicsPipeline& pipeline,
+                std::span<const RectPush> quads) {
     cmd.bind_pipeline(pipeline);
     cmd.set_viewport_and_scissor({size, size});
     for (const auto& q : quads) {
@@ -282,8 +301,8 @@ TEST_F(VulkanTest, DropEverythingRightAfterSubmit) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto survivor = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     {
-        auto storage = vkrc::Buffer::create(
-            device, {.size = 4096, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {}});
+        auto storage =
+            vkrc::Buffer::create(device, {.size = 4096, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {}});
         Fill fill(device, storage);
         DepthTarget target(device);
         auto pipeline = rect_pipeline(device);
@@ -317,36 +336,40 @@ TEST_F(VulkanTest, IndexedQuadFromCopiedVertices) {
         float position[2];
         float color[3];
     };
-    const Vertex vertices[] = {{{-0.5f, -0.5f}, {0, 1, 0}}, {{-0.5f, 0.5f}, {0, 1, 0}},
-                               {{0.5f, 0.5f}, {0, 1, 0}},   {{0.5f, -0.5f}, {0, 1, 0}}};
+    const Vertex vertices[] = {
+        {{-0.5f, -0.5f}, {0, 1, 0}}, {{-0.5f, 0.5f}, {0, 1, 0}}, {{0.5f, 0.5f}, {0, 1, 0}}, {{0.5f, -0.5f}, {0, 1, 0}}};
     const std::uint16_t indices[] = {0, 1, 2, 0, 2, 3};
-    auto staging = vkrc::Buffer::create(device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+    auto staging = vkrc::Buffer::create(device, {.size = sizeof vertices,
+                                                 .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                                  .memory = {.usage = vkrc::MemoryUsage::upload}});
     staging.allocation().write(0, vertices, 4);
     auto vertex_buffer = vkrc::Buffer::create(
-        device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
-    auto index_buffer = vkrc::Buffer::create(device, {.size = sizeof indices, .usage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+        device,
+        {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+    auto index_buffer = vkrc::Buffer::create(device, {.size = sizeof indices,
+                                                      .usage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                                                       .memory = {.usage = vkrc::MemoryUsage::upload}});
     index_buffer.allocation().write(0, indices, 6);
 
     DepthTarget target(device);
     auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    auto pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
-                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
-                        .vertex_binding(0, sizeof(Vertex))
-                        .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
-                        .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
-                        .rendering(std::array{color_format}, depth_format)
-                        .build();
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
+            .vertex_binding(0, sizeof(Vertex))
+            .vertex_attribute(0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, position))
+            .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, color))
+            .rendering(std::array{color_format}, depth_format)
+            .build();
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = pool.allocate();
     cmd.begin();
     const VkBufferCopy whole{0, 0, sizeof vertices};
     cmd.copy_buffer(staging, vertex_buffer, std::span(&whole, 1));
-    auto to_vertex_input = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT,
-                                                VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT);
+    auto to_vertex_input =
+        vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT, VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT);
     cmd.pipeline_barrier(std::span(&to_vertex_input, 1), {}, {});
     begin_target(cmd, target);
     cmd.bind_pipeline(pipeline);

@@ -45,7 +45,9 @@ TEST_F(VulkanTest, ShaderModuleRejectsBadSpirv) {
 }
 
 TEST_F(VulkanTest, ShaderModuleFromFile) {
-    auto dir = std::filesystem::temp_directory_path() / ("vkrc-shader-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" + std::to_string(reinterpret_cast<std::uintptr_t>(this)));
+    auto dir = std::filesystem::temp_directory_path() /
+               ("vkrc-shader-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "-" +
+                std::to_string(reinterpret_cast<std::uintptr_t>(this)));
     std::filesystem::create_directories(dir);
     auto good = dir / "fill.spv";
     {

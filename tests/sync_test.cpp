@@ -43,10 +43,12 @@ TEST_F(VulkanTest, TimelineSemaphoreOrdersTwoSubmissions) {
     auto second_done = vkrc::Fence::create(device);
 
     vkrc::SemaphoreSubmit host_go{timeline, 1}, first_done{timeline, 2}, all_done{timeline, 3};
-    vkrc::submit(queue, {.waits = std::span(&host_go, 1), .command_buffers = std::span(&first, 1),
+    vkrc::submit(queue, {.waits = std::span(&host_go, 1),
+                         .command_buffers = std::span(&first, 1),
                          .signals = std::span(&first_done, 1)});
     vkrc::submit(queue,
-                 {.waits = std::span(&first_done, 1), .command_buffers = std::span(&second, 1),
+                 {.waits = std::span(&first_done, 1),
+                  .command_buffers = std::span(&second, 1),
                   .signals = std::span(&all_done, 1)},
                  second_done);
     EXPECT_EQ(timeline.wait(2, 20'000'000), VK_TIMEOUT);
@@ -101,7 +103,8 @@ TEST_F(VulkanTest, EventIsSetAndResetFromTheHost) {
 }
 
 TEST_F(VulkanTest, TimestampsAreWrittenInOrder) {
-    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE) GTEST_SKIP() << "the device lacks timestampComputeAndGraphics (lavapipe has it)";
+    if (physical_device.properties().limits.timestampComputeAndGraphics == VK_FALSE)
+        GTEST_SKIP() << "the device lacks timestampComputeAndGraphics (lavapipe has it)";
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto queries = vkrc::QueryPool::create(device, {.query_type = VK_QUERY_TYPE_TIMESTAMP, .query_count = 2});
     EXPECT_EQ(queries.query_count(), 2u);

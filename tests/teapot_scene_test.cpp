@@ -23,10 +23,10 @@ bool finite(const glm::mat4& m) {
 }
 
 struct EdgeCounts {
-    std::size_t boundary = 0;       // used by one triangle
-    std::size_t shared = 0;         // used by two, in opposite directions
+    std::size_t boundary = 0;        // used by one triangle
+    std::size_t shared = 0;          // used by two, in opposite directions
     std::size_t same_direction = 0;  // used by two the same way: flipped triangle
-    std::size_t over_shared = 0;    // used by more than two
+    std::size_t over_shared = 0;     // used by more than two
 };
 
 // Edge use of the non-degenerate triangles (those at collapsed patch edges
@@ -38,10 +38,8 @@ EdgeCounts count_edges(const teapot::Mesh& mesh) {
         if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) continue;
         for (int k = 0; k < 3; ++k) {
             unsigned a = v[k], b = v[(k + 1) % 3];
-            if (a < b)
-                ++uses[{a, b}].first;
-            else
-                ++uses[{b, a}].second;
+            if (a < b) ++uses[{a, b}].first;
+            else ++uses[{b, a}].second;
         }
     }
     EdgeCounts counts;
@@ -69,9 +67,9 @@ TEST(TeapotPatches, ParserAcceptsBlanksAndRejectsBadInput) {
     auto one = teapot::parse_patches("1\n1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 2\n2\n0 0 0\n1,2,3\n");
     ASSERT_EQ(one.size(), 1u);
     EXPECT_EQ(one[0].p[15], glm::dvec3(1, 2, 3));
-    EXPECT_THROW(teapot::parse_patches("1\n1,2,3\n"), std::runtime_error);                      // short line
+    EXPECT_THROW(teapot::parse_patches("1\n1,2,3\n"), std::runtime_error);  // short line
     EXPECT_THROW(teapot::parse_patches("1\n1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,3\n2\n0,0,0\n1,1,1\n"),
-                 std::runtime_error);                                                       // index 3 of 2
+                 std::runtime_error);  // index 3 of 2
     EXPECT_THROW(teapot::parse_patches("1\n1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1\n1\n0,x,0\n"), std::runtime_error);
     EXPECT_THROW(teapot::parse_patches("1\n1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1\n2\n0,0,0\n"), std::runtime_error);
 }
@@ -242,8 +240,8 @@ TEST(TeapotCamera, ExtremeAspectsAndDepthRangesStayFinite) {
         teapot::CameraUniforms cam = teapot::camera(count, 800, 600);
         ASSERT_TRUE(finite(cam.view) && finite(cam.proj));
         for (int index : {0, count - 1}) {
-            glm::vec4 clip = cam.proj * cam.view * teapot::teapot_draw(index, count, 0.0).world *
-                             glm::vec4(0, 0, 1.575f, 1);
+            glm::vec4 clip =
+                cam.proj * cam.view * teapot::teapot_draw(index, count, 0.0).world * glm::vec4(0, 0, 1.575f, 1);
             EXPECT_LT(std::abs(clip.x / clip.w), 1.0f) << count;
             EXPECT_LT(std::abs(clip.y / clip.w), 1.0f) << count;
             EXPECT_GT(clip.z / clip.w, 0.0f);

@@ -25,7 +25,7 @@ namespace {
 
 struct Step {
     bool allocate;
-    std::size_t slot;  // which live slot is allocated into or freed
+    std::size_t slot;     // which live slot is allocated into or freed
     std::size_t request;  // index into the request table (allocations only)
 };
 
@@ -109,7 +109,7 @@ double thread_seconds() {
 struct Result {
     std::string allocator;
     std::size_t operations = 0;
-    double seconds = 0;      // thread CPU time of the timed pass
+    double seconds = 0;  // thread CPU time of the timed pass
     double wall_seconds = 0;
     std::uint64_t vk_allocate_calls = 0;
     VkDeviceSize peak_reserved = 0;
@@ -212,8 +212,8 @@ int main(int argc, char** argv) try {
     results.push_back(replay("dedicated", dedicated, device, pattern, dedicated_operations));
     results.push_back(replay("pool", pool, device, pattern, operations));
 
-    std::printf("device: %s; pattern: seed %u, at most %zu live, 256 B - 16 MiB, buffers and images\n",
-                physical.name(), seed, live);
+    std::printf("device: %s; pattern: seed %u, at most %zu live, 256 B - 16 MiB, buffers and images\n", physical.name(),
+                seed, live);
     std::printf("%-10s %10s %14s %12s %18s %18s %8s\n", "allocator", "operations", "alloc+free/s", "vkAllocate",
                 "peak reserved", "peak requested", "waste");
     for (const auto& r : results) {
@@ -226,7 +226,8 @@ int main(int argc, char** argv) try {
     std::printf("pool vs dedicated: %.1fx the allocate+free rate (rates from thread CPU time)\n", speedup);
     if (!csv.empty()) {
         std::ofstream out(csv);
-        out << "allocator,operations,ops_per_s,vk_allocate_calls,peak_reserved_bytes,peak_requested_bytes,cpu_seconds,wall_seconds\n";
+        out << "allocator,operations,ops_per_s,vk_allocate_calls,peak_reserved_bytes,peak_requested_bytes,cpu_seconds,"
+               "wall_seconds\n";
         for (const auto& r : results) {
             out << r.allocator << ',' << r.operations << ',' << std::llround(r.operations / r.seconds) << ','
                 << r.vk_allocate_calls << ',' << r.peak_reserved << ',' << r.peak_requested << ',' << r.seconds << ','

@@ -29,11 +29,11 @@ namespace {
 
 constexpr const char* stage_names[] = {"preinit", "acquire", "uniform", "command", "submit",
                                        "present", "wait",    "update",  "frame"};
-constexpr int stage_count = 9;     // preinit, the seven per-frame stages, their sum
-constexpr int frame_stages = 7;    // acquire .. update
-constexpr int frame_stage = 8;     // the sum of the seven
+constexpr int stage_count = 9;             // preinit, the seven per-frame stages, their sum
+constexpr int frame_stages = 7;            // acquire .. update
+constexpr int frame_stage = 8;             // the sum of the seven
 constexpr double frame_step = 1.0 / 60.0;  // simulated seconds per frame
-constexpr double reference_time = 1.25;   // the image check's fixed time
+constexpr double reference_time = 1.25;    // the image check's fixed time
 constexpr int block_frames = 25;           // measured frames per variant per block
 constexpr int warmup_frames = 30;          // per variant, before the first block
 constexpr int preinit_rounds = 5;          // timed inits per variant
@@ -87,7 +87,8 @@ Options parse(int argc, char** argv) {
                 bool known = false;
                 for (const auto& entry : variant_registry()) known |= entry.name == name;
                 if (!known) usage("unknown variant '" + name + "'");
-                if (std::find(o.variants.begin(), o.variants.end(), name) == o.variants.end()) o.variants.push_back(name);
+                if (std::find(o.variants.begin(), o.variants.end(), name) == o.variants.end())
+                    o.variants.push_back(name);
             }
             if (o.variants.empty()) usage("--variants is empty");
         } else if (a == "--teapots") o.config.teapots = positive(a, value());
@@ -181,8 +182,8 @@ private:
     bool tty_;
 };
 
-ConfigResult run_configuration(const Options& options, const Config& config, int frames,
-                               std::map<int, Mesh>& meshes, int index, int total) {
+ConfigResult run_configuration(const Options& options, const Config& config, int frames, std::map<int, Mesh>& meshes,
+                               int index, int total) {
     using clock = std::chrono::steady_clock;
     auto mesh_it = meshes.find(config.tessellation);
     if (mesh_it == meshes.end())
@@ -286,10 +287,11 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
 
 void print_table(const ConfigResult& r) {
     const Config& c = r.config;
-    std::printf("\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %ux%u, "
-                "%d frames per variant\n",
-                c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
-                std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, r.frames);
+    std::printf(
+        "\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %ux%u, "
+        "%d frames per variant\n",
+        c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
+        std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, r.frames);
     std::printf("presentation: %s\n", r.variants[0].presentation.c_str());
     for (const VariantResult& v : r.variants)
         if (v.presentation != r.variants[0].presentation)
@@ -305,8 +307,8 @@ void print_table(const ConfigResult& r) {
         }
     for (const VariantResult& v : r.variants)
         std::printf("image    %-11s %s (%zu pixels differ from %s, max channel difference %d)\n", v.name.c_str(),
-                    v.differing_pixels == 0 ? "identical" : "DIFFERS", v.differing_pixels,
-                    r.variants[0].name.c_str(), v.max_channel_difference);
+                    v.differing_pixels == 0 ? "identical" : "DIFFERS", v.differing_pixels, r.variants[0].name.c_str(),
+                    v.max_channel_difference);
     if (r.geometric)
         std::printf("geometric error: max %.3g, rms %.3g model units; max %.3g pixels at the nearest teapot\n",
                     r.geometric->max, r.geometric->rms, r.error_pixels);
@@ -328,8 +330,9 @@ void write_csv(const std::string& path, const std::vector<ConfigResult>& results
         if (r.geometric) {
             std::snprintf(line, sizeof line, ",%.6g,%.6g,%.6g,", r.geometric->max, r.geometric->rms, r.error_pixels);
             extra = line;
-            extra += r.image_error_pixels ? std::to_string(*r.image_error_pixels) + "," + std::to_string(r.image_error_channel)
-                                          : ",";
+            extra += r.image_error_pixels
+                         ? std::to_string(*r.image_error_pixels) + "," + std::to_string(r.image_error_channel)
+                         : ",";
         }
         for (const VariantResult& v : r.variants) {
             for (int s = 0; s < stage_count; ++s) {
@@ -436,7 +439,8 @@ int run(int argc, char** argv) {
             }())
             finest = &r;
     for (ConfigResult& r : results) {
-        if (r.config.teapots != options.config.teapots || r.config.frames_in_flight != options.config.frames_in_flight ||
+        if (r.config.teapots != options.config.teapots ||
+            r.config.frames_in_flight != options.config.frames_in_flight ||
             r.config.uniform_writes != options.config.uniform_writes)
             continue;
         r.geometric = geometric_error(newell_teapot(), meshes.at(r.config.tessellation));
@@ -471,9 +475,10 @@ int run(int argc, char** argv) {
                 budget_level = r.config.tessellation;
         }
         if (budget_level)
-            std::printf("a 1-pixel error budget at %ux%u needs tessellation %d (max geometric error <= 1 pixel at the "
-                        "nearest teapot)\n",
-                        options.config.width, options.config.height, *budget_level);
+            std::printf(
+                "a 1-pixel error budget at %ux%u needs tessellation %d (max geometric error <= 1 pixel at the "
+                "nearest teapot)\n",
+                options.config.width, options.config.height, *budget_level);
         else
             std::printf("no level run meets a 1-pixel error budget at %ux%u\n", options.config.width,
                         options.config.height);
@@ -486,11 +491,13 @@ int run(int argc, char** argv) {
 
     int status = 0;
     if (!images_ok) {
-        std::fprintf(stderr, "teapot: FAILED: a variant's image differs from %s's\n", results[0].variants[0].name.c_str());
+        std::fprintf(stderr, "teapot: FAILED: a variant's image differs from %s's\n",
+                     results[0].variants[0].name.c_str());
         status = 1;
     }
     if (!presentation_ok) {
-        std::fprintf(stderr, "teapot: FAILED: the variants present differently (format, mode, image count or extent)\n");
+        std::fprintf(stderr,
+                     "teapot: FAILED: the variants present differently (format, mode, image count or extent)\n");
         status = 1;
     }
     if (validation_messages > 0) {

@@ -15,8 +15,10 @@ public:
 
     vkrc::AllocationInfo allocate(vkrc::DeviceView device, const vkrc::AllocationRequest& request) override {
         const auto& req = request.requirements;
-        if (req.size == 0 || req.size > arena_size_) throw vkrc::UsageError("ArenaAllocator: size 0 or above the arena");
-        auto type = vkrc::choose_memory_type(device.memory_properties(), req.memoryTypeBits, request.intent, "ArenaAllocator");
+        if (req.size == 0 || req.size > arena_size_)
+            throw vkrc::UsageError("ArenaAllocator: size 0 or above the arena");
+        auto type =
+            vkrc::choose_memory_type(device.memory_properties(), req.memoryTypeBits, request.intent, "ArenaAllocator");
         std::lock_guard lock(mutex_);
         Arena& a = arenas_[type];
         if (a.memory == VK_NULL_HANDLE) {
@@ -35,7 +37,8 @@ public:
         a.top = offset + req.size;
         a.live += 1;
         allocations += 1;
-        return {a.memory, offset, req.size, arena_size_, type, a.mapped ? a.mapped + offset : nullptr, false, this, nullptr};
+        return {a.memory, offset, req.size, arena_size_, type, a.mapped ? a.mapped + offset : nullptr,
+                false,    this,   nullptr};
     }
 
     void free(vkrc::DeviceView, const vkrc::AllocationInfo& allocation) override {

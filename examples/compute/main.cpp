@@ -33,22 +33,26 @@ int run(bool validation) {
     // 2. The input in upload memory (the CPU writes it through the mapping),
     //    the output in readback memory (the CPU reads it the same way).
     const VkDeviceSize bytes = count * sizeof(std::uint32_t);
-    auto starts = vkrc::Buffer::create(device, {.size = bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                                .memory = {.usage = vkrc::MemoryUsage::upload}});
-    auto steps = vkrc::Buffer::create(device, {.size = bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                               .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto starts = vkrc::Buffer::create(
+        device,
+        {.size = bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::upload}});
+    auto steps = vkrc::Buffer::create(
+        device,
+        {.size = bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
     std::vector<std::uint32_t> input(count);
     for (std::uint32_t i = 0; i < count; ++i) input[i] = i + 1;
     starts.allocation().write(0, std::span<const std::uint32_t>(input));
 
     // 3. A descriptor set pointing the shader's two bindings at the buffers.
-    auto set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
-                              {.binding = 1, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
-    auto descriptor_pool = vkrc::DescriptorPool::create(
-        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+                                                                {.binding = 1,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto descriptor_pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
     auto set = descriptor_pool.allocate(set_layout);
     set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, starts);
     set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, steps);

@@ -39,7 +39,8 @@ inline int run_example(int argc, char** argv, const char* name, int (*run)(const
         if (std::strcmp(argv[i], "--headless") == 0) options.headless = true;
         else if (std::strcmp(argv[i], "--validation") == 0) options.validation = true;
         else if (std::strcmp(argv[i], "--out") == 0 && has_value) options.out_file = argv[++i];
-        else if (std::strcmp(argv[i], "--frames") == 0 && has_value) options.frames = std::strtol(argv[++i], nullptr, 10);
+        else if (std::strcmp(argv[i], "--frames") == 0 && has_value)
+            options.frames = std::strtol(argv[++i], nullptr, 10);
         else {
             std::fprintf(stderr, "usage: %s [--headless [--out FILE.png]] [--frames N] [--validation]\n", argv[0]);
             return 2;

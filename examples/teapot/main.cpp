@@ -22,8 +22,8 @@ constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;  // every device can ren
 // A buffer the GPU reads, filled once through a staging copy.
 template <typename T>
 vkrc::Buffer device_buffer(const vkrc::Queue& queue, const std::vector<T>& data, VkBufferUsageFlags usage) {
-    auto buffer = vkrc::Buffer::create(queue.device(), {.size = data.size() * sizeof(T),
-                                                        .usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+    auto buffer = vkrc::Buffer::create(
+        queue.device(), {.size = data.size() * sizeof(T), .usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
     vkrc::upload_buffer(queue, buffer, 0, std::as_bytes(std::span(data)));
     return buffer;
 }
@@ -35,7 +35,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     vkrc::DeviceRequirements requirements;
     vkrc::glfw::WindowSurface window;
     if (!options.headless) {
-        window = vkrc::glfw::create_window_surface({.width = 960, .height = 540, .title = "vkrc teapot"}, instance_info);
+        window =
+            vkrc::glfw::create_window_surface({.width = 960, .height = 540, .title = "vkrc teapot"}, instance_info);
         requirements.present_surface = window.surface.vk();
         requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     }
@@ -47,8 +48,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     vkrc::HeadlessPresenter headless;
     if (options.headless)
         headless = vkrc::HeadlessPresenter::create(queue, {.extent = {480, 270}, .format = VK_FORMAT_R8G8B8A8_UNORM});
-    else
-        swapchain = vkrc::Swapchain::create(queue, window.surface);
+    else swapchain = vkrc::Swapchain::create(queue, window.surface);
     vkrc::Presenter& presenter = options.headless ? static_cast<vkrc::Presenter&>(headless) : swapchain;
 
     // 2. The teapot mesh (Bezier patches, 8x8 quads each), in GPU memory.
@@ -64,7 +64,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     auto layout = vkrc::PipelineLayout::create(
         device, {.set_layouts = {set_layout},
                  .push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(teapot::PushConstants)}}});
-    auto pipeline = vkrc::GraphicsPipelineBuilder(layout)
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(layout)
             .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_vert))
             .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_frag))
             .vertex_binding(0, sizeof(glm::vec3))  // positions
@@ -85,8 +86,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         vkrc::DescriptorSet set;
     };
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
-    auto descriptor_pool = vkrc::DescriptorPool::create(
-        device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2}}});
+    auto descriptor_pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2}}});
     std::array<FrameResources, 2> in_flight;
     for (FrameResources& f : in_flight) {
         f = {pool.allocate(), vkrc::Fence::create(device, true),
@@ -126,8 +127,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             depth_extent = frame.extent;
         }
         // Headless runs use a fixed time step, so that their images are reproducible.
-        const double t = options.headless ? n / 60.0
-                                          : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double t = options.headless
+                             ? n / 60.0
+                             : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         teapot::animate(teapot_count, t, draws);
         f.camera.allocation().write_value(0, teapot::camera(teapot_count, frame.extent.width, frame.extent.height));
 
@@ -139,11 +141,12 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                 vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
-            vkrc::image_barrier(depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,  // the previous frame's
-                                depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                                VK_IMAGE_ASPECT_DEPTH_BIT)};
+            vkrc::image_barrier(
+                depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,  // the previous frame's
+                depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, to_attachments);
         vkrc::RenderingAttachment colour_target{.image_view = frame.view.vk()};
         colour_target.clear_value.color = {{0.08f, 0.09f, 0.11f, 1.0f}};
@@ -163,10 +166,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             cmd.draw_indexed(static_cast<std::uint32_t>(mesh.indices.size()));
         }
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(
-            frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame.present_layout,
-            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-            VK_PIPELINE_STAGE_2_NONE, 0);
+        auto to_present = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                              frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
         cmd.end();
         vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},

@@ -23,7 +23,7 @@ constexpr VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
 
 // Texel (x, y) of a level: 4x4 cells alternating between the level's colour and black.
 std::array<std::uint8_t, 4> texel(std::uint32_t level, std::uint32_t x, std::uint32_t y) {
-    static constexpr std::uint8_t colors[levels][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0},
+    static constexpr std::uint8_t colors[levels][3] = {{255, 0, 0},   {0, 255, 0},   {0, 0, 255},    {255, 255, 0},
                                                        {0, 255, 255}, {255, 0, 255}, {255, 255, 255}};
     if ((x / 4 + y / 4) % 2 == 1) return {0, 0, 0, 255};
     return {colors[level][0], colors[level][1], colors[level][2], 255};
@@ -39,7 +39,9 @@ int run(bool validation) {
     // 2. The texture, and every mip level generated on the CPU: upload_image
     //    takes the levels one after the other, tightly packed, and leaves the
     //    image in SHADER_READ_ONLY_OPTIMAL.
-    auto texture = vkrc::Image::create(device, {.format = format, .extent = {size, size, 1}, .mip_levels = levels,
+    auto texture = vkrc::Image::create(device, {.format = format,
+                                                .extent = {size, size, 1},
+                                                .mip_levels = levels,
                                                 .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     std::vector<std::byte> texels;
     texels.reserve(vkrc::image_data_size(texture));
@@ -54,12 +56,14 @@ int run(bool validation) {
     // 3. A view of all levels, a sampler that picks the nearest texel of one
     //    level, and a descriptor set binding the two for the fragment shader.
     auto view = vkrc::ImageView::create(texture);
-    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST,
+    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                                  .min_filter = VK_FILTER_NEAREST,
                                                   .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
                                                   .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
                                                   .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE});
     auto set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT}}});
     auto descriptor_pool = vkrc::DescriptorPool::create(
         device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}}});
@@ -70,8 +74,8 @@ int run(bool validation) {
     // 4. The pipeline: a full-viewport triangle (no culling: it is clockwise)
     //    and textureLod with the level from a push constant.
     auto layout = vkrc::PipelineLayout::create(
-        device, {.set_layouts = {set_layout},
-                 .push_constant_ranges = {{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(float)}}});
+        device,
+        {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(float)}}});
     auto pipeline =
         vkrc::GraphicsPipelineBuilder(layout)
             .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::fullscreen_vert))
@@ -82,9 +86,10 @@ int run(bool validation) {
 
     // 5. The target: one size x size square per drawn level, side by side.
     const std::uint32_t width = size * std::uint32_t(drawn_levels.size());
-    auto target = vkrc::Image::create(device, {.format = format, .extent = {width, size, 1},
-                                               .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    auto target =
+        vkrc::Image::create(device, {.format = format,
+                                     .extent = {width, size, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
     auto target_view = vkrc::ImageView::create(target);
 
     // 6. Record one draw per level, each into its own square, then leave the
@@ -108,10 +113,10 @@ int run(bool validation) {
         cmd.draw(3);
     }
     cmd.end_rendering();
-    auto to_copy = vkrc::image_barrier(
-        target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    auto to_copy =
+        vkrc::image_barrier(target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
     cmd.end();
     auto done = vkrc::Fence::create(device);

@@ -42,16 +42,18 @@ int run(bool validation) {
 
     // 2. A pipeline drawing one rectangle given by push constants, and the target.
     auto layout = vkrc::PipelineLayout::create(
-        device, {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(Rect)}}});
+        device,
+        {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(Rect)}}});
     auto pipeline =
         vkrc::GraphicsPipelineBuilder(layout)
             .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::rect_vert))
             .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::push_color_frag))
             .rendering(std::array{format})
             .build();
-    auto target = vkrc::Image::create(device, {.format = format, .extent = {size, size, 1},
-                                               .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    auto target =
+        vkrc::Image::create(device, {.format = format,
+                                     .extent = {size, size, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
     auto target_view = vkrc::ImageView::create(target);
 
     // 3. Each thread records into a secondary command buffer from its own pool.
@@ -97,10 +99,10 @@ int run(bool validation) {
                              .flags = VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT});
     primary.execute_commands(secondaries);
     primary.end_rendering();
-    auto to_copy = vkrc::image_barrier(
-        target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    auto to_copy =
+        vkrc::image_barrier(target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     primary.pipeline_barrier({}, {}, std::span(&to_copy, 1));
     primary.end();
 

@@ -25,7 +25,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     vkrc::DeviceRequirements requirements;
     vkrc::glfw::WindowSurface window;
     if (!options.headless) {
-        window = vkrc::glfw::create_window_surface({.width = 512, .height = 512, .title = "vkrc triangle"}, instance_info);
+        window =
+            vkrc::glfw::create_window_surface({.width = 512, .height = 512, .title = "vkrc triangle"}, instance_info);
         requirements.present_surface = window.surface.vk();
         requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     }
@@ -37,20 +38,21 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     vkrc::HeadlessPresenter headless;
     if (options.headless)
         headless = vkrc::HeadlessPresenter::create(queue, {.extent = {256, 256}, .format = VK_FORMAT_R8G8B8A8_UNORM});
-    else
-        swapchain = vkrc::Swapchain::create(queue, window.surface, {.log = [](const char* m) { std::puts(m); }});
+    else swapchain = vkrc::Swapchain::create(queue, window.surface, {.log = [](const char* m) { std::puts(m); }});
     vkrc::Presenter& presenter = options.headless ? static_cast<vkrc::Presenter&>(headless) : swapchain;
 
     // 2. Three vertices (red top, green bottom left, blue bottom right) in a buffer
     //    the CPU writes and the GPU reads. Counter-clockwise: front-facing.
     const Vertex vertices[] = {{{0.0f, -0.6f}, {1, 0, 0}}, {{-0.6f, 0.6f}, {0, 1, 0}}, {{0.6f, 0.6f}, {0, 0, 1}}};
-    auto vertex_buffer = vkrc::Buffer::create(device, {.size = sizeof vertices, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+    auto vertex_buffer = vkrc::Buffer::create(device, {.size = sizeof vertices,
+                                                       .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                                                        .memory = {.usage = vkrc::MemoryUsage::upload}});
     vertex_buffer.allocation().write(0, vertices, 3);
 
     // 3. The pipeline: shaders compiled at build time, the vertex layout, and
     //    dynamic rendering into the presenter's format. Viewport and scissor are dynamic.
-    auto pipeline = vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(vkrc::PipelineLayout::create(device))
             .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_vert))
             .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::triangle_frag))
             .vertex_binding(0, sizeof(Vertex))
@@ -93,10 +95,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.bind_vertex_buffer(0, vertex_buffer);
         cmd.draw(3);
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(
-            frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame.present_layout,
-            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-            VK_PIPELINE_STAGE_2_NONE, 0);
+        auto to_present = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                              frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
         cmd.end();
         vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},

@@ -237,7 +237,7 @@ struct SubmitBatch {
 // Limits of one submit() call, whose Vulkan structures are built on the stack.
 struct SubmitLimits {
     static constexpr std::size_t batches = 16;
-    static constexpr std::size_t semaphores = 32;       // waits and signals, each, over all batches
+    static constexpr std::size_t semaphores = 32;        // waits and signals, each, over all batches
     static constexpr std::size_t command_buffers = 128;  // over all batches
 };
 
@@ -355,8 +355,8 @@ inline void CommandBuffer::bind_vertex_buffer(std::uint32_t binding, VkBuffer bu
 }
 inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
                                                std::span<const VkDeviceSize> offsets) const noexcept {
-    fn_->vkCmdBindVertexBuffers(state_->cmd, first_binding, static_cast<std::uint32_t>(buffers.size()),
-                                       buffers.data(), offsets.data());
+    fn_->vkCmdBindVertexBuffers(state_->cmd, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                                offsets.data());
 }
 inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offset, VkIndexType type) const noexcept {
     fn_->vkCmdBindIndexBuffer(state_->cmd, buffer, offset, type);
@@ -366,17 +366,17 @@ inline void CommandBuffer::bind_descriptor_set(const Pipeline& pipeline, std::ui
                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
     VkDescriptorSet raw = set.vk();
     fn_->vkCmdBindDescriptorSets(state_->cmd, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
-                                        static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+                                 static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
 }
 inline void CommandBuffer::bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set,
                                                 std::span<const VkDescriptorSet> sets,
                                                 std::span<const std::uint32_t> dynamic_offsets) const noexcept {
     fn_->vkCmdBindDescriptorSets(state_->cmd, pipeline.bind_point(), pipeline.layout().vk(), first_set,
-                                        static_cast<std::uint32_t>(sets.size()), sets.data(),
-                                        static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+                                 static_cast<std::uint32_t>(sets.size()), sets.data(),
+                                 static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
 }
-inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShaderStageFlags stages,
-                                          std::uint32_t offset, std::uint32_t size, const void* data) const noexcept {
+inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
+                                          std::uint32_t size, const void* data) const noexcept {
     fn_->vkCmdPushConstants(state_->cmd, layout.vk(), stages, offset, size, data);
 }
 inline void CommandBuffer::set_viewport(const VkViewport& viewport) const noexcept {
@@ -402,23 +402,24 @@ inline void CommandBuffer::draw_indexed(std::uint32_t index_count, std::uint32_t
 inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
     fn_->vkCmdDispatch(state_->cmd, x, y, z);
 }
-inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const noexcept {
+inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst,
+                                       std::span<const VkBufferCopy> regions) const noexcept {
     fn_->vkCmdCopyBuffer(state_->cmd, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
                                                 std::span<const VkBufferImageCopy> regions) const noexcept {
     fn_->vkCmdCopyBufferToImage(state_->cmd, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                                       regions.data());
+                                regions.data());
 }
 inline void CommandBuffer::copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
                                                 std::span<const VkBufferImageCopy> regions) const noexcept {
     fn_->vkCmdCopyImageToBuffer(state_->cmd, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()),
-                                       regions.data());
+                                regions.data());
 }
 inline void CommandBuffer::copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
                                       std::span<const VkImageCopy> regions) const noexcept {
-    fn_->vkCmdCopyImage(state_->cmd, src, src_layout, dst, dst_layout,
-                               static_cast<std::uint32_t>(regions.size()), regions.data());
+    fn_->vkCmdCopyImage(state_->cmd, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                        regions.data());
 }
 inline void CommandBuffer::fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
                                        std::uint32_t data) const noexcept {

@@ -7,6 +7,8 @@
 // vkrc::mt) so both libraries can be linked into one program, while a
 // translation unit compiled for one policy cannot link against the other.
 
+// clang-format off
+// (the preprocessor layout below is kept as written)
 // Deliberately outside the include guard: a translation unit that includes
 // vkrc headers, changes VKRC_MULTI_THREAD and includes them again would
 // silently mix two object layouts, so it must not compile.
@@ -53,3 +55,4 @@
 #define VKRC_END_NAMESPACE } }
 
 #endif
+// clang-format on

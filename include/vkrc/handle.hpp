@@ -219,9 +219,7 @@ public:
     std::uint32_t use_count() const noexcept { return state_ ? state_->use_count() : 0; }
     // Drops this handle's reference.
     void reset() noexcept { state_.reset(); }
-    friend bool operator==(const Handle& a, const Handle& b) noexcept {
-        return a.state_.get() == b.state_.get();
-    }
+    friend bool operator==(const Handle& a, const Handle& b) noexcept { return a.state_.get() == b.state_.get(); }
 
     // The state block, for vkrc's own code and for extensions built on it.
     State* state() const noexcept { return state_.get(); }

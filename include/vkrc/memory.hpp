@@ -61,8 +61,8 @@ struct AllocationInfo {
     VkDeviceSize size = 0;         // usable bytes, at least the requested size
     VkDeviceSize memory_size = 0;  // of the whole VkDeviceMemory (the block)
     std::uint32_t memory_type = 0;
-    std::byte* mapped = nullptr;   // host address of offset; null when not host-visible
-    bool dedicated = false;        // the range is the whole of its own VkDeviceMemory
+    std::byte* mapped = nullptr;  // host address of offset; null when not host-visible
+    bool dedicated = false;       // the range is the whole of its own VkDeviceMemory
     // Set by the allocator that made the range; free checks it.
     const DeviceAllocator* allocator = nullptr;
     void* allocator_data = nullptr;  // the allocator's own bookkeeping
@@ -253,7 +253,8 @@ inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t
         throw_out_of_range(who, offset, count, element, size);
     }
     const VkDeviceSize bytes = VkDeviceSize(count) * element;
-    if (offset > size || bytes > size - offset) [[unlikely]] throw_out_of_range(who, offset, count, element, size);
+    if (offset > size || bytes > size - offset) [[unlikely]]
+        throw_out_of_range(who, offset, count, element, size);
 }
 
 // The one mapped write, for Allocation and WriteOnlyView: the range check
@@ -261,8 +262,8 @@ inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t
 // The caller passes the mapping's fields it already holds, so the view's
 // copies are used without a pointer chase.
 template <class T>
-inline void write_mapped(const char* who, const AllocationState* s, std::byte* mapped, VkDeviceSize size,
-                         bool coherent, VkDeviceSize offset, const T* data, std::size_t count) {
+inline void write_mapped(const char* who, const AllocationState* s, std::byte* mapped, VkDeviceSize size, bool coherent,
+                         VkDeviceSize offset, const T* data, std::size_t count) {
     static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
 #if VKRC_RUNTIME_CHECKS
     check_mapped_range(who, offset, count, sizeof(T), size);
@@ -272,7 +273,8 @@ inline void write_mapped(const char* who, const AllocationState* s, std::byte* m
 #endif
     if (count == 0) return;
     std::memcpy(mapped + offset, data, count * sizeof(T));
-    if (!coherent) [[unlikely]] s->flush(offset, count * sizeof(T));
+    if (!coherent) [[unlikely]]
+        s->flush(offset, count * sizeof(T));
 }
 
 }  // namespace detail
@@ -339,8 +341,10 @@ public:
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
         auto& s = *state_;
-        if (!s.info.mapped) [[unlikely]] detail::throw_not_host_visible("vkrc::Allocation::write");
-        detail::write_mapped("vkrc::Allocation::write", &s, s.info.mapped, s.info.size, s.coherent, offset, data, count);
+        if (!s.info.mapped) [[unlikely]]
+            detail::throw_not_host_visible("vkrc::Allocation::write");
+        detail::write_mapped("vkrc::Allocation::write", &s, s.info.mapped, s.info.size, s.coherent, offset, data,
+                             count);
     }
     template <class T>
     void write(VkDeviceSize offset, std::span<const T> data) const {
@@ -355,12 +359,14 @@ public:
     void read(VkDeviceSize offset, T* out, std::size_t count) const {
         static_assert(std::is_trivially_copyable_v<T>, "mapped reads copy bytes");
         auto& s = *state_;
-        if (!s.info.mapped) [[unlikely]] detail::throw_not_host_visible("vkrc::Allocation::read");
+        if (!s.info.mapped) [[unlikely]]
+            detail::throw_not_host_visible("vkrc::Allocation::read");
 #if VKRC_RUNTIME_CHECKS
         detail::check_mapped_range("vkrc::Allocation::read", offset, count, sizeof(T), s.info.size);
 #endif
         if (count == 0) return;
-        if (!s.coherent) [[unlikely]] s.invalidate(offset, count * sizeof(T));
+        if (!s.coherent) [[unlikely]]
+            s.invalidate(offset, count * sizeof(T));
         std::memcpy(out, s.info.mapped + offset, count * sizeof(T));
     }
     template <class T>

@@ -189,15 +189,15 @@ private:
     bool depth_test_ = true;
     bool depth_write_ = true;
     VkCompareOp depth_compare_ = VK_COMPARE_OP_LESS;
-    VkPipelineColorBlendAttachmentState blend_{VK_FALSE,
-                                               VK_BLEND_FACTOR_ONE,
-                                               VK_BLEND_FACTOR_ZERO,
-                                               VK_BLEND_OP_ADD,
-                                               VK_BLEND_FACTOR_ONE,
-                                               VK_BLEND_FACTOR_ZERO,
-                                               VK_BLEND_OP_ADD,
-                                               VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                                                   VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
+    VkPipelineColorBlendAttachmentState blend_{
+        VK_FALSE,
+        VK_BLEND_FACTOR_ONE,
+        VK_BLEND_FACTOR_ZERO,
+        VK_BLEND_OP_ADD,
+        VK_BLEND_FACTOR_ONE,
+        VK_BLEND_FACTOR_ZERO,
+        VK_BLEND_OP_ADD,
+        VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
     VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
     std::vector<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
     RenderPass render_pass_;

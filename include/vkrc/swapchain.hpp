@@ -19,7 +19,6 @@
 #include "vkrc/surface.hpp"
 #include "vkrc/sync.hpp"
 
-
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
@@ -76,7 +75,7 @@ private:
     std::uint32_t sync_count_ = 0;
     std::uint32_t acquire_slot_ = 0;
     detail::SwapchainChainState* chain_ = nullptr;  // kept alive by image
-    const void* source_ = nullptr;  // the headless presenter's state that made it
+    const void* source_ = nullptr;                  // the headless presenter's state that made it
 };
 
 // The interface the frame loop uses; Swapchain and HeadlessPresenter
@@ -103,9 +102,8 @@ protected:
 struct SwapchainCreateInfo {
     // Tried in order; the first the surface supports wins, otherwise the
     // surface's first format.
-    std::vector<VkSurfaceFormatKHR> preferred_formats = {
-        {VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
-        {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
+    std::vector<VkSurfaceFormatKHR> preferred_formats = {{VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
+                                                         {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
     // IMMEDIATE falls back to MAILBOX, MAILBOX to IMMEDIATE, both then to
     // FIFO (which every surface supports).
     VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;

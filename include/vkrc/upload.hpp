@@ -19,7 +19,8 @@ std::uint32_t format_texel_size(VkFormat format) noexcept;
 void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data);
 
 // Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
-std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size);
+std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset,
+                                       VkDeviceSize size);
 
 struct ImageUploadInfo {
     // The image's layout before the upload; UNDEFINED discards its contents.

@@ -143,9 +143,7 @@ void arm(std::uint64_t call, VkResult error) {
     calls.store(0);
     fired_name.store(nullptr);
 }
-std::uint64_t failable_calls() {
-    return calls.load();
-}
+std::uint64_t failable_calls() { return calls.load(); }
 void lose_device() {
     fired_name.store(nullptr);
     simulate_loss();

@@ -57,21 +57,22 @@ std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const Teap
     const auto& m = mesh();
     std::vector<Vertex> vertices(m.positions.size());
     for (std::size_t i = 0; i < vertices.size(); ++i) vertices[i] = {m.positions[i], m.normals[i]};
-    auto vertex_buffer = vkrc::Buffer::create(
-        device, {.size = vertices.size() * sizeof(Vertex),
-                 .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                 .allocator = allocator});
+    auto vertex_buffer =
+        vkrc::Buffer::create(device, {.size = vertices.size() * sizeof(Vertex),
+                                      .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      .allocator = allocator});
     vkrc::upload_buffer(queue, vertex_buffer, 0, std::as_bytes(std::span(vertices)));
-    auto index_buffer = vkrc::Buffer::create(
-        device, {.size = m.indices.size() * sizeof(std::uint16_t),
-                 .usage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                 .allocator = allocator});
+    auto index_buffer =
+        vkrc::Buffer::create(device, {.size = m.indices.size() * sizeof(std::uint16_t),
+                                      .usage = VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      .allocator = allocator});
     vkrc::upload_buffer(queue, index_buffer, 0, std::as_bytes(std::span(m.indices)));
 
     // One mapped uniform buffer and descriptor set per frame in flight.
-    auto set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_VERTEX_BIT}}});
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_VERTEX_BIT}}});
     auto descriptor_pool = vkrc::DescriptorPool::create(
         device, {.max_sets = ring, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ring}}});
     std::array<vkrc::Buffer, ring> uniforms;
@@ -86,26 +87,27 @@ std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const Teap
     }
 
     auto layout = vkrc::PipelineLayout::create(
-        device, {.set_layouts = {set_layout},
-                 .push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(DrawPush)}}});
-    auto pipeline = vkrc::GraphicsPipelineBuilder(layout)
-                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_vert))
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_frag))
-                        .vertex_binding(0, sizeof(Vertex))
-                        .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position))
-                        .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal))
-                        .cull_mode(VK_CULL_MODE_NONE)
-                        .rendering(std::array{color_format}, depth_format)
-                        .build();
+        device,
+        {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(DrawPush)}}});
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(layout)
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::teapot_frag))
+            .vertex_binding(0, sizeof(Vertex))
+            .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position))
+            .vertex_attribute(1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal))
+            .cull_mode(VK_CULL_MODE_NONE)
+            .rendering(std::array{color_format}, depth_format)
+            .build();
 
     // The offscreen target ring.
     std::array<Target, ring> targets;
     for (auto& t : targets) {
-        t.color = vkrc::Image::create(device, {.format = color_format,
-                                               .extent = {extent, extent, 1},
-                                               .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                                        VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                               .allocator = allocator});
+        t.color =
+            vkrc::Image::create(device, {.format = color_format,
+                                         .extent = {extent, extent, 1},
+                                         .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                         .allocator = allocator});
         t.depth = vkrc::Image::create(device, {.format = depth_format,
                                                .extent = {extent, extent, 1},
                                                .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
@@ -144,13 +146,12 @@ std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const Teap
             vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                 VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
-            vkrc::image_barrier(target.depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                0,
-                                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                                VK_IMAGE_ASPECT_DEPTH_BIT)};
+            vkrc::image_barrier(
+                target.depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT, 0,
+                VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, in);
         vkrc::RenderingAttachment color{.image_view = target.color_view.vk()};
         color.clear_value.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
@@ -174,11 +175,10 @@ std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const Teap
             cmd.draw_indexed(static_cast<std::uint32_t>(m.indices.size()));
         }
         cmd.end_rendering();
-        const auto out = vkrc::image_barrier(target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                                             VK_ACCESS_2_TRANSFER_READ_BIT);
+        const auto out = vkrc::image_barrier(
+            target.color.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         cmd.pipeline_barrier({}, {}, std::span(&out, 1));
         if (frame == options.frames - 1) {
             VkBufferImageCopy region{};

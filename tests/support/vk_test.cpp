@@ -58,7 +58,7 @@ void expect_no_validation_messages(ValidationLog& log) {
 }  // namespace vkrc_test
 
 #if defined(__SANITIZE_ADDRESS__)
-#include <dlfcn.h>
+#  include <dlfcn.h>
 namespace {
 // The loader unloads the driver and the layer at vkDestroyInstance; leaks
 // inside them would then be reported from "<unknown module>" and could not be

@@ -39,8 +39,10 @@ pid_t spawn_xvfb(const std::string& display) {
     posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
     std::string name = "Xvfb", screen = "-screen", zero = "0", geometry = "1280x1024x24", nolisten = "-nolisten",
                 tcp = "tcp";
-    char* argv[] = {name.data(), const_cast<char*>(display.c_str()), screen.data(), zero.data(), geometry.data(),
-                    nolisten.data(), tcp.data(), nullptr};
+    char* argv[] = {name.data(),     const_cast<char*>(display.c_str()),
+                    screen.data(),   zero.data(),
+                    geometry.data(), nolisten.data(),
+                    tcp.data(),      nullptr};
     pid_t pid = -1;
     int r = posix_spawnp(&pid, "Xvfb", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);

@@ -18,8 +18,8 @@ namespace {
 struct Colour {
     std::uint8_t r, g, b;
 };
-constexpr Colour palette[] = {{31, 119, 180}, {255, 127, 14}, {44, 160, 44}, {214, 39, 40}, {148, 103, 189},
-                              {140, 86, 75}};
+constexpr Colour palette[] = {{31, 119, 180}, {255, 127, 14},  {44, 160, 44},
+                              {214, 39, 40},  {148, 103, 189}, {140, 86, 75}};
 constexpr Colour black{0, 0, 0}, grey{200, 200, 200};
 
 class Canvas {
@@ -34,8 +34,12 @@ public:
                 p[0] = c.r, p[1] = c.g, p[2] = c.b, p[3] = 255;
             }
     }
-    void hline(int x0, int x1, int y, Colour c, int thick = 1) { fill(std::min(x0, x1), y, std::max(x0, x1) + 1, y + thick, c); }
-    void vline(int x, int y0, int y1, Colour c, int thick = 1) { fill(x, std::min(y0, y1), x + thick, std::max(y0, y1) + 1, c); }
+    void hline(int x0, int x1, int y, Colour c, int thick = 1) {
+        fill(std::min(x0, x1), y, std::max(x0, x1) + 1, y + thick, c);
+    }
+    void vline(int x, int y0, int y1, Colour c, int thick = 1) {
+        fill(x, std::min(y0, y1), x + thick, std::max(y0, y1) + 1, c);
+    }
 
     // Text at twice stb_easy_font's size, top-left at (x, y).
     void text(int x, int y, const std::string& s, Colour c) {
@@ -79,7 +83,8 @@ void write_png(const std::string& path, std::uint32_t width, std::uint32_t heigh
         throw std::runtime_error("cannot write " + path);
 }
 
-void write_histogram_png(const std::string& path, const std::string& title, const std::vector<HistogramSeries>& series) {
+void write_histogram_png(const std::string& path, const std::string& title,
+                         const std::vector<HistogramSeries>& series) {
     const int width = 900, height = 500, left = 70, right = 20, top = 50, bottom = 60;
     Canvas canvas(width, height);
     std::vector<double> all;

@@ -22,7 +22,7 @@ struct HistogramSeries {
 void write_histogram_png(const std::string& path, const std::string& title, const std::vector<HistogramSeries>& series);
 
 struct RatioBar {
-    std::string group;    // stage
+    std::string group;  // stage
     std::string variant;
     double ratio = 0, low = 0, high = 0;
 };

@@ -151,11 +151,10 @@ public:
 };
 
 // Windowed mode's choices (the convention above), one rule for all variants.
-inline constexpr VkSurfaceFormatKHR window_formats[2] = {
-    {VK_FORMAT_B8G8R8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
-    {VK_FORMAT_R8G8B8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
-inline constexpr VkPresentModeKHR window_present_modes[3] = {VK_PRESENT_MODE_IMMEDIATE_KHR,
-                                                             VK_PRESENT_MODE_MAILBOX_KHR, VK_PRESENT_MODE_FIFO_KHR};
+inline constexpr VkSurfaceFormatKHR window_formats[2] = {{VK_FORMAT_B8G8R8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
+                                                         {VK_FORMAT_R8G8B8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
+inline constexpr VkPresentModeKHR window_present_modes[3] = {VK_PRESENT_MODE_IMMEDIATE_KHR, VK_PRESENT_MODE_MAILBOX_KHR,
+                                                             VK_PRESENT_MODE_FIFO_KHR};
 
 inline bool is_window_format(VkSurfaceFormatKHR f) {
     return std::any_of(std::begin(window_formats), std::end(window_formats), [&](const VkSurfaceFormatKHR& w) {
@@ -164,7 +163,8 @@ inline bool is_window_format(VkSurfaceFormatKHR f) {
 }
 
 [[noreturn]] inline void throw_no_window_format() {
-    throw std::runtime_error("--window: the surface supports neither B8G8R8A8_UNORM nor R8G8B8A8_UNORM (SRGB_NONLINEAR)");
+    throw std::runtime_error(
+        "--window: the surface supports neither B8G8R8A8_UNORM nor R8G8B8A8_UNORM (SRGB_NONLINEAR)");
 }
 
 inline VkSurfaceFormatKHR choose_window_format(std::span<const VkSurfaceFormatKHR> supported) {
@@ -252,9 +252,9 @@ VKAPI_ATTR VkBool32 VKAPI_CALL validation_callback(VkDebugUtilsMessageSeverityFl
                                                    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
 inline constexpr VkDebugUtilsMessageSeverityFlagsEXT validation_severities =
     VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-inline constexpr VkDebugUtilsMessageTypeFlagsEXT validation_types =
-    VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+inline constexpr VkDebugUtilsMessageTypeFlagsEXT validation_types = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                                                                    VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                                                                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
 inline constexpr const char* validation_layer = "VK_LAYER_KHRONOS_validation";
 
 // The variants this program has, by name, in the order they are listed.

@@ -14,8 +14,8 @@ namespace {
 [[noreturn]] void throw_glfw(const char* call, const char* hint = "") {
     const char* description = nullptr;
     glfwGetError(&description);
-    throw std::runtime_error(std::string("--window: ") + call + " failed: " +
-                             (description ? description : "no GLFW error description") + hint);
+    throw std::runtime_error(std::string("--window: ") + call +
+                             " failed: " + (description ? description : "no GLFW error description") + hint);
 }
 
 }  // namespace

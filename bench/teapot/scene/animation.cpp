@@ -35,7 +35,7 @@ glm::dmat3 teapot_rotation(int index, double t) {
     double spin = 0.5 * (1 + index % 3) * w + 0.7 * index;
     double tilt = 0.25 * std::sin(0.5 * w + index);
     double cs = std::cos(spin), ss = std::sin(spin), ct = std::cos(tilt), st = std::sin(tilt);
-    glm::dmat3 spin_y(cs, 0, -ss, 0, 1, 0, ss, 0, cs);     // columns
+    glm::dmat3 spin_y(cs, 0, -ss, 0, 1, 0, ss, 0, cs);  // columns
     glm::dmat3 tilt_x(1, 0, 0, 0, ct, st, 0, -st, ct);
     glm::dmat3 z_up_to_y_up(1, 0, 0, 0, 0, -1, 0, 1, 0);  // model z -> world y
     return tilt_x * spin_y * z_up_to_y_up;
@@ -54,7 +54,8 @@ PushConstants teapot_draw(int index, int count, double t) {
     glm::dmat4 world(1.0);
     for (int c = 0; c < 3; ++c) world[c] = glm::dvec4(r[c], 0.0);
     world[3] = glm::dvec4(translation, 1.0);
-    glm::dvec4 colour(0.55 + 0.45 * std::sin(0.5 * w + 0.9 * index), 0.55 + 0.45 * std::sin(1.0 * w + 2.1 * index + 2.0),
+    glm::dvec4 colour(0.55 + 0.45 * std::sin(0.5 * w + 0.9 * index),
+                      0.55 + 0.45 * std::sin(1.0 * w + 2.1 * index + 2.0),
                       0.55 + 0.45 * std::sin(1.5 * w + 3.3 * index + 4.0), 1.0);
     return {glm::mat4(world), glm::vec4(colour)};
 }

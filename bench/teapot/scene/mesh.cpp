@@ -116,9 +116,8 @@ std::vector<Patch> parse_patches(std::string_view text) {
     for (std::size_t n = 0; n < patch_count; ++n) {
         for (int k = 0; k < 16; ++k) {
             if (indices[n][k] >= point_count)
-                throw std::runtime_error("teapot::parse_patches: patch " + std::to_string(n + 1) +
-                                         " uses point " + std::to_string(indices[n][k] + 1) + " of " +
-                                         std::to_string(point_count));
+                throw std::runtime_error("teapot::parse_patches: patch " + std::to_string(n + 1) + " uses point " +
+                                         std::to_string(indices[n][k] + 1) + " of " + std::to_string(point_count));
             patches[n].p[k] = points[indices[n][k]];
         }
     }
@@ -130,9 +129,7 @@ const std::vector<Patch>& newell_teapot() {
     return patches;
 }
 
-glm::dvec3 evaluate(const Patch& patch, double u, double v) {
-    return combine(patch, bernstein(u), bernstein(v));
-}
+glm::dvec3 evaluate(const Patch& patch, double u, double v) { return combine(patch, bernstein(u), bernstein(v)); }
 
 SurfacePoint evaluate_point(const Patch& patch, double u, double v) {
     auto bu = bernstein(u), bv = bernstein(v);
@@ -150,10 +147,8 @@ SurfacePoint evaluate_point(const Patch& patch, double u, double v) {
         // limit from inside the patch is the cross with the mixed derivative,
         // signed by the side the inside lies on.
         glm::dvec3 duv = combine(patch, du, dv);
-        if (glm::length(s.dv) <= tiny)
-            n = glm::cross(s.du, duv) * (u < 0.5 ? 1.0 : -1.0);
-        else if (glm::length(s.du) <= tiny)
-            n = glm::cross(duv, s.dv) * (v < 0.5 ? 1.0 : -1.0);
+        if (glm::length(s.dv) <= tiny) n = glm::cross(s.du, duv) * (u < 0.5 ? 1.0 : -1.0);
+        else if (glm::length(s.du) <= tiny) n = glm::cross(duv, s.dv) * (v < 0.5 ? 1.0 : -1.0);
     }
     double length = glm::length(n);
     if (!(length > 0.0) || !std::isfinite(length)) {
@@ -255,8 +250,7 @@ Mesh tessellate(std::span<const Patch> patches, int quads_per_edge) {
 
 GeometricError geometric_error(std::span<const Patch> patches, const Mesh& mesh, int samples_per_edge) {
     if (samples_per_edge < 1)
-        throw std::invalid_argument("teapot::geometric_error: samples_per_edge is " +
-                                    std::to_string(samples_per_edge));
+        throw std::invalid_argument("teapot::geometric_error: samples_per_edge is " + std::to_string(samples_per_edge));
     GeometricError error;
     double sum_squares = 0;
     const int s = samples_per_edge;

@@ -23,9 +23,11 @@ namespace teapot {
 namespace {
 
 void check(VkResult result, const char* call) {
-    if (result != VK_SUCCESS) throw std::runtime_error(std::string(call) + " failed: VkResult " + std::to_string(result));
+    if (result != VK_SUCCESS)
+        throw std::runtime_error(std::string(call) + " failed: VkResult " + std::to_string(result));
 }
 
+// clang-format off
 // Device-level functions the variant calls.
 #define TEAPOT_DEVICE_FUNCTIONS(X)                                                                               \
     X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) X(vkCreateBuffer) X(vkDestroyBuffer)               \
@@ -42,6 +44,7 @@ void check(VkResult result, const char* call) {
     X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)                \
     X(vkCreateSemaphore) X(vkDestroySemaphore) X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR)                   \
     X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) X(vkQueuePresentKHR)
+// clang-format on
 
 struct DeviceFunctions {
 #define TEAPOT_MEMBER(name) PFN_##name name = nullptr;
@@ -79,7 +82,9 @@ public:
         slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
         if (!present_to_window_) {
             image_ = static_cast<std::uint32_t>(frame_ % ring_.size());
-            target_ = {ring_[image_].image, ring_[image_].view, {config_.width, config_.height},
+            target_ = {ring_[image_].image,
+                       ring_[image_].view,
+                       {config_.width, config_.height},
                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
             return;
         }
@@ -93,8 +98,7 @@ public:
             }
             if (result == VK_SUBOPTIMAL_KHR)
                 swapchain_stale_ = true;  // the image is still usable: re-created after its present
-            else
-                check(result, "vkAcquireNextImageKHR");
+            else check(result, "vkAcquireNextImageKHR");
             break;
         }
         target_ = {swapchain_images_[image_], swapchain_views_[image_], swapchain_extent_,
@@ -108,11 +112,13 @@ public:
 
     void command() override {
         Frame& f = frames_[slot_];
-        check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.pool, 0), "vkResetCommandPool");
+        check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.pool, 0),
+              "vkResetCommandPool");
         VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         VkCommandBuffer cmd = f.cmd;
-        check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin), "vkBeginCommandBuffer");
+        check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin),
+              "vkBeginCommandBuffer");
 
         VkImageMemoryBarrier2 to_render[2]{};
         to_render[0].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
@@ -234,8 +240,7 @@ public:
             VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(queue_, &info);
             if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
                 swapchain_stale_ = true;  // re-created at the next acquire
-            else
-                check(result, "vkQueuePresentKHR");
+            else check(result, "vkQueuePresentKHR");
         }
         presented_image_ = image_;
         ++frame_;
@@ -329,9 +334,9 @@ public:
     const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
 
     std::string presentation() const override {
-        return config_.window ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(),
-                                                       swapchain_extent_)
-                              : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
+        return config_.window
+                   ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(), swapchain_extent_)
+                   : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
     }
 
 private:
@@ -360,10 +365,8 @@ private:
     // own pointer for raw-direct. Resolved at compile time.
     template <typename Pfn>
     Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
-        if constexpr (Direct)
-            return fn_.*member;
-        else
-            return exported;
+        if constexpr (Direct) return fn_.*member;
+        else return exported;
     }
 
     void create_instance() {
@@ -430,8 +433,9 @@ private:
             if (physical_device_) break;
         }
         if (!physical_device_)
-            throw std::runtime_error(config_.window ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
-                                                    : "no Vulkan 1.3 device with a graphics queue");
+            throw std::runtime_error(config_.window
+                                         ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
+                                         : "no Vulkan 1.3 device with a graphics queue");
         vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
 
         float priority = 1.0f;
@@ -499,8 +503,8 @@ private:
         normals_ = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, normals_memory_);
         indices_ = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, indices_memory_);
         uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
-        uniform_buffer_ = create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                                        uniform_);
+        uniform_buffer_ =
+            create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, uniform_);
         readback_buffer_ = create_buffer(VkDeviceSize(config_.width) * config_.height * 4,
                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback_);
     }
@@ -553,8 +557,7 @@ private:
     void create_images() {
         ring_.resize(config_.window ? 1 : config_.frames_in_flight + 1);
         for (Image& image : ring_)
-            image = create_image(colour_format_,
-                                 VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+            image = create_image(colour_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                                  VK_IMAGE_ASPECT_COLOR_BIT, {config_.width, config_.height});
         create_depth();
     }
@@ -676,10 +679,20 @@ private:
         VkShaderModule vert = create_shader(vkrc_shaders::teapot_vert);
         VkShaderModule frag = create_shader(vkrc_shaders::teapot_frag);
         VkPipelineShaderStageCreateInfo stages[2]{};
-        stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
-                     vert, "main", nullptr};
-        stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
-                     frag, "main", nullptr};
+        stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                     nullptr,
+                     0,
+                     VK_SHADER_STAGE_VERTEX_BIT,
+                     vert,
+                     "main",
+                     nullptr};
+        stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                     nullptr,
+                     0,
+                     VK_SHADER_STAGE_FRAGMENT_BIT,
+                     frag,
+                     "main",
+                     nullptr};
         VkVertexInputBindingDescription bindings[2] = {{0, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX},
                                                        {1, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX}};
         VkVertexInputAttributeDescription attributes[2] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
@@ -706,8 +719,8 @@ private:
         depth.depthWriteEnable = VK_TRUE;
         depth.depthCompareOp = VK_COMPARE_OP_LESS;
         VkPipelineColorBlendAttachmentState blend_attachment{};
-        blend_attachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                                          VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+        blend_attachment.colorWriteMask =
+            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
         VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
         blend.attachmentCount = 1;
         blend.pAttachments = &blend_attachment;

@@ -53,7 +53,8 @@ public:
             if (swapchain_stale_) recreate_swapchain();
             try {
                 auto [result, index] = swapchain_.acquireNextImage(UINT64_MAX, *frames_[slot_].acquire_semaphore);
-                if (result == vk::Result::eSuboptimalKHR) swapchain_stale_ = true;  // usable; re-created after its present
+                if (result == vk::Result::eSuboptimalKHR)
+                    swapchain_stale_ = true;  // usable; re-created after its present
                 image_ = index;
                 break;
             } catch (const vk::OutOfDateKHRError&) {
@@ -75,12 +76,11 @@ public:
         const vk::raii::CommandBuffer& cmd = f.cmd;
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
         std::array<vk::ImageMemoryBarrier2, 2> to_render{
-            vk::ImageMemoryBarrier2(vk::PipelineStageFlagBits2::eColorAttachmentOutput, {},
-                                    vk::PipelineStageFlagBits2::eColorAttachmentOutput,
-                                    vk::AccessFlagBits2::eColorAttachmentWrite, vk::ImageLayout::eUndefined,
-                                    vk::ImageLayout::eColorAttachmentOptimal, VK_QUEUE_FAMILY_IGNORED,
-                                    VK_QUEUE_FAMILY_IGNORED, target_.image,
-                                    {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}),
+            vk::ImageMemoryBarrier2(
+                vk::PipelineStageFlagBits2::eColorAttachmentOutput, {},
+                vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
+                vk::ImageLayout::eUndefined, vk::ImageLayout::eColorAttachmentOptimal, VK_QUEUE_FAMILY_IGNORED,
+                VK_QUEUE_FAMILY_IGNORED, target_.image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}),
             vk::ImageMemoryBarrier2(
                 vk::PipelineStageFlagBits2::eEarlyFragmentTests | vk::PipelineStageFlagBits2::eLateFragmentTests,
                 vk::AccessFlagBits2::eDepthStencilAttachmentWrite,
@@ -97,8 +97,7 @@ public:
         vk::RenderingAttachmentInfo depth(*depth_.view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
                                           vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
                                           vk::ClearDepthStencilValue(1.0f, 0));
-        cmd.beginRendering(
-            vk::RenderingInfo({}, {{0, 0}, target_.extent}, 1, 0, colour, &depth));
+        cmd.beginRendering(vk::RenderingInfo({}, {{0, 0}, target_.extent}, 1, 0, colour, &depth));
         cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline_);
         cmd.setViewport(0, vk::Viewport(0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1));
         cmd.setScissor(0, vk::Rect2D({0, 0}, target_.extent));
@@ -180,14 +179,14 @@ public:
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
         vk::ImageMemoryBarrier2 to_copy(
             vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
-            vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferRead,
-            vk::ImageLayout::eTransferSrcOptimal, vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED,
-            VK_QUEUE_FAMILY_IGNORED, *ring_[presented_image_].image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+            vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferRead, vk::ImageLayout::eTransferSrcOptimal,
+            vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
+            *ring_[presented_image_].image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
         cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_copy));
         vk::BufferImageCopy region(0, 0, 0, {vk::ImageAspectFlagBits::eColor, 0, 0, 1}, {0, 0, 0},
                                    {config_.width, config_.height, 1});
-        cmd.copyImageToBuffer(*ring_[presented_image_].image, vk::ImageLayout::eTransferSrcOptimal,
-                              *readback_.buffer, region);
+        cmd.copyImageToBuffer(*ring_[presented_image_].image, vk::ImageLayout::eTransferSrcOptimal, *readback_.buffer,
+                              region);
         vk::BufferMemoryBarrier2 to_host(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
                                          vk::PipelineStageFlagBits2::eHost, vk::AccessFlagBits2::eHostRead,
                                          VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *readback_.buffer, 0,
@@ -209,9 +208,10 @@ public:
     const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
 
     std::string presentation() const override {
-        return config_.window ? swapchain_presentation(VkFormat(colour_format_), VkPresentModeKHR(present_mode_),
-                                                       swapchain_images_.size(), swapchain_extent_)
-                              : headless_presentation(ring_.size(), VkFormat(colour_format_), {config_.width, config_.height});
+        return config_.window
+                   ? swapchain_presentation(VkFormat(colour_format_), VkPresentModeKHR(present_mode_),
+                                            swapchain_images_.size(), swapchain_extent_)
+                   : headless_presentation(ring_.size(), VkFormat(colour_format_), {config_.width, config_.height});
     }
 
 private:
@@ -286,15 +286,17 @@ private:
             if (physical_device_) break;
         }
         if (!physical_device_)
-            throw std::runtime_error(config_.window ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
-                                                    : "no Vulkan 1.3 device with a graphics queue");
+            throw std::runtime_error(config_.window
+                                         ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
+                                         : "no Vulkan 1.3 device with a graphics queue");
         memory_properties_ = physical_device_->getMemoryProperties();
         float priority = 1.0f;
         vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
         std::vector<const char*> extensions;
         if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
         vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> chain(
-            vk::DeviceCreateInfo({}, queue_info, {}, extensions), vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
+            vk::DeviceCreateInfo({}, queue_info, {}, extensions),
+            vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
         device_.emplace(*physical_device_, chain.get<vk::DeviceCreateInfo>());
         queue_.emplace(*device_, queue_family_, 0);
     }
@@ -313,8 +315,7 @@ private:
         vk::MemoryRequirements requirements = b.buffer.getMemoryRequirements();
         const vk::MemoryPropertyFlags host =
             vk::MemoryPropertyFlagBits::eHostVisible | vk::MemoryPropertyFlagBits::eHostCoherent;
-        std::uint32_t type =
-            memory_type(requirements.memoryTypeBits, host | vk::MemoryPropertyFlagBits::eDeviceLocal);
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, host | vk::MemoryPropertyFlagBits::eDeviceLocal);
         if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, host);
         b.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
         b.buffer.bindMemory(*b.memory, 0);
@@ -336,8 +337,8 @@ private:
         uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
         uniform_ = create_buffer(uniform_stride_ * config_.frames_in_flight, vk::BufferUsageFlagBits::eUniformBuffer);
         uniform_mapped_ = uniform_.mapped;
-        readback_ = create_buffer(vk::DeviceSize(config_.width) * config_.height * 4,
-                                  vk::BufferUsageFlagBits::eTransferDst);
+        readback_ =
+            create_buffer(vk::DeviceSize(config_.width) * config_.height * 4, vk::BufferUsageFlagBits::eTransferDst);
     }
 
     Image create_image(vk::Format format, vk::ImageUsageFlags usage, vk::ImageAspectFlags aspect, vk::Extent2D extent) {
@@ -350,8 +351,8 @@ private:
         if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, {});
         image.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
         image.image.bindMemory(*image.memory, 0);
-        image.view = vk::raii::ImageView(
-            *device_, vk::ImageViewCreateInfo({}, *image.image, vk::ImageViewType::e2D, format, {}, {aspect, 0, 1, 0, 1}));
+        image.view = vk::raii::ImageView(*device_, vk::ImageViewCreateInfo({}, *image.image, vk::ImageViewType::e2D,
+                                                                           format, {}, {aspect, 0, 1, 0, 1}));
         return image;
     }
 
@@ -360,9 +361,9 @@ private:
     void create_images() {
         const int ring_size = config_.window ? 1 : config_.frames_in_flight + 1;
         for (int i = 0; i < ring_size; ++i)
-            ring_.push_back(create_image(colour_format_,
-                                         vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
-                                         vk::ImageAspectFlagBits::eColor, {config_.width, config_.height}));
+            ring_.push_back(create_image(
+                colour_format_, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+                vk::ImageAspectFlagBits::eColor, {config_.width, config_.height}));
         create_depth();
     }
 
@@ -393,20 +394,19 @@ private:
         const VkSurfaceCapabilitiesKHR caps = physical_device_->getSurfaceCapabilitiesKHR(**surface_);
         const VkExtent2D extent = swapchain_extent(config_, caps);
         if (extent.width == 0 || extent.height == 0) return false;
-        vk::SwapchainCreateInfoKHR info({}, **surface_, swapchain_image_request(config_, caps), surface_format_.format,
-                                        surface_format_.colorSpace, vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment,
-                                        vk::SharingMode::eExclusive, {},
-                                        vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
-                                        vk::CompositeAlphaFlagBitsKHR(composite_alpha(caps)), present_mode_, true,
-                                        *swapchain_);
+        vk::SwapchainCreateInfoKHR info(
+            {}, **surface_, swapchain_image_request(config_, caps), surface_format_.format, surface_format_.colorSpace,
+            vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment, vk::SharingMode::eExclusive, {},
+            vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
+            vk::CompositeAlphaFlagBitsKHR(composite_alpha(caps)), present_mode_, true, *swapchain_);
         swapchain_views_.clear();
         render_done_.clear();
         swapchain_ = vk::raii::SwapchainKHR(*device_, info);  // destroys the retired one
         swapchain_images_ = swapchain_.getImages();
         for (vk::Image image : swapchain_images_) {
-            swapchain_views_.emplace_back(*device_, vk::ImageViewCreateInfo({}, image, vk::ImageViewType::e2D,
-                                                                            colour_format_, {},
-                                                                            {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}));
+            swapchain_views_.emplace_back(*device_,
+                                          vk::ImageViewCreateInfo({}, image, vk::ImageViewType::e2D, colour_format_, {},
+                                                                  {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1}));
             render_done_.emplace_back(*device_, vk::SemaphoreCreateInfo());
         }
         swapchain_extent_ = extent;
@@ -466,8 +466,8 @@ private:
         vk::DescriptorPoolSize pool_size(vk::DescriptorType::eUniformBuffer, slots);
         // vk::raii::DescriptorSet frees its set on destruction, which needs the flag.
         descriptor_pool_ = vk::raii::DescriptorPool(
-            *device_, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, slots,
-                                                   pool_size));
+            *device_,
+            vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, slots, pool_size));
         for (std::uint32_t i = 0; i < slots; ++i) {
             Frame f;
             f.pool = vk::raii::CommandPool(

@@ -37,7 +37,7 @@
 #include <string>
 
 #ifndef TEAPOT_VKRC_FACTORY
-#error "TEAPOT_VKRC_FACTORY must name this copy's factory (make_vkrc_st_variant or make_vkrc_mt_variant)"
+#  error "TEAPOT_VKRC_FACTORY must name this copy's factory (make_vkrc_st_variant or make_vkrc_mt_variant)"
 #endif
 
 namespace teapot {
@@ -96,11 +96,11 @@ public:
             vkrc::image_barrier(frame_.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                 vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
-            vkrc::image_barrier(depth_.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depth_stages,
-                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                                    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                                VK_IMAGE_ASPECT_DEPTH_BIT)};
+            vkrc::image_barrier(
+                depth_.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, to_render);
 
         vkrc::RenderingAttachment colour{frame_.view.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -109,9 +109,8 @@ public:
         vkrc::RenderingAttachment depth{depth_view_.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                                         VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
         depth.clear_value.depthStencil = {1.0f, 0};
-        cmd.begin_rendering({.render_area = {{0, 0}, frame_.extent},
-                             .color_attachments = {&colour, 1},
-                             .depth_attachment = &depth});
+        cmd.begin_rendering(
+            {.render_area = {{0, 0}, frame_.extent}, .color_attachments = {&colour, 1}, .depth_attachment = &depth});
 
         cmd.bind_pipeline(pipeline_);
         cmd.set_viewport_and_scissor(frame_.extent);
@@ -128,10 +127,10 @@ public:
         cmd.end_rendering();
 
         // PRESENT_SRC_KHR for a swapchain, TRANSFER_SRC_OPTIMAL headless.
-        const VkImageMemoryBarrier2 to_present = vkrc::image_barrier(
-            frame_.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
-            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-            VK_PIPELINE_STAGE_2_NONE, 0);
+        const VkImageMemoryBarrier2 to_present =
+            vkrc::image_barrier(frame_.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
+                                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, {&to_present, 1});
         cmd.end();
     }
@@ -252,8 +251,7 @@ private:
             info.extent = {config_.width, config_.height};  // where the surface leaves it to the swapchain
             swapchain_ = vkrc::Swapchain::create(queue_, surface_, info);
             // vkrc falls back to the surface's first format; the convention has no fallback.
-            if (!is_window_format({swapchain_.format(), swapchain_.color_space()}))
-                throw_no_window_format();
+            if (!is_window_format({swapchain_.format(), swapchain_.color_space()})) throw_no_window_format();
             format = swapchain_.format();
         }
         offscreen_ = vkrc::HeadlessPresenter::create(
@@ -281,12 +279,11 @@ private:
         // write strategy of every variant (no flush).
         const VkDeviceSize alignment = device_.physical_device().properties().limits.minUniformBufferOffsetAlignment;
         uniform_stride_ = (sizeof(CameraUniforms) + alignment - 1) / alignment * alignment;
-        uniforms_ = vkrc::Buffer::create(
-            device_, {.size = uniform_stride_ * config_.frames_in_flight,
-                      .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
-                      .memory = {.usage = vkrc::MemoryUsage::upload,
-                                 .required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                                 .preferred_flags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT}});
+        uniforms_ = vkrc::Buffer::create(device_, {.size = uniform_stride_ * config_.frames_in_flight,
+                                                   .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                                                   .memory = {.usage = vkrc::MemoryUsage::upload,
+                                                              .required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                                              .preferred_flags = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT}});
         uniform_writer_ = uniforms_.allocation().write_only();
     }
 
@@ -305,18 +302,18 @@ private:
         vkrc::PipelineLayout layout = vkrc::PipelineLayout::create(
             device_, {.set_layouts = {set_layout_},
                       .push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)}}});
-        pipeline_ = vkrc::GraphicsPipelineBuilder(layout)
-                        .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_vert))
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT,
-                                vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_frag))
-                        .vertex_binding(0, sizeof(glm::vec3))
-                        .vertex_binding(1, sizeof(glm::vec3))
-                        .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0)
-                        .vertex_attribute(1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0)
-                        .cull_mode(VK_CULL_MODE_NONE)  // the spout and lid openings show inner faces
-                        .depth_test(true, true, VK_COMPARE_OP_LESS)
-                        .rendering({&colour_format_, 1}, depth_format)
-                        .build();
+        pipeline_ =
+            vkrc::GraphicsPipelineBuilder(layout)
+                .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_vert))
+                .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_frag))
+                .vertex_binding(0, sizeof(glm::vec3))
+                .vertex_binding(1, sizeof(glm::vec3))
+                .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0)
+                .vertex_attribute(1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0)
+                .cull_mode(VK_CULL_MODE_NONE)  // the spout and lid openings show inner faces
+                .depth_test(true, true, VK_COMPARE_OP_LESS)
+                .rendering({&colour_format_, 1}, depth_format)
+                .build();
     }
 
     void create_frames() {
@@ -350,10 +347,10 @@ private:
     vkrc::Buffer uniforms_;
     vkrc::WriteOnlyView uniform_writer_;
     VkDeviceSize uniform_stride_ = 0;
-    vkrc::Swapchain swapchain_;           // windowed
-    vkrc::HeadlessPresenter offscreen_;   // headless: every frame; windowed: the reference frame
+    vkrc::Swapchain swapchain_;          // windowed
+    vkrc::HeadlessPresenter offscreen_;  // headless: every frame; windowed: the reference frame
     vkrc::Presenter* presenter_ = nullptr;
-    vkrc::Frame frame_;                   // the frame between acquire and the next acquire
+    vkrc::Frame frame_;  // the frame between acquire and the next acquire
     vkrc::Image depth_;
     vkrc::ImageView depth_view_;
     VkExtent2D depth_extent_{};

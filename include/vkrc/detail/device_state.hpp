@@ -42,8 +42,7 @@ struct QueueState {
     // Raises the completed cache to value (several threads may refresh it).
     void note_completed(std::uint64_t value) noexcept {
         std::uint64_t seen = completed.load(__ATOMIC_RELAXED);
-        while (seen < value && !completed.compare_exchange_weak(seen, value, __ATOMIC_RELAXED)) {
-        }
+        while (seen < value && !completed.compare_exchange_weak(seen, value, __ATOMIC_RELAXED)) {}
     }
 };
 
@@ -81,8 +80,7 @@ public:
     // a fence or the timeline has already shown it), signalling the timeline
     // first when no submit has; failed_call, if given, receives the name of
     // the call that failed.
-    VkResult wait_for_submission(QueueState& queue, std::uint64_t number,
-                                 const char** failed_call = nullptr) noexcept;
+    VkResult wait_for_submission(QueueState& queue, std::uint64_t number, const char** failed_call = nullptr) noexcept;
 
     // For objects a pool owns (command buffers, descriptor sets), which must
     // be freed under their pool's lock rather than by a DeferredAction: the

@@ -26,8 +26,7 @@ public:
             device.submitted_snapshot(scratch_);
             if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
             batches_.back().handles.push_back(handle);
-        } catch (...) {
-        }
+        } catch (...) {}
     }
     // Caller holds the pool's lock. Moves the handles whose GPU work has
     // completed into out, in the order they were pushed.
