@@ -1,4 +1,6 @@
 #include "vkrc/device.hpp"
+
+#include "text.hpp"
 #include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
 
 #include <algorithm>
@@ -14,52 +16,43 @@ DeviceState::~DeviceState() {
     if (device == VK_NULL_HANDLE) return;
     // Every handle is gone; whatever the GPU still runs must finish before
     // the queued destructions. A lost device returns at once.
-    VkResult idle = fn.vkDeviceWaitIdle(device);
-    if (idle == VK_ERROR_DEVICE_LOST) mark_lost();
+    VkResult idle = note_result(fn.vkDeviceWaitIdle(device));
     if (idle != VK_SUCCESS && !lost.load(std::memory_order_relaxed)) {
         // Out of memory while waiting: vkrc's own timelines still say when
         // its submissions are done.
-        for (auto& q : queues) wait_for_submission(q, q.submitted.load(std::memory_order_acquire));
+        for (auto& q : queues) wait_for_submission(q, q.timeline.last_submitted());
     }
-    for (auto& batch : deferred_) {
-        for (auto& action : batch.actions) action.run(*this, action.handle, action.context);
-    }
-    deferred_.clear();
-    release_allocators();
+    deferred.run_all(*this);
+    allocators.release_all(*this);
     for (auto& q : queues) {
-        if (q.timeline != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.timeline, nullptr);
+        if (q.semaphore != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.semaphore, nullptr);
     }
     if (ownership == Ownership::owned) fn.vkDestroyDevice(device, nullptr);
 }
 
 bool DeviceState::refresh(QueueState& q) noexcept {
     std::uint64_t value = 0;
-    VkResult r = fn.vkGetSemaphoreCounterValue(device, q.timeline, &value);
-    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
-    if (r != VK_SUCCESS) return false;
-    q.note_completed(value);
+    if (note_result(fn.vkGetSemaphoreCounterValue(device, q.semaphore, &value)) != VK_SUCCESS) return false;
+    q.timeline.note_completed(value);
     return true;
 }
 
 bool DeviceState::idle_now() noexcept {
     bool idle = true;
     for (auto& q : queues) {
-        const std::uint64_t last = q.submitted.load(std::memory_order_acquire);
-        if (q.completed.load(std::memory_order_relaxed) >= last) continue;
+        const std::uint64_t last = q.timeline.last_submitted();
+        if (q.timeline.completed() >= last) continue;
         // Without a signal covering the last submit, nothing says it has completed.
-        if (q.signalled.load(std::memory_order_acquire) < last || !refresh(q) ||
-            q.completed.load(std::memory_order_relaxed) < last) {
-            idle = false;
-        }
+        if (q.timeline.last_signalled() < last || !refresh(q) || q.timeline.completed() < last) idle = false;
     }
     return idle || lost.load(std::memory_order_relaxed);
 }
 
 VkResult DeviceState::wait_for_submission(QueueState& q, std::uint64_t number, const char** failed_call) noexcept {
-    if (q.completed.load(std::memory_order_relaxed) >= number) return VK_SUCCESS;
+    if (q.timeline.completed() >= number) return VK_SUCCESS;
     // Waits for a value some submit signals, at or after that submission (the
     // validation layer of 1.3.239 reports a timeout for values between signals).
-    std::uint64_t value = q.signalled.load(std::memory_order_acquire);
+    std::uint64_t value = q.timeline.last_signalled();
     if (value < number) {
         VkResult r = signal_submitted_work(q, value);
         if (r != VK_SUCCESS) {
@@ -69,46 +62,67 @@ VkResult DeviceState::wait_for_submission(QueueState& q, std::uint64_t number, c
     }
     VkSemaphoreWaitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
     wait.semaphoreCount = 1;
-    wait.pSemaphores = &q.timeline;
+    wait.pSemaphores = &q.semaphore;
     wait.pValues = &value;
-    VkResult r = fn.vkWaitSemaphores(device, &wait, UINT64_MAX);
-    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
-    if (r == VK_SUCCESS) q.note_completed(value);
+    VkResult r = note_result(fn.vkWaitSemaphores(device, &wait, UINT64_MAX));
+    if (r == VK_SUCCESS) q.timeline.note_completed(value);
     if (r != VK_SUCCESS && failed_call) *failed_call = "vkWaitSemaphores";
     return r;
 }
 
+void DeviceState::await_submission(QueueState& q, std::uint64_t number) {
+    const char* failed_call = nullptr;
+    VkResult r = wait_for_submission(q, number, &failed_call);
+    if (r != VK_SUCCESS) check(r, failed_call);
+}
+
 VkResult DeviceState::signal_submitted_work(QueueState& q, std::uint64_t& value) noexcept {
     LockGuard lock(q.mutex);
-    const std::uint64_t last = q.submitted.load(std::memory_order_relaxed);
-    value = q.signalled.load(std::memory_order_relaxed);
-    if (value == last) return VK_SUCCESS;
-    const bool wanted = q.signal_wanted.exchange(false, std::memory_order_relaxed);
+    const std::uint64_t number = q.timeline.next_number();
+    value = q.timeline.last_signalled();
+    if (value == number - 1) return VK_SUCCESS;
+    const bool wanted = q.timeline.take_signal_request();
     VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-    signal.semaphore = q.timeline;
-    signal.value = last + 1;
+    signal.semaphore = q.semaphore;
+    signal.value = number;
     signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
     VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     submit.signalSemaphoreInfoCount = 1;
     submit.pSignalSemaphoreInfos = &signal;
-    VkResult r = fn.vkQueueSubmit2(q.queue, 1, &submit, VK_NULL_HANDLE);
-    if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+    VkResult r = note_result(fn.vkQueueSubmit2(q.queue, 1, &submit, VK_NULL_HANDLE));
     if (r != VK_SUCCESS) {
-        if (wanted) q.signal_wanted.store(true, std::memory_order_relaxed);
+        if (wanted) q.timeline.request_signal();
         return r;
     }
-    value = last + 1;
-    q.submitted.store(value, std::memory_order_release);
-    q.signalled.store(value, std::memory_order_release);
+    value = number;
+    q.timeline.note_signalled(number);
     return VK_SUCCESS;
 }
 
-void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
+void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) {
+    out.resize(queues.size());
+    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].timeline.covering_value();
+}
+
+bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
+    if (lost.load(std::memory_order_relaxed)) return true;
+    for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
+        auto& q = queues[i];
+        if (q.timeline.completed() >= snapshot[i]) continue;
+        if (!refresh(q)) return lost.load(std::memory_order_relaxed);
+        if (q.timeline.completed() < snapshot[i]) return false;
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------- DeferredDestructor
+
+void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept {
     std::vector<DeferredAction> ready;
     bool run_now = false;
     {
-        LockGuard lock(deferred_mutex_);
-        if (deferred_.empty() && idle_now()) {
+        LockGuard lock(mutex_);
+        if (batches_.empty() && device.idle_now()) {
             run_now = true;
         } else {
             bool queued = false;
@@ -116,89 +130,80 @@ void DeviceState::destroy_after_gpu(DeferredAction action) noexcept {
                 // Needs the values of work submitted so far; a batch queued
                 // while the same work was pending is shared.
                 std::vector<std::uint64_t> values;
-                submitted_snapshot(values);
-                if (deferred_.empty() || deferred_.back().wait_values != values) {
-                    deferred_.push_back(Batch{std::move(values), {}});
+                device.submitted_snapshot(values);
+                if (batches_.empty() || batches_.back().wait_values != values) {
+                    batches_.push_back(Batch{std::move(values), {}});
                 }
-                deferred_.back().actions.push_back(action);
-                deferred_actions_.fetch_add(1, std::memory_order_relaxed);
+                batches_.back().actions.push_back(action);
+                count_.fetch_add(1, std::memory_order_relaxed);
                 queued = true;
-                take_ready(ready);
+                take_ready(device, ready);
             } catch (...) {
                 // Out of host memory. Unqueued, waiting is the only safe way
                 // left to destroy the object; queued, it runs on a later collect.
                 if (!queued) {
-                    fn.vkDeviceWaitIdle(device);
+                    device.fn.vkDeviceWaitIdle(device.device);
                     run_now = true;
                 }
             }
         }
     }
-    if (run_now) action.run(*this, action.handle, action.context);
-    for (auto& a : ready) a.run(*this, a.handle, a.context);
+    if (run_now) action.run(device, action.handle, action.context);
+    for (auto& a : ready) a.run(device, a.handle, a.context);
 }
 
-void DeviceState::take_ready(std::vector<DeferredAction>& out) {
-    if (deferred_.empty()) return;
-    bool all = idle_now();
+void DeferredDestructor::take_ready(DeviceState& device, std::vector<DeferredAction>& out) {
+    if (batches_.empty()) return;
+    const bool all = device.idle_now();
+    auto done = [&](const Batch& batch) {
+        for (std::size_t i = 0; i < device.queues.size(); ++i) {
+            if (device.queues[i].timeline.completed() < batch.wait_values[i]) return false;
+        }
+        return true;
+    };
     std::size_t batches = 0;
     std::size_t actions = 0;
-    for (const auto& batch : deferred_) {
-        bool done = all;
-        if (!done) {
-            done = true;
-            for (std::size_t i = 0; i < queues.size(); ++i) {
-                if (queues[i].completed.load(std::memory_order_relaxed) < batch.wait_values[i]) done = false;
-            }
-        }
-        if (!done) break;
+    for (const auto& batch : batches_) {
+        if (!all && !done(batch)) break;
         ++batches;
         actions += batch.actions.size();
     }
     // The only allocation comes first, so a failure leaves the queue as it was.
     out.reserve(out.size() + actions);
     for (; batches > 0; --batches) {
-        auto& batch = deferred_.front();
+        auto& batch = batches_.front();
         out.insert(out.end(), batch.actions.begin(), batch.actions.end());
-        deferred_actions_.fetch_sub(batch.actions.size(), std::memory_order_relaxed);
-        deferred_.pop_front();
+        count_.fetch_sub(batch.actions.size(), std::memory_order_relaxed);
+        batches_.pop_front();
     }
 }
 
-void DeviceState::collect() noexcept {
+void DeferredDestructor::collect(DeviceState& device) noexcept {
     std::vector<DeferredAction> ready;
     {
-        if (deferred_actions_.load(std::memory_order_relaxed) == 0) return;
-        LockGuard lock(deferred_mutex_);
-        if (deferred_.empty()) return;
+        if (count_.load(std::memory_order_relaxed) == 0) return;
+        LockGuard lock(mutex_);
+        if (batches_.empty()) return;
         try {
-            take_ready(ready);
+            take_ready(device, ready);
         } catch (...) {
             return;  // out of host memory: the actions stay queued for a later collect
         }
     }
-    for (auto& a : ready) a.run(*this, a.handle, a.context);
+    for (auto& a : ready) a.run(device, a.handle, a.context);
 }
 
-void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) {
-    out.resize(queues.size());
-    for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].covering_value();
-}
-
-bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
-    if (lost.load(std::memory_order_relaxed)) return true;
-    for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
-        auto& q = queues[i];
-        if (q.completed.load(std::memory_order_relaxed) >= snapshot[i]) continue;
-        if (!refresh(q)) return lost.load(std::memory_order_relaxed);
-        if (q.completed.load(std::memory_order_relaxed) < snapshot[i]) return false;
+void DeferredDestructor::run_all(DeviceState& device) noexcept {
+    for (auto& batch : batches_) {
+        for (auto& action : batch.actions) action.run(device, action.handle, action.context);
     }
-    return true;
+    batches_.clear();
+    count_.store(0, std::memory_order_relaxed);
 }
 
-std::size_t DeviceState::deferred_count() const noexcept {
-    LockGuard lock(deferred_mutex_);
-    return deferred_actions_.load(std::memory_order_relaxed);
+std::size_t DeferredDestructor::size() const noexcept {
+    LockGuard lock(mutex_);
+    return count_.load(std::memory_order_relaxed);
 }
 
 }  // namespace detail
@@ -221,7 +226,7 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
             q.family_index = request.queue_family_index;
             q.index = i;
             s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q.queue);
-            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &q.timeline), "vkCreateSemaphore");
+            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &q.semaphore), "vkCreateSemaphore");
         }
     }
 }
@@ -272,10 +277,8 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     }
 
     std::vector<const char*> extensions = info.enabled_extension_names;
-    if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) &&
-        std::none_of(extensions.begin(), extensions.end(),
-                     [](const char* e) { return std::strcmp(e, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0; })) {
-        extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
+        detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
 
     auto f13 = info.vulkan13_features;
@@ -328,8 +331,7 @@ Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership own
 }
 
 bool Device::extension_enabled(const char* name) const noexcept {
-    const auto& e = state_->enabled_extensions;
-    return std::find(e.begin(), e.end(), name) != e.end();
+    return detail::contains(state_->enabled_extensions, name);
 }
 
 Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
@@ -348,19 +350,63 @@ Queue Device::default_queue() const {
 void Device::wait_idle() const {
     // Everything submitted before the wait is complete after it.
     std::vector<std::uint64_t> submitted;
-    for (auto& q : state_->queues) submitted.push_back(q.submitted.load(std::memory_order_acquire));
+    for (auto& q : state_->queues) submitted.push_back(q.timeline.last_submitted());
     VkResult r = fn().vkDeviceWaitIdle(vk());
-    if (r == VK_ERROR_DEVICE_LOST) state_->mark_lost();
     if (r == VK_SUCCESS) {
-        for (std::size_t i = 0; i < submitted.size(); ++i) state_->queues[i].note_completed(submitted[i]);
+        for (std::size_t i = 0; i < submitted.size(); ++i) state_->queues[i].timeline.note_completed(submitted[i]);
     }
-    state_->collect();
-    check(r, "vkDeviceWaitIdle");
+    state_->finish_call(r, "vkDeviceWaitIdle");
 }
 
-void Device::collect_garbage() const noexcept { state_->collect(); }
-std::size_t Device::deferred_count() const noexcept { return state_->deferred_count(); }
+void Device::collect_garbage() const noexcept { state_->deferred.collect(*state_); }
+std::size_t Device::deferred_count() const noexcept { return state_->deferred.size(); }
 bool Device::lost() const noexcept { return state_->lost.load(std::memory_order_relaxed); }
+
+namespace {
+
+// Submits with the queue's timeline signal added: into the last batch when
+// its signals fit on the stack; otherwise into one more batch, which
+// submission order still places after all the work before it. Under the
+// queue's lock.
+VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, std::span<const VkSubmitInfo2> submits,
+                           VkFence fence, std::uint64_t number) noexcept {
+    q.timeline.take_signal_request();
+    VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    timeline.semaphore = q.semaphore;
+    timeline.value = number;
+    timeline.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+    constexpr std::uint32_t inline_signals = 8;
+    VkSemaphoreSubmitInfo signals[inline_signals + 1];
+    VkSubmitInfo2 tail{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    std::size_t head = submits.size();
+    if (!submits.empty() && submits.back().signalSemaphoreInfoCount <= inline_signals) {
+        head = submits.size() - 1;
+        tail = submits.back();
+        if (tail.signalSemaphoreInfoCount) {
+            std::memcpy(signals, tail.pSignalSemaphoreInfos,
+                        tail.signalSemaphoreInfoCount * sizeof(VkSemaphoreSubmitInfo));
+        }
+        signals[tail.signalSemaphoreInfoCount] = timeline;
+        tail.signalSemaphoreInfoCount += 1;
+        tail.pSignalSemaphoreInfos = signals;
+    } else {
+        tail.signalSemaphoreInfoCount = 1;
+        tail.pSignalSemaphoreInfos = &timeline;
+    }
+    VkResult r = VK_SUCCESS;
+    if (head > 0) r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
+    const bool head_went_in = head > 0 && r == VK_SUCCESS;
+    if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
+    if (r == VK_SUCCESS) {
+        q.timeline.note_signalled(number);
+    } else {
+        if (head_went_in) q.timeline.note_submitted(number);
+        q.timeline.request_signal();
+    }
+    return r;
+}
+
+}  // namespace
 
 std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fence) const {
     auto& q = *queue_;
@@ -369,56 +415,15 @@ std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fenc
     std::uint64_t number;
     {
         LockGuard lock(q.mutex);
-        number = q.submitted.load(std::memory_order_relaxed) + 1;
-        if (!q.signal_wanted.load(std::memory_order_relaxed)) {
+        number = q.timeline.next_number();
+        if (!q.timeline.signal_requested()) {
             r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(submits.size()), submits.data(), fence);
-            if (r == VK_SUCCESS) q.submitted.store(number, std::memory_order_release);
+            if (r == VK_SUCCESS) q.timeline.note_submitted(number);
         } else {
-            // Cleared before submitting: a request made meanwhile is either
-            // covered by this submit's signal or asks the next submit again.
-            q.signal_wanted.store(false, std::memory_order_relaxed);
-            VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-            timeline.semaphore = q.timeline;
-            timeline.value = number;
-            timeline.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-            // The signal goes into the last batch when its signals fit on the
-            // stack; otherwise into one more batch, which submission order
-            // still places after all the work before it.
-            constexpr std::uint32_t inline_signals = 8;
-            VkSemaphoreSubmitInfo signals[inline_signals + 1];
-            VkSubmitInfo2 tail{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-            std::size_t head = submits.size();
-            if (!submits.empty() && submits.back().signalSemaphoreInfoCount <= inline_signals) {
-                head = submits.size() - 1;
-                tail = submits.back();
-                if (tail.signalSemaphoreInfoCount) {
-                    std::memcpy(signals, tail.pSignalSemaphoreInfos,
-                                tail.signalSemaphoreInfoCount * sizeof(VkSemaphoreSubmitInfo));
-                }
-                signals[tail.signalSemaphoreInfoCount] = timeline;
-                tail.signalSemaphoreInfoCount += 1;
-                tail.pSignalSemaphoreInfos = signals;
-            } else {
-                tail.signalSemaphoreInfoCount = 1;
-                tail.pSignalSemaphoreInfos = &timeline;
-            }
-            r = VK_SUCCESS;
-            if (head > 0)
-                r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
-            const bool head_went_in = head > 0 && r == VK_SUCCESS;
-            if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
-            if (r == VK_SUCCESS) {
-                q.submitted.store(number, std::memory_order_release);
-                q.signalled.store(number, std::memory_order_release);
-            } else {
-                if (head_went_in) q.submitted.store(number, std::memory_order_release);
-                q.signal_wanted.store(true, std::memory_order_relaxed);
-            }
+            r = submit_signalling(d, q, submits, fence, number);
         }
     }
-    if (r == VK_ERROR_DEVICE_LOST) d.mark_lost();
-    d.collect();
-    check(r, "vkQueueSubmit2");
+    d.finish_call(r, "vkQueueSubmit2");
     return number;
 }
 
@@ -434,13 +439,11 @@ void Queue::wait_idle() const {
     std::uint64_t submitted;
     {
         LockGuard lock(queue_->mutex);
-        submitted = queue_->submitted.load(std::memory_order_relaxed);
+        submitted = queue_->timeline.last_submitted();
         r = d.fn.vkQueueWaitIdle(queue_->queue);
     }
-    if (r == VK_ERROR_DEVICE_LOST) d.mark_lost();
-    if (r == VK_SUCCESS) queue_->note_completed(submitted);
-    d.collect();
-    check(r, "vkQueueWaitIdle");
+    if (r == VK_SUCCESS) queue_->timeline.note_completed(submitted);
+    d.finish_call(r, "vkQueueWaitIdle");
 }
 
 VKRC_END_NAMESPACE

@@ -1,5 +1,7 @@
 #include "vkrc/glfw.hpp"
 
+#include "text.hpp"
+
 #include <GLFW/glfw3.h>
 
 #include <algorithm>
@@ -94,10 +96,7 @@ WindowSurface create_window_surface(const WindowCreateInfo& window_info, Instanc
     WindowSurface out;
     out.window = Window::create(window_info);
     for (const char* name : required_instance_extensions()) {
-        auto& list = instance_info.enabled_extension_names;
-        if (std::none_of(list.begin(), list.end(), [&](const char* n) { return std::strcmp(n, name) == 0; })) {
-            list.push_back(name);
-        }
+        detail::add_unique(instance_info.enabled_extension_names, name);
     }
     out.instance = Instance::create(instance_info);
     out.surface = create_surface(out.instance, out.window.get());

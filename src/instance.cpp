@@ -1,5 +1,7 @@
 #include "vkrc/instance.hpp"
 
+#include "text.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -16,11 +18,6 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debug_trampoline(VkDebugUtilsMessageSeverityFlagB
     const auto& callback = *static_cast<const DebugCallback*>(user);
     callback(DebugMessage{severity, types, data->pMessageIdName, data->pMessage});
     return VK_FALSE;  // never abort the call that produced the message
-}
-
-void add_unique(std::vector<const char*>& names, const char* name) {
-    auto same = [&](const char* n) { return std::strcmp(n, name) == 0; };
-    if (std::none_of(names.begin(), names.end(), same)) names.push_back(name);
 }
 
 template <class T, class F>
@@ -63,8 +60,8 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     std::vector<const char*> layers = info.enabled_layer_names;
     std::vector<const char*> extensions = info.enabled_extension_names;
     if (info.validation) {
-        add_unique(layers, validation_layer);
-        add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        detail::add_unique(layers, validation_layer);
+        detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
     // The state exists before the instance: its callback's address is the
     // messenger's user data from vkCreateInstance to vkDestroyInstance.
@@ -72,7 +69,7 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     auto& s = *instance.state_;
     const bool messenger = info.debug_callback || info.validation;
     if (messenger) {
-        add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
         s.debug_callback = info.debug_callback ? info.debug_callback : DebugCallback(print_debug_message);
     }
 
@@ -133,8 +130,7 @@ Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_
 }
 
 bool Instance::extension_enabled(const char* name) const noexcept {
-    const auto& e = state_->enabled_extensions;
-    return std::find(e.begin(), e.end(), name) != e.end();
+    return detail::contains(state_->enabled_extensions, name);
 }
 
 std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {

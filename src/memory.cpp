@@ -8,8 +8,7 @@
 VKRC_BEGIN_NAMESPACE
 
 bool DeviceView::extension_enabled(const char* name) const noexcept {
-    const auto& e = s_->enabled_extensions;
-    return std::find(e.begin(), e.end(), name) != e.end();
+    return detail::contains(s_->enabled_extensions, name);
 }
 
 HeapStatistics AllocatorStatistics::total() const noexcept {
@@ -132,16 +131,6 @@ std::uint32_t choose_memory_type(const VkPhysicalDeviceMemoryProperties& propert
 
 namespace detail {
 
-std::string hex(std::uint64_t v) {
-    static const char digits[] = "0123456789abcdef";
-    std::string s;
-    do {
-        s.insert(s.begin(), digits[v & 15]);
-        v >>= 4;
-    } while (v);
-    return s;
-}
-
 std::string bytes_text(VkDeviceSize n) { return std::to_string(n) + " bytes"; }
 
 void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who) {
@@ -249,9 +238,9 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
     if (a) {
-        s.keep_allocator(allocator);
+        s.allocators.keep(allocator);
     } else {
-        a = &s.default_allocator();
+        a = &s.allocators.default_allocator();
     }
     AllocationInfo info = a->allocate(DeviceView(s), request);
     if (info.allocator != a) {
@@ -302,10 +291,10 @@ void Allocation::invalidate(VkDeviceSize offset, VkDeviceSize size) const {
     state_->invalidate(offset, size);
 }
 
-DeviceAllocator& default_allocator(const Device& device) { return device.state()->default_allocator(); }
+DeviceAllocator& default_allocator(const Device& device) { return device.state()->allocators.default_allocator(); }
 
 AllocatorStatistics memory_statistics(const Device& device) {
-    return device.state()->default_allocator().statistics(DeviceView(*device.state()));
+    return device.state()->allocators.default_allocator().statistics(DeviceView(*device.state()));
 }
 
 // ---------------------------------------------------------------- DedicatedAllocator
@@ -341,10 +330,8 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
     info.allocator = this;
     LockGuard lock(mutex_);
     auto& heap = stats_.heaps[props.memoryTypes[type].heapIndex];
-    heap.block_bytes += info.size;
-    heap.allocation_bytes += info.size;
-    heap.block_count += 1;
-    heap.allocation_count += 1;
+    detail::add_block(heap, info.size);
+    detail::add_range(heap, info.size);
     stats_.vk_allocate_calls += 1;
     return info;
 }
@@ -356,10 +343,8 @@ void DedicatedAllocator::free(DeviceView device, const AllocationInfo& allocatio
     device.fn().vkFreeMemory(device.vk(), allocation.memory, nullptr);
     LockGuard lock(mutex_);
     auto& heap = stats_.heaps[device.memory_properties().memoryTypes[allocation.memory_type].heapIndex];
-    heap.block_bytes -= allocation.size;
-    heap.allocation_bytes -= allocation.size;
-    heap.block_count -= 1;
-    heap.allocation_count -= 1;
+    detail::remove_block(heap, allocation.size);
+    detail::remove_range(heap, allocation.size);
     memory_objects_ -= 1;
 }
 
@@ -377,29 +362,28 @@ AllocatorStatistics DedicatedAllocator::statistics(DeviceView device) const {
 
 namespace detail {
 
-DeviceAllocator& DeviceState::default_allocator() {
-    LockGuard lock(allocators_mutex_);
-    if (!default_allocator_) {
+DeviceAllocator& AllocatorRegistry::default_allocator() {
+    LockGuard lock(mutex_);
+    if (!default_) {
         auto pool = make_allocator<PoolAllocator>();
         allocators_.insert(allocators_.begin(), pool);
-        default_allocator_ = pool.get();
+        default_ = pool.get();
     }
-    return *default_allocator_;
+    return *default_;
 }
 
-void DeviceState::keep_allocator(const Ref<DeviceAllocator>& allocator) {
-    LockGuard lock(allocators_mutex_);
+void AllocatorRegistry::keep(const Ref<DeviceAllocator>& allocator) {
+    LockGuard lock(mutex_);
     auto same = [&](const Ref<DeviceAllocator>& a) { return a.get() == allocator.get(); };
     if (std::find_if(allocators_.begin(), allocators_.end(), same) == allocators_.end()) {
         allocators_.push_back(allocator);
     }
 }
 
-void DeviceState::release_allocators() noexcept {
-    // Called by the destructor after every deferred free has run.
-    for (auto& a : allocators_) a->release(DeviceView(*this));
+void AllocatorRegistry::release_all(DeviceState& device) noexcept {
+    for (auto& a : allocators_) a->release(DeviceView(device));
     allocators_.clear();
-    default_allocator_ = nullptr;
+    default_ = nullptr;
 }
 
 }  // namespace detail

@@ -1,6 +1,7 @@
 // Helpers shared by the allocators (not installed).
 #pragma once
 
+#include "text.hpp"
 #include "vkrc/memory.hpp"
 
 #include <string>
@@ -8,7 +9,6 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-std::string hex(std::uint64_t v);
 std::string bytes_text(VkDeviceSize n);
 // Throws UsageError for a zero size, two dedicated resources, or a size larger than the heap.
 void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who);
@@ -16,6 +16,26 @@ void check_request(DeviceView device, const AllocationRequest& request, std::uin
 // mapped whole when host-visible.
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,
                                       VkBuffer dedicated_buffer, VkImage dedicated_image, std::byte** mapped);
+
+// The statistics bookkeeping both allocators do: a VkDeviceMemory of bytes
+// made or freed (a block, or a dedicated allocation), a range of bytes
+// handed out or taken back (a dedicated allocation is both).
+inline void add_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    heap.block_bytes += bytes;
+    heap.block_count += 1;
+}
+inline void remove_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    heap.block_bytes -= bytes;
+    heap.block_count -= 1;
+}
+inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    heap.allocation_bytes += bytes;
+    heap.allocation_count += 1;
+}
+inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    heap.allocation_bytes -= bytes;
+    heap.allocation_count -= 1;
+}
 
 // Vulkan's alignments are powers of two; the division is for anything else.
 constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {

@@ -1,5 +1,7 @@
 #include "vkrc/instance.hpp"
 
+#include "text.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -16,8 +18,7 @@ std::string version_string(std::uint32_t v) {
 }  // namespace
 
 bool PhysicalDevice::supports_extension(const char* name) const noexcept {
-    const auto& e = state_->extensions;
-    return std::find(e.begin(), e.end(), name) != e.end();
+    return detail::contains(state_->extensions, name);
 }
 
 int PhysicalDevice::find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_surface) const {
@@ -53,11 +54,7 @@ std::vector<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& r
         if (!supports_extension(ext)) reasons.push_back(std::string("lacks extension ") + ext);
     }
     if (find_queue_family(req.queue_flags) < 0) {
-        reasons.push_back("no queue family with flags 0x" + [&] {
-            char buf[16];
-            std::snprintf(buf, sizeof buf, "%x", req.queue_flags);
-            return std::string(buf);
-        }());
+        reasons.push_back("no queue family with flags 0x" + detail::hex(req.queue_flags));
     } else if (req.present_surface != VK_NULL_HANDLE && find_queue_family(req.queue_flags, req.present_surface) < 0) {
         reasons.push_back("no queue family with those flags can present to the surface");
     }

@@ -252,9 +252,7 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
     pool.insert_free(node);
     pool.blocks.push_back(block.get());
     memory_objects += 1;
-    auto& h = heap(pool.memory_type);
-    h.block_bytes += size;
-    h.block_count += 1;
+    detail::add_block(heap(pool.memory_type), size);
     return *block.release();
 }
 
@@ -266,9 +264,7 @@ void PoolAllocator::Impl::free_block(DeviceView d, Pool& pool, Block& block) noe
         n = next;
     }
     d.fn().vkFreeMemory(d.vk(), block.memory, nullptr);
-    auto& h = heap(pool.memory_type);
-    h.block_bytes -= block.size;
-    h.block_count -= 1;
+    detail::remove_block(heap(pool.memory_type), block.size);
     memory_objects -= 1;
     std::erase(pool.blocks, &block);
     delete &block;
@@ -314,11 +310,8 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
         info.dedicated = true;
         m.stats.vk_allocate_calls += 1;
         m.memory_objects += 1;
-        auto& h = m.heap(type);
-        h.block_bytes += info.size;
-        h.allocation_bytes += info.size;
-        h.block_count += 1;
-        h.allocation_count += 1;
+        detail::add_block(m.heap(type), info.size);
+        detail::add_range(m.heap(type), info.size);
         return info;
     }
 
@@ -387,9 +380,7 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     info.memory_size = block.size;
     info.mapped = block.mapped ? block.mapped + start : nullptr;
     info.allocator_data = node;
-    auto& h = m.heap(type);
-    h.allocation_bytes += size;
-    h.allocation_count += 1;
+    detail::add_range(m.heap(type), size);
     return info;
 }
 
@@ -403,18 +394,15 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
     auto& h = m.heap(allocation.memory_type);
     if (allocation.dedicated) {
         d.fn().vkFreeMemory(d.vk(), allocation.memory, nullptr);
-        h.block_bytes -= allocation.size;
-        h.block_count -= 1;
-        h.allocation_bytes -= allocation.size;
-        h.allocation_count -= 1;
+        detail::remove_block(h, allocation.size);
+        detail::remove_range(h, allocation.size);
         m.memory_objects -= 1;
         return;
     }
     Node* node = static_cast<Node*>(allocation.allocator_data);
     Block& block = *node->block;
     Pool& pool = *block.pool;
-    h.allocation_bytes -= node->size;
-    h.allocation_count -= 1;
+    detail::remove_range(h, node->size);
     block.allocations -= 1;
 
     // Merge with the free neighbours on both sides.

@@ -34,14 +34,46 @@ SamplerState::~SamplerState() {
 
 namespace {
 
-AllocationRequest make_request(const VkMemoryRequirements2& requirements,
-                               const VkMemoryDedicatedRequirements& dedicated, const MemoryIntent& intent) {
-    AllocationRequest request;
+// The memory of a new buffer or image: its requirements, with the dedicated
+// ones, from get_requirements (vkGet*MemoryRequirements2), placed by the
+// allocator; request carries the rest. Binding is the caller's.
+template <class GetRequirements>
+Allocation allocate_memory(const Device& device, AllocationRequest request, const SharedAllocator& allocator,
+                           GetRequirements get_requirements) {
+    VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
+    VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
+    get_requirements(requirements);
     request.requirements = requirements.memoryRequirements;
-    request.intent = intent;
     request.prefers_dedicated = dedicated.prefersDedicatedAllocation;
     request.requires_dedicated = dedicated.requiresDedicatedAllocation;
-    return request;
+    return Allocation::create(device, request, allocator);
+}
+
+// The state of a buffer, created or adopted (the handle is set by the caller).
+detail::Ref<detail::BufferState> buffer_state(const Device& device, VkDeviceSize size, VkBufferUsageFlags usage,
+                                              Ownership ownership) {
+    detail::Ref<detail::BufferState> state(new detail::BufferState);
+    state->device = device;
+    state->size = size;
+    state->usage = usage;
+    state->ownership = ownership;
+    return state;
+}
+
+// The state of an image as info describes it, created or adopted.
+detail::Ref<detail::ImageState> image_state(const Device& device, const ImageCreateInfo& info, Ownership ownership) {
+    detail::Ref<detail::ImageState> state(new detail::ImageState);
+    state->device = device;
+    state->image_type = info.image_type;
+    state->format = info.format;
+    state->extent = info.extent;
+    state->mip_levels = info.mip_levels;
+    state->array_layers = info.array_layers;
+    state->samples = info.samples;
+    state->usage = info.usage;
+    state->flags = info.flags;
+    state->ownership = ownership;
+    return state;
 }
 
 }  // namespace
@@ -73,20 +105,17 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     create.pQueueFamilyIndices = info.queue_family_indices.data();
 
     // The state owns the buffer from here, so a failure below destroys it.
-    detail::Ref<detail::BufferState> state(new detail::BufferState);
+    auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
     check(device.fn().vkCreateBuffer(device.vk(), &create, nullptr, &state->buffer), "vkCreateBuffer");
-    state->device = device;
-    state->size = info.size;
-    state->usage = info.usage;
-
-    VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
-    VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
-    VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->buffer};
-    device.fn().vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
-    AllocationRequest request = make_request(requirements, dedicated, info.memory);
+    AllocationRequest request;
+    request.intent = info.memory;
     request.dedicated_buffer = state->buffer;
     request.linear = true;
-    state->allocation = Allocation::create(device, request, info.allocator);
+    state->allocation = allocate_memory(device, request, info.allocator, [&](VkMemoryRequirements2& requirements) {
+        VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr,
+                                              state->buffer};
+        device.fn().vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
+    });
     check(device.fn().vkBindBufferMemory(device.vk(), state->buffer, state->allocation.memory(),
                                          state->allocation.offset()),
           "vkBindBufferMemory");
@@ -97,12 +126,8 @@ Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, V
                      Ownership ownership) {
     if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
     if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
-    detail::Ref<detail::BufferState> state(new detail::BufferState);
-    state->ownership = ownership;
-    state->device = device;
+    auto state = buffer_state(device, size, usage, ownership);
     state->buffer = buffer;
-    state->size = size;
-    state->usage = usage;
     return Buffer(std::move(state));
 }
 
@@ -144,26 +169,16 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
     create.pQueueFamilyIndices = info.queue_family_indices.data();
     create.initialLayout = info.initial_layout;
 
-    detail::Ref<detail::ImageState> state(new detail::ImageState);
+    auto state = image_state(device, info, Ownership::owned);
     check(device.fn().vkCreateImage(device.vk(), &create, nullptr, &state->image), "vkCreateImage");
-    state->device = device;
-    state->image_type = info.image_type;
-    state->format = info.format;
-    state->extent = info.extent;
-    state->mip_levels = info.mip_levels;
-    state->array_layers = info.array_layers;
-    state->samples = info.samples;
-    state->usage = info.usage;
-    state->flags = info.flags;
-
-    VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
-    VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
-    VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->image};
-    device.fn().vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
-    AllocationRequest request = make_request(requirements, dedicated, info.memory);
+    AllocationRequest request;
+    request.intent = info.memory;
     request.dedicated_image = state->image;
     request.linear = info.tiling == VK_IMAGE_TILING_LINEAR;
-    state->allocation = Allocation::create(device, request, info.allocator);
+    state->allocation = allocate_memory(device, request, info.allocator, [&](VkMemoryRequirements2& requirements) {
+        VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->image};
+        device.fn().vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
+    });
     check(device.fn().vkBindImageMemory(device.vk(), state->image, state->allocation.memory(),
                                         state->allocation.offset()),
           "vkBindImageMemory");
@@ -173,18 +188,8 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
 Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership) {
     if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
     if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
-    detail::Ref<detail::ImageState> state(new detail::ImageState);
-    state->ownership = ownership;
-    state->device = device;
+    auto state = image_state(device, info, ownership);
     state->image = image;
-    state->image_type = info.image_type;
-    state->format = info.format;
-    state->extent = info.extent;
-    state->mip_levels = info.mip_levels;
-    state->array_layers = info.array_layers;
-    state->samples = info.samples;
-    state->usage = info.usage;
-    state->flags = info.flags;
     return Image(std::move(state));
 }
 

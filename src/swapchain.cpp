@@ -1,6 +1,5 @@
 #include "vkrc/swapchain.hpp"
 
-#include "swapchain_state.hpp"
 #include "vkrc/upload.hpp"
 
 #include <algorithm>
@@ -21,7 +20,7 @@ SwapchainChainState::~SwapchainChainState() {
         // destroy_after_gpu below waits for that value (docs/design.md,
         // Presentation).
         try {
-            queue.state()->signal_wanted.store(true, std::memory_order_relaxed);
+            queue.state()->timeline.request_signal();
             queue.submit({});
         } catch (...) {
             LockGuard lock(queue.mutex());
@@ -260,13 +259,6 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     return PresentStatus::success;
 }
 
-// Waits until the queue's submission number has completed (0: nothing to wait for).
-void wait_for_queue(const Queue& queue, std::uint64_t number) {
-    const char* failed_call = nullptr;
-    VkResult r = queue.device().state()->wait_for_submission(*queue.state(), number, &failed_call);
-    if (r != VK_SUCCESS) check(r, failed_call);
-}
-
 }  // namespace
 
 Swapchain Swapchain::create(const Queue& queue, const Surface& surface) {
@@ -331,7 +323,7 @@ Frame Swapchain::acquire() {
     const std::uint32_t slot = s.next_acquire;
     // The semaphore must have no pending wait: its last frame was presented
     // after the submission that waited on it, at this queue value.
-    wait_for_queue(s.queue, s.acquire_done_values[slot]);
+    s.queue.device().state()->await_submission(*s.queue.state(), s.acquire_done_values[slot]);
     std::uint32_t index = 0;
     VkResult r = device.fn().vkAcquireNextImageKHR(device.vk(), s.chain->swapchain, UINT64_MAX,
                                                    s.acquire_semaphores[slot].vk(), VK_NULL_HANDLE, &index);
@@ -340,8 +332,7 @@ Frame Swapchain::acquire() {
         frame.status = PresentStatus::out_of_date;
         return frame;
     }
-    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
-    check(r, "vkAcquireNextImageKHR");
+    device.state()->check_result(r, "vkAcquireNextImageKHR");
     if (r == VK_SUBOPTIMAL_KHR) s.needs_recreate = true;
     s.next_acquire = (slot + 1) % static_cast<std::uint32_t>(s.acquire_semaphores.size());
     frame.status = r == VK_SUBOPTIMAL_KHR ? PresentStatus::suboptimal : PresentStatus::success;
@@ -382,13 +373,12 @@ PresentStatus Swapchain::present(const Frame& frame) {
     chain.presented = true;
     // The slot's reuse waits for this submission number: in a frame loop the
     // frame's fence has usually shown it complete by then.
-    s.acquire_done_values[frame.acquire_slot_] = s.queue.state()->submitted.load(std::memory_order_acquire);
+    s.acquire_done_values[frame.acquire_slot_] = s.queue.state()->timeline.last_submitted();
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         s.needs_recreate = true;
         return PresentStatus::out_of_date;
     }
-    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
-    check(r, "vkQueuePresentKHR");
+    device.state()->check_result(r, "vkQueuePresentKHR");
     if (r == VK_SUBOPTIMAL_KHR) {
         s.needs_recreate = true;
         return PresentStatus::suboptimal;
@@ -408,116 +398,8 @@ void Swapchain::set_extent(VkExtent2D extent) {
     s.info.extent = extent;
 }
 
-namespace {
-
-void make_ring(detail::HeadlessPresenterState& s) {
-    ImageCreateInfo info;
-    info.format = s.info.format;
-    info.extent = {s.info.extent.width, s.info.extent.height, 1};
-    info.usage = s.info.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    std::vector<Image> images;
-    std::vector<ImageView> views;
-    for (std::uint32_t i = 0; i < s.info.image_count; ++i) {
-        images.push_back(Image::create(s.queue.device(), info));
-        views.push_back(ImageView::create(images.back()));
-    }
-    s.images = std::move(images);
-    s.views = std::move(views);
-    s.needs_resize = false;
-}
-
-}  // namespace
-
-HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPresenterCreateInfo& info) {
-    if (!queue) throw UsageError("vkrc::HeadlessPresenter::create: the Queue is empty");
-    if (info.extent.width == 0 || info.extent.height == 0) {
-        throw UsageError("vkrc::HeadlessPresenter::create: extent is zero");
-    }
-    if (info.image_count == 0) throw UsageError("vkrc::HeadlessPresenter::create: image_count is 0");
-    detail::Ref<detail::HeadlessPresenterState> state(new detail::HeadlessPresenterState);
-    state->queue = queue;
-    state->info = info;
-    make_ring(*state);
-    return HeadlessPresenter(std::move(state));
-}
-
-Frame HeadlessPresenter::acquire() {
-    auto& s = *state_;
-    LockGuard lock(s.mutex);
-    Frame frame;
-    if (s.needs_resize) {
-        if (s.info.extent.width == 0 || s.info.extent.height == 0) {
-            frame.status = PresentStatus::zero_extent;
-            return frame;
-        }
-        make_ring(s);
-    }
-    const auto index = static_cast<std::uint32_t>(s.acquired++ % s.info.image_count);
-    frame.status = PresentStatus::success;
-    frame.image_index = index;
-    frame.image = s.images[index];
-    frame.view = s.views[index];
-    frame.extent = s.info.extent;
-    frame.format = s.info.format;
-    frame.present_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-    frame.source_ = &s;
-    return frame;
-}
-
-PresentStatus HeadlessPresenter::present(const Frame& frame) {
-    auto& s = *state_;
-    if (!frame.image || frame.source_ != &s) {
-        throw UsageError("vkrc::HeadlessPresenter::present: the frame was not acquired from this presenter");
-    }
-    s.last_presented.store(frame.image_index, std::memory_order_relaxed);
-    return PresentStatus::success;
-}
-
-std::vector<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
-    auto& s = *state_;
-    Image image;
-    {
-        LockGuard lock(s.mutex);
-        if (image_index >= s.images.size()) {
-            throw UsageError("vkrc::HeadlessPresenter::read_back: image " + std::to_string(image_index) +
-                             " does not exist (the ring has " + std::to_string(s.images.size()) + ")");
-        }
-        image = s.images[image_index];
-    }
-    wait_for_queue(s.queue, s.queue.state()->submitted.load(std::memory_order_acquire));
-    return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-}
-
-void HeadlessPresenter::resize(VkExtent2D extent) {
-    auto& s = *state_;
-    LockGuard lock(s.mutex);
-    s.info.extent = extent;
-    s.needs_resize = true;
-}
-
 std::span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
 std::span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
-
-// ---------------------------------------------------------------- handle members
-// Out of line: the states are not in the public header.
-
-Swapchain::Swapchain() noexcept = default;
-Swapchain::~Swapchain() = default;
-Swapchain::Swapchain(const Swapchain& other) noexcept = default;
-Swapchain::Swapchain(Swapchain&& other) noexcept = default;
-Swapchain& Swapchain::operator=(const Swapchain& other) noexcept = default;
-Swapchain& Swapchain::operator=(Swapchain&& other) noexcept = default;
-void Swapchain::reset() noexcept { Handle::reset(); }
-std::uint32_t Swapchain::use_count() const noexcept { return Handle::use_count(); }
-
-HeadlessPresenter::HeadlessPresenter() noexcept = default;
-HeadlessPresenter::~HeadlessPresenter() = default;
-HeadlessPresenter::HeadlessPresenter(const HeadlessPresenter& other) noexcept = default;
-HeadlessPresenter::HeadlessPresenter(HeadlessPresenter&& other) noexcept = default;
-HeadlessPresenter& HeadlessPresenter::operator=(const HeadlessPresenter& other) noexcept = default;
-HeadlessPresenter& HeadlessPresenter::operator=(HeadlessPresenter&& other) noexcept = default;
-void HeadlessPresenter::reset() noexcept { Handle::reset(); }
-std::uint32_t HeadlessPresenter::use_count() const noexcept { return Handle::use_count(); }
 
 VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
 VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
@@ -527,12 +409,5 @@ const Surface& Swapchain::surface() const noexcept { return state_->surface; }
 const Queue& Swapchain::queue() const noexcept { return state_->queue; }
 VkColorSpaceKHR Swapchain::color_space() const noexcept { return state_->surface_format.colorSpace; }
 VkPresentModeKHR Swapchain::present_mode() const noexcept { return state_->present_mode; }
-
-VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }
-VkFormat HeadlessPresenter::format() const noexcept { return state_->info.format; }
-std::uint32_t HeadlessPresenter::image_count() const noexcept { return state_->info.image_count; }
-std::uint32_t HeadlessPresenter::last_presented() const noexcept {
-    return state_->last_presented.load(std::memory_order_relaxed);
-}
 
 VKRC_END_NAMESPACE

@@ -8,12 +8,6 @@ namespace {
 void require_device(const Device& device, const char* who) {
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
 }
-// Records device loss and runs completed deferred destructions after a wait.
-VkResult after_wait(const Device& device, VkResult r, const char* call) {
-    if (r == VK_ERROR_DEVICE_LOST) device.state()->mark_lost();
-    device.collect_garbage();
-    return check(r, call);
-}
 }  // namespace
 
 namespace detail {
@@ -69,7 +63,7 @@ VkResult Fence::wait(std::uint64_t timeout_ns) const {
         state_->in_flight = false;
         state_->note_signalled();
     }
-    return after_wait(d, r, "vkWaitForFences");
+    return d.state()->finish_call(r, "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
@@ -79,7 +73,7 @@ VkResult Fence::status() const {
         state_->in_flight = false;
         state_->note_signalled();
     }
-    return after_wait(d, r, "vkGetFenceStatus");
+    return d.state()->finish_call(r, "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
@@ -139,7 +133,8 @@ std::uint64_t Semaphore::value() const {
     require_timeline(*this, "vkrc::Semaphore::value");
     const auto& d = state_->device;
     std::uint64_t v = 0;
-    after_wait(d, d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->semaphore, &v), "vkGetSemaphoreCounterValue");
+    d.state()->finish_call(d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->semaphore, &v),
+                           "vkGetSemaphoreCounterValue");
     return v;
 }
 
@@ -159,7 +154,7 @@ VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
     info.semaphoreCount = 1;
     info.pSemaphores = &state_->semaphore;
     info.pValues = &value;
-    return after_wait(d, d.fn().vkWaitSemaphores(d.vk(), &info, timeout_ns), "vkWaitSemaphores");
+    return d.state()->finish_call(d.fn().vkWaitSemaphores(d.vk(), &info, timeout_ns), "vkWaitSemaphores");
 }
 
 Event Event::create(const Device& device, bool device_only) {
@@ -211,7 +206,7 @@ VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> 
     VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->pool, first_query, static_cast<std::uint32_t>(count),
                                               out.size_bytes(), out.data(), stride_words * sizeof(std::uint64_t),
                                               flags | VK_QUERY_RESULT_64_BIT);
-    return after_wait(d, r, "vkGetQueryPoolResults");
+    return d.state()->finish_call(r, "vkGetQueryPoolResults");
 }
 
 double QueryPool::timestamp_period_ns() const noexcept {

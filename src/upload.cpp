@@ -1,9 +1,10 @@
 #include "vkrc/upload.hpp"
 
-#include "vkrc/command.hpp"
+#include "vkrc/submit.hpp"
 #include "vkrc/sync.hpp"
 
 #include <string>
+#include <type_traits>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -33,60 +34,26 @@ std::uint32_t format_texel_size(VkFormat format) noexcept {
 
 namespace {
 
-// One command buffer from a transient pool, submitted and waited for.
+// One command buffer from a transient pool, submitted and waited for. The
+// pool, command buffer and fence are vkrc objects, so their destruction is
+// deferred past the submitted work like any other (a failed wait included).
 class OneTimeCommands {
 public:
-    explicit OneTimeCommands(const Queue& queue) : queue_(queue), device_(queue.device()) {
-        const auto& fn = device_.fn();
-        VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-        pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-        pool_info.queueFamilyIndex = queue.family_index();
-        check(fn.vkCreateCommandPool(device_.vk(), &pool_info, nullptr, &pool_), "vkCreateCommandPool");
-        VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO, nullptr, pool_,
-                                          VK_COMMAND_BUFFER_LEVEL_PRIMARY, 1};
-        try {
-            check(fn.vkAllocateCommandBuffers(device_.vk(), &alloc, &cmd_), "vkAllocateCommandBuffers");
-            VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-            begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-            check(fn.vkBeginCommandBuffer(cmd_, &begin), "vkBeginCommandBuffer");
-        } catch (...) {
-            fn.vkDestroyCommandPool(device_.vk(), pool_, nullptr);
-            throw;
-        }
+    explicit OneTimeCommands(const Queue& queue)
+        : queue_(queue),
+          pool_(CommandPool::create(queue.device(), {VK_COMMAND_POOL_CREATE_TRANSIENT_BIT, queue.family_index()})),
+          cmd_(pool_.allocate()) {
+        cmd_.begin(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
     }
-    ~OneTimeCommands() {
-        // Deferred like every other object: when the fence wait failed (out of
-        // memory), the submitted work may still use the pool and the fence.
-        auto& d = *device_.state();
-        if (submitted_ && !waited_) {
-            detail::destroy_submitted_fence(d, fence_);
-        } else {
-            detail::defer_destroy<&DeviceFunctions::vkDestroyFence>(d, fence_);
-        }
-        detail::defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(d, pool_);
-    }
-    OneTimeCommands(const OneTimeCommands&) = delete;
-    OneTimeCommands& operator=(const OneTimeCommands&) = delete;
 
-    VkCommandBuffer cmd() const noexcept { return cmd_; }
-    const DeviceFunctions& fn() const noexcept { return device_.fn(); }
+    VkCommandBuffer cmd() const noexcept { return cmd_.vk(); }
+    const DeviceFunctions& fn() const noexcept { return cmd_.fn(); }
 
     void submit_and_wait() {
-        const auto& fn = device_.fn();
-        check(fn.vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
-        VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        check(fn.vkCreateFence(device_.vk(), &fence_info, nullptr, &fence_), "vkCreateFence");
-        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO, nullptr, cmd_, 0};
-        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit.commandBufferInfoCount = 1;
-        submit.pCommandBufferInfos = &cmd_info;
-        queue_.submit({&submit, 1}, fence_);
-        submitted_ = true;
-        VkResult r = fn.vkWaitForFences(device_.vk(), 1, &fence_, VK_TRUE, UINT64_MAX);
-        waited_ = r == VK_SUCCESS;
-        if (r == VK_ERROR_DEVICE_LOST) device_.state()->mark_lost();
-        check(r, "vkWaitForFences");
-        device_.collect_garbage();
+        cmd_.end();
+        Fence fence = Fence::create(queue_.device());
+        submit(queue_, SubmitBatch{{}, {&cmd_, 1}, {}}, fence);
+        fence.wait();
     }
 
     void image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
@@ -95,28 +62,18 @@ public:
         VkImageMemoryBarrier2 b = vkrc::image_barrier(image, old_layout, new_layout, src_stage, src_access, dst_stage,
                                                       dst_access, range.aspectMask);
         b.subresourceRange = range;
-        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dep.imageMemoryBarrierCount = 1;
-        dep.pImageMemoryBarriers = &b;
-        fn().vkCmdPipelineBarrier2(cmd_, &dep);
+        cmd_.pipeline_barrier({}, {}, {&b, 1});
     }
     void memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
                         VkAccessFlags2 dst_access) const {
-        VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, nullptr, src_stage, src_access, dst_stage, dst_access};
-        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dep.memoryBarrierCount = 1;
-        dep.pMemoryBarriers = &b;
-        fn().vkCmdPipelineBarrier2(cmd_, &dep);
+        const VkMemoryBarrier2 b = vkrc::memory_barrier(src_stage, src_access, dst_stage, dst_access);
+        cmd_.pipeline_barrier({&b, 1}, {}, {});
     }
 
 private:
     Queue queue_;
-    Device device_;
-    VkCommandPool pool_ = VK_NULL_HANDLE;
-    VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-    VkFence fence_ = VK_NULL_HANDLE;
-    bool submitted_ = false;
-    bool waited_ = false;
+    CommandPool pool_;
+    CommandBuffer cmd_;
 };
 
 Buffer staging_buffer(const Device& device, VkDeviceSize size, MemoryUsage usage) {
@@ -127,9 +84,20 @@ Buffer staging_buffer(const Device& device, VkDeviceSize size, MemoryUsage usage
     return Buffer::create(device, info);
 }
 
-void check_queue(const Queue& queue, const Device& device, const char* who) {
+// The checks every transfer starts with: the buffer or image exists, belongs
+// to the queue's device and has the transfer usage (usage_name) it needs.
+template <class Resource>
+void check_transfer(const Queue& queue, const Resource& resource, std::uint32_t usage, const char* usage_name,
+                    const char* who) {
+    constexpr bool buffer = std::is_same_v<Resource, Buffer>;
+    if (!resource) throw UsageError(std::string(who) + (buffer ? ": the Buffer is empty" : ": the Image is empty"));
     if (!queue) throw UsageError(std::string(who) + ": the Queue is empty");
-    if (!(queue.device() == device)) throw UsageError(std::string(who) + ": the queue belongs to another device");
+    if (!(queue.device() == resource.device())) {
+        throw UsageError(std::string(who) + ": the queue belongs to another device");
+    }
+    if (!(resource.usage() & usage)) {
+        throw UsageError(std::string(who) + (buffer ? ": the buffer lacks " : ": the image lacks ") + usage_name);
+    }
 }
 
 std::uint32_t checked_texel_size(const Image& image, const char* who) {
@@ -160,11 +128,7 @@ VkDeviceSize level_size(const Image& image, std::uint32_t level, std::uint32_t t
 
 void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) {
     constexpr const char* who = "vkrc::upload_buffer";
-    if (!buffer) throw UsageError(std::string(who) + ": the Buffer is empty");
-    check_queue(queue, buffer.device(), who);
-    if (!(buffer.usage() & VK_BUFFER_USAGE_TRANSFER_DST_BIT)) {
-        throw UsageError(std::string(who) + ": the buffer lacks VK_BUFFER_USAGE_TRANSFER_DST_BIT");
-    }
+    check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "VK_BUFFER_USAGE_TRANSFER_DST_BIT", who);
     if (offset > buffer.size() || data.size() > buffer.size() - offset) {
         throw UsageError(std::string(who) + ": " + std::to_string(data.size()) + " bytes at offset " +
                          std::to_string(offset) + " do not fit in the " + std::to_string(buffer.size()) +
@@ -186,11 +150,7 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
 std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset,
                                        VkDeviceSize size) {
     constexpr const char* who = "vkrc::download_buffer";
-    if (!buffer) throw UsageError(std::string(who) + ": the Buffer is empty");
-    check_queue(queue, buffer.device(), who);
-    if (!(buffer.usage() & VK_BUFFER_USAGE_TRANSFER_SRC_BIT)) {
-        throw UsageError(std::string(who) + ": the buffer lacks VK_BUFFER_USAGE_TRANSFER_SRC_BIT");
-    }
+    check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "VK_BUFFER_USAGE_TRANSFER_SRC_BIT", who);
     if (offset > buffer.size() || size > buffer.size() - offset) {
         throw UsageError(std::string(who) + ": " + std::to_string(size) + " bytes at offset " + std::to_string(offset) +
                          " are not all in the " + std::to_string(buffer.size()) + "-byte buffer");
@@ -227,11 +187,7 @@ VkDeviceSize image_data_size(const Image& image) {
 void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
                   const ImageUploadInfo& info) {
     constexpr const char* who = "vkrc::upload_image";
-    if (!image) throw UsageError(std::string(who) + ": the Image is empty");
-    check_queue(queue, image.device(), who);
-    if (!(image.usage() & VK_IMAGE_USAGE_TRANSFER_DST_BIT)) {
-        throw UsageError(std::string(who) + ": the image lacks VK_IMAGE_USAGE_TRANSFER_DST_BIT");
-    }
+    check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_DST_BIT, "VK_IMAGE_USAGE_TRANSFER_DST_BIT", who);
     const std::uint32_t texel = checked_texel_size(image, who);
     const VkDeviceSize expected = image_data_size(image);
     if (data.size() != expected) {
@@ -274,11 +230,7 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
 std::vector<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout,
                                       std::uint32_t mip_level, std::uint32_t array_layer) {
     constexpr const char* who = "vkrc::download_image";
-    if (!image) throw UsageError(std::string(who) + ": the Image is empty");
-    check_queue(queue, image.device(), who);
-    if (!(image.usage() & VK_IMAGE_USAGE_TRANSFER_SRC_BIT)) {
-        throw UsageError(std::string(who) + ": the image lacks VK_IMAGE_USAGE_TRANSFER_SRC_BIT");
-    }
+    check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "VK_IMAGE_USAGE_TRANSFER_SRC_BIT", who);
     if (mip_level >= image.mip_levels() || array_layer >= image.array_layers()) {
         throw UsageError(std::string(who) + ": level " + std::to_string(mip_level) + " layer " +
                          std::to_string(array_layer) + " is not in the image");

@@ -264,9 +264,9 @@ TEST_F(VulkanTest, TimelineSignalGoesInItsOwnBatchWhenTheLastIsFull) {
         batch.signalSemaphoreInfoCount = count;
         batch.pSignalSemaphoreInfos = signals.data();
         for (auto& s : signals) s.value += 1;
-        queue.state()->signal_wanted.store(true);
+        queue.state()->timeline.request_signal();
         const std::uint64_t number = queue.submit(std::span(&batch, 1));
-        EXPECT_EQ(queue.state()->signalled.load(), number) << count << " signals in the batch";
+        EXPECT_EQ(queue.state()->timeline.last_signalled(), number) << count << " signals in the batch";
     }
     queue.wait_idle();
 }

@@ -1,4 +1,4 @@
-// Command pools, command buffers, recording and typed submission.
+// Command pools, command buffers and recording (submission: vkrc/submit.hpp).
 //
 // Recording methods are inline: each is one call through the device function
 // table with the raw handles read out of the wrappers. No allocation, no
@@ -57,10 +57,10 @@ private:
 // render_pass empty and color_formats empty for secondaries used outside
 // rendering; set either for RENDER_PASS_CONTINUE secondaries.
 struct CommandBufferInheritance {
-    RenderPass render_pass;
+    RenderPass render_pass{};
     std::uint32_t subpass = 0;
-    Framebuffer framebuffer;
-    std::span<const VkFormat> color_formats;
+    Framebuffer framebuffer{};
+    std::span<const VkFormat> color_formats{};
     VkFormat depth_format = VK_FORMAT_UNDEFINED;
     VkFormat stencil_format = VK_FORMAT_UNDEFINED;
     VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
@@ -80,7 +80,7 @@ struct RenderingAttachment {
 struct RenderingInfo {
     static constexpr std::uint32_t max_color_attachments = 8;
     VkRect2D render_area{};
-    std::span<const RenderingAttachment> color_attachments;
+    std::span<const RenderingAttachment> color_attachments{};
     const RenderingAttachment* depth_attachment = nullptr;
     const RenderingAttachment* stencil_attachment = nullptr;
     VkRenderingFlags flags = 0;
@@ -214,37 +214,6 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkI
 // A global memory barrier.
 VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                 VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept;
-
-// A semaphore to wait on or signal in a submission (VkSemaphoreSubmitInfo);
-// value is ignored for binary semaphores.
-struct SemaphoreSubmit {
-    SemaphoreSubmit() noexcept = default;
-    SemaphoreSubmit(const Semaphore& s, std::uint64_t v = 0,
-                    VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) noexcept
-        : semaphore(s.vk()), value(v), stage_mask(stages) {}
-    VkSemaphore semaphore = VK_NULL_HANDLE;
-    std::uint64_t value = 0;
-    VkPipelineStageFlags2 stage_mask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-};
-
-// One batch of a submission (VkSubmitInfo2).
-struct SubmitBatch {
-    std::span<const SemaphoreSubmit> waits;
-    std::span<const CommandBuffer> command_buffers;
-    std::span<const SemaphoreSubmit> signals;
-};
-
-// Limits of one submit() call, whose Vulkan structures are built on the stack.
-struct SubmitLimits {
-    static constexpr std::size_t batches = 16;
-    static constexpr std::size_t semaphores = 32;        // waits and signals, each, over all batches
-    static constexpr std::size_t command_buffers = 128;  // over all batches
-};
-
-// Queue::submit with typed batches; the fence (if any) signals when all are
-// done. No heap allocation; throws UsageError beyond SubmitLimits.
-void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence = {});
-void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence = {});
 
 namespace detail {
 

@@ -26,7 +26,7 @@ struct DescriptorSetLayoutBinding {
 // Mirrors VkDescriptorSetLayoutCreateInfo.
 struct DescriptorSetLayoutCreateInfo {
     VkDescriptorSetLayoutCreateFlags flags = 0;
-    std::vector<DescriptorSetLayoutBinding> bindings;
+    std::vector<DescriptorSetLayoutBinding> bindings{};
 };
 
 class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
@@ -46,7 +46,7 @@ private:
 struct DescriptorPoolCreateInfo {
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     std::uint32_t max_sets = 0;
-    std::vector<VkDescriptorPoolSize> pool_sizes;
+    std::vector<VkDescriptorPoolSize> pool_sizes{};
 };
 
 class DescriptorSet;

@@ -3,13 +3,16 @@
 
 #include "vkrc/instance.hpp"
 
+#include <deque>
 #include <span>
 
 VKRC_BEGIN_NAMESPACE
 
+class DeviceAllocator;
+
 namespace detail {
 class DeviceState;
-struct QueueState;
+class QueueState;
 }  // namespace detail
 
 // Queues wanted from one family (VkDeviceQueueCreateInfo).
@@ -24,8 +27,8 @@ struct QueueRequest {
 // feature in the structs below. vkrc fills their sType and pNext.
 struct DeviceCreateInfo {
     // Empty: one queue from the first family with graphics and compute.
-    std::vector<QueueRequest> queue_requests;
-    std::vector<const char*> enabled_extension_names;
+    std::vector<QueueRequest> queue_requests{};
+    std::vector<const char*> enabled_extension_names{};
     VkPhysicalDeviceFeatures enabled_features{};
     VkPhysicalDeviceVulkan11Features vulkan11_features{};
     VkPhysicalDeviceVulkan12Features vulkan12_features{};
@@ -122,6 +125,224 @@ private:
     detail::QueueState* queue_ = nullptr;  // owned by the device
 };
 
-VKRC_END_NAMESPACE
+namespace detail {
 
-#include "vkrc/detail/device_state.hpp"
+// The numbering of one queue's submissions and what is known of their
+// completion: vkrc's only GPU-side tracking. Submits are numbered from 1; a
+// submit signals the queue's timeline semaphore with its own number only
+// when someone asked since the last signal (a dropped object, a pool freeing
+// a child, a wait), so frame loops that drop nothing never pay for a signal.
+// The note_submitted / note_signalled / next_number / take_signal_request
+// calls are made under the queue's mutex; the others from any thread.
+class QueueTimeline {
+public:
+    // The number the next submit gets.
+    std::uint64_t next_number() const noexcept { return submitted_.load(__ATOMIC_RELAXED) + 1; }
+    // The number of the last submit (0: none yet).
+    std::uint64_t last_submitted() const noexcept { return submitted_.load(__ATOMIC_ACQUIRE); }
+    // The number of the last submit that signalled the timeline semaphore.
+    std::uint64_t last_signalled() const noexcept { return signalled_.load(__ATOMIC_ACQUIRE); }
+    // The highest number known to have completed: read from the semaphore,
+    // or that of a vkrc-submitted fence seen signalled (a fence signal covers
+    // all earlier work on its queue).
+    std::uint64_t completed() const noexcept { return completed_.load(__ATOMIC_RELAXED); }
+
+    // Asks the next submit to signal the semaphore.
+    void request_signal() noexcept { signal_wanted_.store(true, __ATOMIC_RELAXED); }
+    // Whether a signal was asked for since the last one.
+    bool signal_requested() const noexcept { return signal_wanted_.load(__ATOMIC_RELAXED); }
+    // Clears the request and says whether there was one; taken before
+    // submitting, so a request made meanwhile is either covered by this
+    // submit's signal or asks the next submit again.
+    bool take_signal_request() noexcept { return signal_wanted_.exchange(false, __ATOMIC_RELAXED); }
+
+    // Submit number went in without a signal.
+    void note_submitted(std::uint64_t number) noexcept { submitted_.store(number, __ATOMIC_RELEASE); }
+    // Submit number went in and signals the semaphore with its number.
+    void note_signalled(std::uint64_t number) noexcept {
+        submitted_.store(number, __ATOMIC_RELEASE);
+        signalled_.store(number, __ATOMIC_RELEASE);
+    }
+    // Raises completed() to value (several threads may refresh it).
+    void note_completed(std::uint64_t value) noexcept {
+        std::uint64_t seen = completed_.load(__ATOMIC_RELAXED);
+        while (seen < value && !completed_.compare_exchange_weak(seen, value, __ATOMIC_RELAXED)) {}
+    }
+
+    // The number whose completion means all work submitted so far has
+    // completed. When no signal covers it yet, asks the next submit for one
+    // (until then only a vkrc fence of that submit or a later one, or a wait
+    // for idle, can show it complete).
+    std::uint64_t covering_value() noexcept {
+        const std::uint64_t last = last_submitted();
+        if (last_signalled() < last) request_signal();
+        return last;
+    }
+
+private:
+    Atomic<std::uint64_t> submitted_{0};
+    Atomic<std::uint64_t> signalled_{0};
+    Atomic<bool> signal_wanted_{false};
+    Atomic<std::uint64_t> completed_{0};
+};
+
+class QueueState {
+public:
+    VkQueue queue = VK_NULL_HANDLE;
+    std::uint32_t family_index = 0;
+    std::uint32_t index = 0;
+    VkSemaphore semaphore = VK_NULL_HANDLE;  // the timeline's, counting in submission numbers
+    QueueTimeline timeline;
+    mutable Mutex mutex;
+};
+
+// Work to run once the GPU is done with an object: destroying its Vulkan
+// handle, or returning its memory to an allocator. A plain function pointer
+// and two words, so that queued actions hold no references and a Device with
+// pending actions is still torn down when its last handle goes.
+struct DeferredAction {
+    void (*run)(DeviceState& device, std::uint64_t handle, void* context) noexcept = nullptr;
+    std::uint64_t handle = 0;
+    void* context = nullptr;
+};
+
+// The device's queue of deferred actions. Actions queued while the same work
+// was pending share one batch; batches run in the order they were queued, so
+// an object queued after another (an image after its view) is destroyed after it.
+class DeferredDestructor {
+public:
+    // Runs the action now when no vkrc-submitted work is pending, otherwise once all work submitted before this call has completed.
+    void destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept;
+    // Runs the queued actions whose work has completed; never blocks on the GPU.
+    void collect(DeviceState& device) noexcept;
+    // Runs every queued action at once; for teardown, after the GPU is idle or lost.
+    void run_all(DeviceState& device) noexcept;
+    // The number of queued actions.
+    std::size_t size() const noexcept;
+
+private:
+    // Moves the actions whose work has completed to out; may throw bad_alloc.
+    void take_ready(DeviceState& device, std::vector<DeferredAction>& out);
+
+    struct Batch {
+        std::vector<std::uint64_t> wait_values;  // per queue
+        std::vector<DeferredAction> actions;
+    };
+    mutable Mutex mutex_;
+    std::deque<Batch> batches_;
+    // Read without the lock by collect() to skip it when nothing is queued.
+    Atomic<std::size_t> count_{0};
+};
+
+// Every allocator used with the device, kept until teardown so that deferred
+// frees can still reach it (memory.cpp).
+class AllocatorRegistry {
+public:
+    // The device's default allocator, a PoolAllocator made on first use.
+    DeviceAllocator& default_allocator();
+    // Keeps allocator until release_all (once per allocator).
+    void keep(const Ref<DeviceAllocator>& allocator);
+    // Calls each allocator's release() and drops them; teardown, after every deferred free ran.
+    void release_all(DeviceState& device) noexcept;
+
+private:
+    Mutex mutex_;
+    std::vector<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
+    DeviceAllocator* default_ = nullptr;
+};
+
+class DeviceState final : public RefCounted {
+public:
+    ~DeviceState() override;
+
+    // See DeferredDestructor::destroy_after_gpu.
+    void destroy_after_gpu(DeferredAction action) noexcept { deferred.destroy_after_gpu(*this, action); }
+    // Marks the device lost: the GPU will touch nothing any more, so every
+    // queued action may run.
+    void mark_lost() noexcept { lost.store(true, __ATOMIC_RELAXED); }
+    // Marks the device lost when r says so; returns r.
+    VkResult note_result(VkResult r) noexcept {
+        if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+        return r;
+    }
+    // Marks the device lost when r says so, then check(r, call).
+    VkResult check_result(VkResult r, const char* call) { return check(note_result(r), call); }
+    // After a call that may have run or waited for GPU work: marks the device
+    // lost when r says so, runs the completed deferred actions, then check(r, call).
+    VkResult finish_call(VkResult r, const char* call) {
+        note_result(r);
+        deferred.collect(*this);
+        return check(r, call);
+    }
+    // Under the queue's lock: when submits since the last timeline signal
+    // carried none, submits an empty batch that signals. value receives a
+    // timeline value, signalled or on its way, that covers all work submitted
+    // so far.
+    VkResult signal_submitted_work(QueueState& queue, std::uint64_t& value) noexcept;
+    // Waits until the queue's submission number has completed (at once when
+    // a fence or the timeline has already shown it), signalling the timeline
+    // first when no submit has; failed_call, if given, receives the name of
+    // the call that failed.
+    VkResult wait_for_submission(QueueState& queue, std::uint64_t number, const char** failed_call = nullptr) noexcept;
+    // wait_for_submission, throwing Error (DeviceLostError) on failure.
+    void await_submission(QueueState& queue, std::uint64_t number);
+
+    // For objects a pool owns (command buffers, descriptor sets), which must
+    // be freed under their pool's lock rather than by a DeferredAction: the
+    // covering values of every queue (out is resized to the queue count), and
+    // whether the GPU has completed the work they stand for.
+    void submitted_snapshot(std::vector<std::uint64_t>& out);
+    bool reached(std::span<const std::uint64_t> snapshot) noexcept;
+    // Reads the queues' timelines; true when everything submitted has completed.
+    bool idle_now() noexcept;
+
+    VkDevice device = VK_NULL_HANDLE;
+    DeviceFunctions fn;
+    PhysicalDevice physical_device;
+    Ownership ownership = Ownership::owned;
+    std::vector<Text> enabled_extensions;
+    std::deque<QueueState> queues;  // a deque: Queue handles point into it
+    Atomic<bool> lost{false};
+    DeferredDestructor deferred;
+    AllocatorRegistry allocators;
+
+private:
+    // Reads one queue's timeline into its completed cache; false on failure.
+    bool refresh(QueueState& queue) noexcept;
+};
+
+// Converts any Vulkan handle to the word stored in a DeferredAction.
+template <class VkHandle>
+std::uint64_t handle_bits(VkHandle handle) noexcept {
+    return (std::uint64_t)(handle);
+}
+template <class VkHandle>
+VkHandle handle_from_bits(std::uint64_t bits) noexcept {
+    return (VkHandle)(bits);
+}
+
+// Queues vkDestroyX(device, handle, nullptr) to run after the GPU is done.
+// Usage: defer_destroy<&DeviceFunctions::vkDestroyBuffer>(device, buffer);
+template <auto DestroyMember, class VkHandle>
+void defer_destroy(DeviceState& device, VkHandle handle) noexcept {
+    if (handle == VK_NULL_HANDLE) return;
+    device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
+                                  (d.fn.*DestroyMember)(d.device, handle_from_bits<VkHandle>(bits), nullptr);
+                              },
+                              handle_bits(handle), nullptr});
+}
+
+}  // namespace detail
+
+inline VkDevice Device::vk() const noexcept { return state_->device; }
+inline const DeviceFunctions& Device::fn() const noexcept { return state_->fn; }
+inline const PhysicalDevice& Device::physical_device() const noexcept { return state_->physical_device; }
+inline const Instance& Device::instance() const noexcept { return state_->physical_device.instance(); }
+
+inline VkQueue Queue::vk() const noexcept { return queue_->queue; }
+inline std::uint32_t Queue::family_index() const noexcept { return queue_->family_index; }
+inline std::uint32_t Queue::index() const noexcept { return queue_->index; }
+inline VkSemaphore Queue::timeline_semaphore() const noexcept { return queue_->semaphore; }
+inline Mutex& Queue::mutex() const noexcept { return queue_->mutex; }
+
+VKRC_END_NAMESPACE

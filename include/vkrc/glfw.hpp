@@ -58,9 +58,9 @@ private:
 // A window, an instance made from instance_info plus GLFW's extensions, and
 // a surface for the window. Members are destroyed surface first, window last.
 struct WindowSurface {
-    Window window;
-    Instance instance;
-    Surface surface;
+    Window window{};
+    Instance instance{};
+    Surface surface{};
 };
 WindowSurface create_window_surface(const WindowCreateInfo& window, InstanceCreateInfo instance_info = {});
 

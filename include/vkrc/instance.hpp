@@ -19,10 +19,10 @@ class PhysicalDevice;
 
 // One message from VK_EXT_debug_utils (the validation layer among others).
 struct DebugMessage {
-    VkDebugUtilsMessageSeverityFlagBitsEXT severity;
-    VkDebugUtilsMessageTypeFlagsEXT types;
-    const char* message_id_name;  // may be null
-    const char* message;
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity{};
+    VkDebugUtilsMessageTypeFlagsEXT types{};
+    const char* message_id_name{};  // may be null
+    const char* message{};
 };
 using DebugCallback = std::function<void(const DebugMessage&)>;
 
@@ -34,14 +34,14 @@ struct InstanceCreateInfo {
     const char* application_name = "vkrc application";
     std::uint32_t application_version = 0;
     std::uint32_t api_version = VK_API_VERSION_1_3;
-    std::vector<const char*> enabled_layer_names;
-    std::vector<const char*> enabled_extension_names;
+    std::vector<const char*> enabled_layer_names{};
+    std::vector<const char*> enabled_extension_names{};
     // Adds VK_LAYER_KHRONOS_validation and VK_EXT_debug_utils.
     bool validation = false;
     // Installs a debug-utils messenger for the instance's whole life (and for
     // vkCreateInstance/vkDestroyInstance themselves). Null with validation on
     // means print_debug_message. Set it without validation to hear other layers.
-    DebugCallback debug_callback;
+    DebugCallback debug_callback{};
     VkDebugUtilsMessageSeverityFlagsEXT debug_severities =
         VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     // Entry point every function is loaded through; null means the loader's.
@@ -82,7 +82,7 @@ private:
 struct DeviceRequirements {
     std::uint32_t min_api_version = VK_API_VERSION_1_3;
     VkQueueFlags queue_flags = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-    std::vector<const char*> required_extensions;
+    std::vector<const char*> required_extensions{};
     // A queue family of the chosen device must be able to present to it.
     VkSurfaceKHR present_surface = VK_NULL_HANDLE;
     // Devices of earlier types in this list win; CPU devices (lavapipe) are accepted.
@@ -137,6 +137,48 @@ private:
     friend class Instance;
 };
 
-VKRC_END_NAMESPACE
+namespace detail {
 
-#include "vkrc/detail/instance_state.hpp"
+class InstanceState final : public RefCounted {
+public:
+    ~InstanceState() override;
+
+    VkInstance instance = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
+    std::uint32_t api_version = 0;
+    GlobalFunctions global_fn;
+    InstanceFunctions fn;
+    std::vector<Text> enabled_extensions;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    DebugCallback debug_callback;  // the messengers' user data: the state never moves
+};
+
+class PhysicalDeviceState final : public RefCounted {
+public:
+    Instance instance;
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkPhysicalDeviceProperties properties{};
+    VkPhysicalDeviceMemoryProperties memory_properties{};
+    std::vector<VkQueueFamilyProperties> queue_families;
+    std::vector<Text> extensions;
+};
+
+}  // namespace detail
+
+inline VkInstance Instance::vk() const noexcept { return state_->instance; }
+inline const InstanceFunctions& Instance::fn() const noexcept { return state_->fn; }
+inline const GlobalFunctions& Instance::global_fn() const noexcept { return state_->global_fn; }
+inline std::uint32_t Instance::api_version() const noexcept { return state_->api_version; }
+
+inline VkPhysicalDevice PhysicalDevice::vk() const noexcept { return state_->physical_device; }
+inline const Instance& PhysicalDevice::instance() const noexcept { return state_->instance; }
+inline const InstanceFunctions& PhysicalDevice::fn() const noexcept { return state_->instance.fn(); }
+inline const VkPhysicalDeviceProperties& PhysicalDevice::properties() const noexcept { return state_->properties; }
+inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties() const noexcept {
+    return state_->memory_properties;
+}
+inline const std::vector<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const noexcept {
+    return state_->queue_families;
+}
+
+VKRC_END_NAMESPACE

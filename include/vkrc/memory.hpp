@@ -42,7 +42,7 @@ struct MemoryIntent {
 // Everything an allocator needs to place one resource.
 struct AllocationRequest {
     VkMemoryRequirements requirements{};
-    MemoryIntent intent;
+    MemoryIntent intent{};
     // From VkMemoryDedicatedRequirements (Vulkan 1.1 core).
     bool prefers_dedicated = false;
     bool requires_dedicated = false;
@@ -227,7 +227,8 @@ constexpr MemoryRange mapped_range(VkDeviceSize allocation_offset, VkDeviceSize 
     return {first, last - first};
 }
 
-struct AllocationState final : RefCounted {
+class AllocationState final : public RefCounted {
+public:
     Ref<DeviceState> device;
     AllocationInfo info;
     DeviceAllocator* allocator = nullptr;

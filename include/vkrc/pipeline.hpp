@@ -19,8 +19,8 @@ class PipelineCacheState;
 
 // Mirrors VkPipelineLayoutCreateInfo.
 struct PipelineLayoutCreateInfo {
-    std::vector<DescriptorSetLayout> set_layouts;
-    std::vector<VkPushConstantRange> push_constant_ranges;
+    std::vector<DescriptorSetLayout> set_layouts{};
+    std::vector<VkPushConstantRange> push_constant_ranges{};
 };
 
 class PipelineLayout : public Handle<detail::PipelineLayoutState> {
@@ -37,19 +37,19 @@ private:
 
 // Mirrors VkSubpassDescription (graphics subpasses).
 struct SubpassDescription {
-    std::vector<VkAttachmentReference> input_attachments;
-    std::vector<VkAttachmentReference> color_attachments;
-    std::vector<VkAttachmentReference> resolve_attachments;  // empty or one per colour attachment
+    std::vector<VkAttachmentReference> input_attachments{};
+    std::vector<VkAttachmentReference> color_attachments{};
+    std::vector<VkAttachmentReference> resolve_attachments{};  // empty or one per colour attachment
     // attachment VK_ATTACHMENT_UNUSED (the default): no depth/stencil attachment.
     VkAttachmentReference depth_stencil_attachment{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
-    std::vector<std::uint32_t> preserve_attachments;
+    std::vector<std::uint32_t> preserve_attachments{};
 };
 
 // Mirrors VkRenderPassCreateInfo.
 struct RenderPassCreateInfo {
-    std::vector<VkAttachmentDescription> attachments;
-    std::vector<SubpassDescription> subpasses;
-    std::vector<VkSubpassDependency> dependencies;
+    std::vector<VkAttachmentDescription> attachments{};
+    std::vector<SubpassDescription> subpasses{};
+    std::vector<VkSubpassDependency> dependencies{};
 };
 
 class RenderPass : public Handle<detail::RenderPassState> {
@@ -66,8 +66,8 @@ private:
 
 // Mirrors VkFramebufferCreateInfo.
 struct FramebufferCreateInfo {
-    RenderPass render_pass;
-    std::vector<ImageView> attachments;
+    RenderPass render_pass{};
+    std::vector<ImageView> attachments{};
     std::uint32_t width = 0;
     std::uint32_t height = 0;
     std::uint32_t layers = 1;

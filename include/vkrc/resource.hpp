@@ -8,11 +8,11 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-struct BufferState;
-struct ImageState;
-struct ImageViewState;
-struct BufferViewState;
-struct SamplerState;
+class BufferState;
+class ImageState;
+class ImageViewState;
+class BufferViewState;
+class SamplerState;
 }  // namespace detail
 
 // Mirrors VkBufferCreateInfo, plus where its memory comes from.
@@ -21,10 +21,10 @@ struct BufferCreateInfo {
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
-    std::vector<std::uint32_t> queue_family_indices;
-    MemoryIntent memory;
+    std::vector<std::uint32_t> queue_family_indices{};
+    MemoryIntent memory{};
     // Null: the device's default allocator (a PoolAllocator).
-    SharedAllocator allocator;
+    SharedAllocator allocator{};
     const void* next = nullptr;
 };
 
@@ -62,10 +62,10 @@ struct ImageCreateInfo {
     VkImageTiling tiling = VK_IMAGE_TILING_OPTIMAL;
     VkImageUsageFlags usage = 0;
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
-    std::vector<std::uint32_t> queue_family_indices;
+    std::vector<std::uint32_t> queue_family_indices{};
     VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    MemoryIntent memory;
-    SharedAllocator allocator;
+    MemoryIntent memory{};
+    SharedAllocator allocator{};
     const void* next = nullptr;
 };
 
@@ -182,7 +182,8 @@ VkImageAspectFlags format_aspects(VkFormat format) noexcept;
 
 namespace detail {
 
-struct BufferState final : RefCounted {
+class BufferState final : public RefCounted {
+public:
     ~BufferState() override;
     Device device;
     VkBuffer buffer = VK_NULL_HANDLE;
@@ -192,7 +193,8 @@ struct BufferState final : RefCounted {
     Allocation allocation;  // released after the buffer's destruction is queued
 };
 
-struct ImageState final : RefCounted {
+class ImageState final : public RefCounted {
+public:
     ~ImageState() override;
     Device device;
     VkImage image = VK_NULL_HANDLE;
@@ -211,7 +213,8 @@ struct ImageState final : RefCounted {
     Ref<RefCounted> owner;
 };
 
-struct ImageViewState final : RefCounted {
+class ImageViewState final : public RefCounted {
+public:
     ~ImageViewState() override;
     Image image;
     VkImageView view = VK_NULL_HANDLE;
@@ -219,13 +222,15 @@ struct ImageViewState final : RefCounted {
     VkImageSubresourceRange range{};
 };
 
-struct BufferViewState final : RefCounted {
+class BufferViewState final : public RefCounted {
+public:
     ~BufferViewState() override;
     Buffer buffer;
     VkBufferView view = VK_NULL_HANDLE;
 };
 
-struct SamplerState final : RefCounted {
+class SamplerState final : public RefCounted {
+public:
     ~SamplerState() override;
     Device device;
     VkSampler sampler = VK_NULL_HANDLE;

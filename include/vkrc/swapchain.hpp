@@ -14,7 +14,7 @@
 // presented: its semaphores are reused on that condition.
 #pragma once
 
-#include "vkrc/command.hpp"
+#include "vkrc/submit.hpp"
 #include "vkrc/resource.hpp"
 #include "vkrc/surface.hpp"
 #include "vkrc/sync.hpp"
@@ -117,7 +117,7 @@ struct SwapchainCreateInfo {
     // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
     VkExtent2D extent{};
     // Receives the choices made and why, at creation and every re-creation.
-    std::function<void(const char*)> log;
+    std::function<void(const char*)> log{};
 };
 
 // A swapchain for one Surface, re-created in place. Keeps its Surface,
@@ -126,16 +126,7 @@ struct SwapchainCreateInfo {
 // until every frame that used it is dropped and its work has completed.
 class Swapchain : public Handle<detail::SwapchainState>, public Presenter {
 public:
-    Swapchain() noexcept;
-    // Out of line, with the state (src/swapchain_state.hpp), which the
-    // public header does not include.
-    ~Swapchain() override;
-    Swapchain(const Swapchain& other) noexcept;
-    Swapchain(Swapchain&& other) noexcept;
-    Swapchain& operator=(const Swapchain& other) noexcept;
-    Swapchain& operator=(Swapchain&& other) noexcept;
-    void reset() noexcept;
-    std::uint32_t use_count() const noexcept;
+    Swapchain() noexcept = default;
     // Creates the swapchain and takes the surface: a second live Swapchain
     // for the same surface is a UsageError. After a previous Swapchain of the
     // surface was dropped, waits for the device to be idle so that its Vulkan
@@ -194,16 +185,7 @@ struct HeadlessPresenterCreateInfo {
 // being rewritten while the GPU still renders into it.
 class HeadlessPresenter : public Handle<detail::HeadlessPresenterState>, public Presenter {
 public:
-    HeadlessPresenter() noexcept;
-    // Out of line, with the state (src/swapchain_state.hpp), which the
-    // public header does not include.
-    ~HeadlessPresenter() override;
-    HeadlessPresenter(const HeadlessPresenter& other) noexcept;
-    HeadlessPresenter(HeadlessPresenter&& other) noexcept;
-    HeadlessPresenter& operator=(const HeadlessPresenter& other) noexcept;
-    HeadlessPresenter& operator=(HeadlessPresenter&& other) noexcept;
-    void reset() noexcept;
-    std::uint32_t use_count() const noexcept;
+    HeadlessPresenter() noexcept = default;
     static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
 
     Frame acquire() override;
@@ -224,5 +206,63 @@ public:
 private:
     using Handle::Handle;
 };
+
+namespace detail {
+
+// One Vulkan swapchain (current or retired) and its per-image semaphores.
+class SwapchainChainState final : public RefCounted {
+public:
+    // Queues the swapchain's destruction after everything submitted on the
+    // queue so far, including (by an empty submission) its last present;
+    // see the Presentation section of docs/design.md.
+    ~SwapchainChainState() override;
+    Queue queue;
+    Surface surface;
+    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+    // Signalled by the rendering of image i, waited by its present; reused
+    // only when image i is acquired again.
+    std::vector<Semaphore> render_done;
+    bool presented = false;  // under the owning SwapchainState's mutex
+    // Not retired when its Swapchain went: its destruction ends the surface's
+    // SurfaceState::releasing.
+    bool last = false;
+};
+
+class SwapchainState final : public RefCounted {
+public:
+    ~SwapchainState() override;  // gives the surface back
+    Queue queue;
+    Surface surface;
+    SwapchainCreateInfo info;
+    Ref<SwapchainChainState> chain;  // null until the surface has an area
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    // Ring of acquire semaphores, each reused once the queue has reached the
+    // value recorded when the frame that waited on it was presented.
+    std::vector<Semaphore> acquire_semaphores;
+    std::vector<std::uint64_t> acquire_done_values;
+    std::uint32_t next_acquire = 0;
+    VkSurfaceFormatKHR surface_format{};
+    VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+    VkExtent2D extent{};
+    bool needs_recreate = false;
+    Mutex mutex;
+};
+
+class HeadlessPresenterState final : public RefCounted {
+public:
+    Queue queue;
+    HeadlessPresenterCreateInfo info;
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+    std::uint64_t acquired = 0;  // under mutex
+    // Written by present without the lock: present then touches no state it
+    // must read first (its frame is checked against the frame's own fields).
+    Atomic<std::uint32_t> last_presented{UINT32_MAX};
+    bool needs_resize = false;
+    mutable Mutex mutex;
+};
+
+}  // namespace detail
 
 VKRC_END_NAMESPACE

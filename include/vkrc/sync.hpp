@@ -131,9 +131,15 @@ public:
     // value does not mean the fence's own signal operation has completed,
     // so destruction then waits for the fence (see destroy_submitted_fence).
     bool in_flight = false;
+    // vkrc::submit fenced submission number on queue with this fence.
+    void note_submitted(QueueState& submitted_queue, std::uint64_t number) noexcept {
+        queue = &submitted_queue;
+        submit_number = number;
+        in_flight = true;
+    }
     // After a successful wait or status: records the submission as complete.
     void note_signalled() noexcept {
-        if (queue) queue->note_completed(submit_number);
+        if (queue) queue->timeline.note_completed(submit_number);
     }
 };
 

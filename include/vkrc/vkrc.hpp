@@ -13,6 +13,7 @@
 #include "vkrc/pipeline.hpp"
 #include "vkrc/resource.hpp"
 #include "vkrc/shader.hpp"
+#include "vkrc/submit.hpp"
 #include "vkrc/surface.hpp"
 #include "vkrc/swapchain.hpp"
 #include "vkrc/sync.hpp"

@@ -1,0 +1,32 @@
+#include "text.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+VKRC_BEGIN_NAMESPACE
+namespace detail {
+
+bool contains(const std::vector<Text>& names, const char* name) noexcept {
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+bool contains(const std::vector<const char*>& names, const char* name) noexcept {
+    return std::any_of(names.begin(), names.end(), [&](const char* n) { return std::strcmp(n, name) == 0; });
+}
+
+void add_unique(std::vector<const char*>& names, const char* name) {
+    if (!contains(names, name)) names.push_back(name);
+}
+
+std::string hex(std::uint64_t v) {
+    static const char digits[] = "0123456789abcdef";
+    std::string s;
+    do {
+        s.insert(s.begin(), digits[v & 15]);
+        v >>= 4;
+    } while (v);
+    return s;
+}
+
+}  // namespace detail
+VKRC_END_NAMESPACE
