@@ -201,20 +201,20 @@ TEST(DeferredDestruction, DeviceTeardownDrainsPendingWork) {
 TEST_F(VulkanTest, SubmitSignalsTheTimelineOnlyWhenAsked) {
     actions_run = 0;
     auto& q = *queue.state();
-    const std::uint64_t signalled = q.signalled.load();
+    const std::uint64_t signalled = q.timeline.last_signalled();
     VkSubmitInfo2 empty{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     std::array<VkSubmitInfo2, 3> batches{empty, empty, empty};
     const std::uint64_t first = queue.submit(batches);
     EXPECT_EQ(queue.submit({}), first + 1) << "submissions are numbered";
-    EXPECT_EQ(q.signalled.load(), signalled) << "nothing dropped: the application's submits only";
+    EXPECT_EQ(q.timeline.last_signalled(), signalled) << "nothing dropped: the application's submits only";
 
     // A drop while work may be pending asks the next submit for one signal.
     device.state()->destroy_after_gpu({count_action, 1, nullptr});
     EXPECT_EQ(device.deferred_count(), 1u);
     const std::uint64_t third = queue.submit(batches);
-    EXPECT_EQ(q.signalled.load(), third);
+    EXPECT_EQ(q.timeline.last_signalled(), third);
     queue.submit(batches);
-    EXPECT_EQ(q.signalled.load(), third) << "one signal per request";
+    EXPECT_EQ(q.timeline.last_signalled(), third) << "one signal per request";
 
     // Waiting on the timeline needs a signalled value: completion_value submits one.
     const std::uint64_t value = queue.completion_value();
