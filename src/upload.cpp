@@ -3,6 +3,8 @@
 #include "vkrc/command.hpp"
 #include "vkrc/sync.hpp"
 
+#include "enum_names.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -135,7 +137,7 @@ void check_queue(const Queue& queue, const Device& device, const char* who) {
 std::uint32_t checked_texel_size(const Image& image, const char* who) {
     const std::uint32_t texel = format_texel_size(image.format());
     if (texel == 0) {
-        throw UsageError(std::string(who) + ": format " + std::to_string(image.format()) +
+        throw UsageError(std::string(who) + ": format " + detail::enum_text(image.format()) +
                          " is not an uncompressed colour format");
     }
     if (image.samples() != VK_SAMPLE_COUNT_1_BIT) throw UsageError(std::string(who) + ": the image is multisampled");
