@@ -14,34 +14,31 @@ include(CMakePackageConfigHelpers)
 set(VKRC_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/vkrc" CACHE STRING
     "Where the vkrc CMake package files are installed, relative to the prefix")
 
-set(vkrc_install_targets "")
+# One export set and one install component per policy (st, mt: the library,
+# its add-ons and vkrcTargets-<policy>.cmake), and the component "common"
+# (headers, package files, shader helper), so that an installation may hold
+# only one policy: cmake --install <build> --component common, then
+# --component mt. vkrcConfig.cmake includes the vkrcTargets-*.cmake it finds.
+# Add-on libraries (vkrc_glfw_<policy>, EXPORT_NAME glfw_<policy>) join their
+# policy's set when they are built; vkrcConfig.cmake finds their dependencies.
 foreach(policy IN LISTS VKRC_POLICIES)
-  list(APPEND vkrc_install_targets vkrc_${policy})
-endforeach()
-# Add-on libraries join the same export set when they are built; each one's
-# EXPORT_NAME gives its imported name (vkrc_glfw_st -> vkrc::glfw_st). Their
-# dependencies are found in vkrcConfig.cmake.in, next to Vulkan's.
-set(VKRC_INSTALLED_GLFW OFF)
-foreach(policy IN LISTS VKRC_POLICIES)
+  set(targets vkrc_${policy})
   if(TARGET vkrc_glfw_${policy})
-    list(APPEND vkrc_install_targets vkrc_glfw_${policy})
-    set(VKRC_INSTALLED_GLFW ON)
+    list(APPEND targets vkrc_glfw_${policy})
   endif()
+  install(TARGETS ${targets}
+    EXPORT vkrcTargets-${policy}
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT ${policy}
+    INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(EXPORT vkrcTargets-${policy}
+    NAMESPACE vkrc::
+    FILE vkrcTargets-${policy}.cmake
+    DESTINATION ${VKRC_INSTALL_CMAKEDIR}
+    COMPONENT ${policy})
 endforeach()
-
-install(TARGETS ${vkrc_install_targets}
-  EXPORT vkrcTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # The whole directory, so headers added later need no change here.
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/vkrc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(EXPORT vkrcTargets
-  NAMESPACE vkrc::
-  FILE vkrcTargets.cmake
-  DESTINATION ${VKRC_INSTALL_CMAKEDIR})
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/vkrc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT common)
 
-# The policies and add-ons this installation holds, for vkrcConfig.cmake.
-set(VKRC_INSTALLED_POLICIES "${VKRC_POLICIES}")
 configure_package_config_file(
   ${CMAKE_CURRENT_LIST_DIR}/vkrcConfig.cmake.in
   ${PROJECT_BINARY_DIR}/vkrcConfig.cmake
@@ -53,7 +50,11 @@ write_basic_package_version_file(
   ${PROJECT_BINARY_DIR}/vkrcConfigVersion.cmake
   VERSION ${PROJECT_VERSION}
   COMPATIBILITY SameMinorVersion)
+# vkrc_add_shaders for find_package users: vkrcConfig.cmake includes it.
 install(FILES
   ${PROJECT_BINARY_DIR}/vkrcConfig.cmake
   ${PROJECT_BINARY_DIR}/vkrcConfigVersion.cmake
-  DESTINATION ${VKRC_INSTALL_CMAKEDIR})
+  ${CMAKE_CURRENT_LIST_DIR}/VkrcShaders.cmake
+  ${CMAKE_CURRENT_LIST_DIR}/VkrcShaderWrap.cmake
+  DESTINATION ${VKRC_INSTALL_CMAKEDIR}
+  COMPONENT common)

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Builds vkrc and runs every test: both thread policies under the validation
-# layer, then the whole suite under AddressSanitizer+UndefinedBehaviorSanitizer
-# and the multi-thread tests under ThreadSanitizer. Installs missing Debian
-# packages first. Usage: scripts/test.sh [--quick]   (--quick: no sanitizers)
+# Checks the formatting, builds vkrc and runs every test: both thread policies
+# under the validation layer, with GCC and with clang, then the whole suite
+# under AddressSanitizer+UndefinedBehaviorSanitizer and the multi-thread tests
+# under ThreadSanitizer. Installs missing Debian packages first.
+# Usage: scripts/test.sh [--quick]   (--quick: no sanitizers)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,7 +27,12 @@ run_config() {  # name, ctest args, cmake args...
     (cd "build-$name" && ctest --output-on-failure -j "$jobs" $ctest_args)
 }
 
+echo "=== format"
+bash scripts/format.sh --check
 run_config test "" -DVKRC_BUILD_BENCH=ON -DVKRC_BUILD_EXAMPLES=ON
+# clang: the library, the tests (hot_path included) and the consumer tests;
+# the benchmarks and examples are GCC's only, to keep CI time down.
+run_config clang "" -DCMAKE_CXX_COMPILER=clang++ -DVKRC_BUILD_BENCH=OFF -DVKRC_BUILD_EXAMPLES=OFF
 if [ "${1:-}" != "--quick" ]; then
     san="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
     run_config asan "" -DVKRC_BUILD_BENCH=OFF -DVKRC_BUILD_EXAMPLES=OFF \

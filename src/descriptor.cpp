@@ -1,5 +1,7 @@
 #include "vkrc/descriptor.hpp"
 
+#include "enum_names.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -122,8 +124,8 @@ void check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkD
         if (b.binding != binding) continue;
         if (b.descriptor_type != type) {
             throw UsageError(std::string(who) + ": binding " + std::to_string(binding) + " has descriptor type " +
-                             std::to_string(b.descriptor_type) + " in the set layout, the write has type " +
-                             std::to_string(type));
+                             detail::enum_text(b.descriptor_type) + " in the set layout, the write has type " +
+                             detail::enum_text(type));
         }
         if (array_element >= b.descriptor_count) {
             throw UsageError(std::string(who) + ": array element " + std::to_string(array_element) +
@@ -148,7 +150,7 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, c
             ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
             : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (is_buffer_type(type) && !(buffer.usage() & needs)) {
-        throw UsageError(std::string(who) + ": the buffer lacks the usage descriptor type " + std::to_string(type) +
+        throw UsageError(std::string(who) + ": the buffer lacks the usage descriptor type " + detail::enum_text(type) +
                          " needs (VUID-VkWriteDescriptorSet-descriptorType-00330/00331)");
     }
     write_buffer(binding, type, buffer.vk(), offset, range, array_element);
@@ -188,7 +190,7 @@ void update_one(const detail::DescriptorSetState& s, std::uint32_t binding, VkDe
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
     if (!is_buffer_type(type)) {
-        throw UsageError("vkrc::DescriptorSet::write_buffer: descriptor type " + std::to_string(type) +
+        throw UsageError("vkrc::DescriptorSet::write_buffer: descriptor type " + detail::enum_text(type) +
                          " is not a buffer type");
     }
     check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_buffer");
@@ -199,7 +201,7 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, V
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
     if (!is_image_type(type)) {
-        throw UsageError("vkrc::DescriptorSet::write_image: descriptor type " + std::to_string(type) +
+        throw UsageError("vkrc::DescriptorSet::write_image: descriptor type " + detail::enum_text(type) +
                          " is not an image or sampler type");
     }
     check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_image");

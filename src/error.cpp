@@ -1,5 +1,7 @@
 #include "vkrc/error.hpp"
 
+#include "enum_names.hpp"
+
 #include <cstdint>
 #include <cstring>
 #include <new>
@@ -47,6 +49,24 @@ const char* to_string(VkResult result) noexcept {
         default: return nullptr;
     }
 }
+
+namespace detail {
+namespace {
+#include "enum_names.inl"
+
+template <class Enum>
+std::string enum_text_of(Enum value, const char* type) {
+    const char* name = enum_name(value);
+    return name ? std::string(name) : std::string(type) + "(" + std::to_string(static_cast<long long>(value)) + ")";
+}
+}  // namespace
+
+std::string enum_text(VkDescriptorType value) { return enum_text_of(value, "VkDescriptorType"); }
+std::string enum_text(VkFormat value) { return enum_text_of(value, "VkFormat"); }
+std::string enum_text(VkPhysicalDeviceType value) { return enum_text_of(value, "VkPhysicalDeviceType"); }
+std::string enum_text(VkColorSpaceKHR value) { return enum_text_of(value, "VkColorSpaceKHR"); }
+std::string enum_text(VkImageLayout value) { return enum_text_of(value, "VkImageLayout"); }
+}  // namespace detail
 
 Error::Error(VkResult result, const char* call) : result_(result), call_(call) {
     const char* name = vkrc::to_string(result);

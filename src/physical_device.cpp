@@ -1,5 +1,6 @@
 #include "vkrc/instance.hpp"
 
+#include "enum_names.hpp"
 #include "text.hpp"
 
 #include <algorithm>
@@ -45,7 +46,7 @@ std::vector<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& r
     }
     if (std::find(req.preferred_types.begin(), req.preferred_types.end(), props.deviceType) ==
         req.preferred_types.end()) {
-        reasons.push_back("device type " + std::to_string(props.deviceType) + " is not among the accepted types");
+        reasons.push_back("device type " + detail::enum_text(props.deviceType) + " is not among the accepted types");
     }
     if (req.name_contains && std::strstr(props.deviceName, req.name_contains) == nullptr) {
         reasons.push_back("name does not contain \"" + std::string(req.name_contains) + "\"");

@@ -2,6 +2,8 @@
 
 #include "vkrc/upload.hpp"
 
+#include "enum_names.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -224,16 +226,16 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     }
     if (create.format != image.format()) {
         if (!(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT)) {
-            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) +
-                             " differs from the image's " + std::to_string(image.format()) +
+            throw UsageError(std::string(who) + ": format " + detail::enum_text(create.format) +
+                             " differs from the image's " + detail::enum_text(image.format()) +
                              " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
         }
         const std::uint32_t view_texel = format_texel_size(create.format);
         const std::uint32_t image_texel = format_texel_size(image.format());
         if (view_texel != 0 && image_texel != 0 && view_texel != image_texel) {
-            throw UsageError(std::string(who) + ": format " + std::to_string(create.format) + " has " +
+            throw UsageError(std::string(who) + ": format " + detail::enum_text(create.format) + " has " +
                              std::to_string(view_texel) + "-byte texels, the image's format " +
-                             std::to_string(image.format()) + " has " + std::to_string(image_texel));
+                             detail::enum_text(image.format()) + " has " + std::to_string(image_texel));
         }
     }
     detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);

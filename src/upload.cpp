@@ -3,6 +3,8 @@
 #include "vkrc/submit.hpp"
 #include "vkrc/sync.hpp"
 
+#include "enum_names.hpp"
+
 #include <string>
 #include <type_traits>
 
@@ -103,7 +105,7 @@ void check_transfer(const Queue& queue, const Resource& resource, std::uint32_t 
 std::uint32_t checked_texel_size(const Image& image, const char* who) {
     const std::uint32_t texel = format_texel_size(image.format());
     if (texel == 0) {
-        throw UsageError(std::string(who) + ": format " + std::to_string(image.format()) +
+        throw UsageError(std::string(who) + ": format " + detail::enum_text(image.format()) +
                          " is not an uncompressed colour format");
     }
     if (image.samples() != VK_SAMPLE_COUNT_1_BIT) throw UsageError(std::string(who) + ": the image is multisampled");

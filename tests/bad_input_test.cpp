@@ -137,14 +137,16 @@ TEST_F(VulkanTest, DescriptorWritesMustMatchTheLayout) {
         device, {.size = 256, .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
     expect_usage_error(
         [&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer); },
-        {"vkrc::DescriptorSet::write_buffer", "binding 0 has descriptor type 6", "the write has type 7"});
+        {"vkrc::DescriptorSet::write_buffer", "binding 0 has descriptor type VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER",
+         "the write has type VK_DESCRIPTOR_TYPE_STORAGE_BUFFER"});
     expect_usage_error([&] { set.write_buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer); },
                        {"vkrc::DescriptorSet::write_buffer", "no binding 3"});
     expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, buffer, 0, VK_WHOLE_SIZE, 2); },
                        {"vkrc::DescriptorSet::write_buffer", "array element 2"});
     expect_usage_error(
         [&] { set.write_image(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_GENERAL); },
-        {"vkrc::DescriptorSet::write_image", "not an image or sampler type"});
+        {"vkrc::DescriptorSet::write_image", "descriptor type VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER",
+         "not an image or sampler type"});
     auto vertex_only = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT});
     expect_usage_error([&] { set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, vertex_only); },
                        {"vkrc::DescriptorSet::write_buffer", "lacks the usage"});

@@ -32,6 +32,13 @@ if(VKRC_INSTALL)
   set_tests_properties(consumer.install PROPERTIES FIXTURES_SETUP vkrc_installed LABELS consumer)
   set_tests_properties(consumer.find_package PROPERTIES FIXTURES_REQUIRED vkrc_installed
     ENVIRONMENT "${VKRC_TEST_ENV}" LABELS consumer)
+  # Installations holding one policy's library (install components).
+  foreach(policy IN LISTS VKRC_POLICIES)
+    add_test(NAME consumer.find_package_${policy}_only COMMAND ${consumer_command} -DSTEP=one_policy -DONLY_POLICY=${policy}
+      -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/consumer-${policy}-only -P ${consumer_script})
+    set_tests_properties(consumer.find_package_${policy}_only PROPERTIES FIXTURES_REQUIRED vkrc_installed
+      ENVIRONMENT "${VKRC_TEST_ENV}" LABELS consumer)
+  endforeach()
 endif()
 add_test(NAME consumer.add_subdirectory COMMAND ${consumer_command} -DSTEP=subdirectory
   -DWORK_DIR=${CMAKE_CURRENT_BINARY_DIR}/consumer-subdirectory -P ${consumer_script})

@@ -29,9 +29,31 @@ endfunction()
 string(REPLACE "," ";" policies "${POLICIES}")
 
 if(STEP STREQUAL "install")
+  # Everything into PREFIX; each policy's component alone (with the common
+  # one) into PREFIX-<policy>-only.
   file(REMOVE_RECURSE ${PREFIX})
   run(${CMAKE_COMMAND} --install ${VKRC_BINARY_DIR} --prefix ${PREFIX} --config "${BUILD_TYPE}")
   message(STATUS "installed vkrc into ${PREFIX}")
+  foreach(policy IN LISTS policies)
+    file(REMOVE_RECURSE ${PREFIX}-${policy}-only)
+    foreach(component common ${policy})
+      run(${CMAKE_COMMAND} --install ${VKRC_BINARY_DIR} --prefix ${PREFIX}-${policy}-only --config "${BUILD_TYPE}"
+          --component ${component})
+    endforeach()
+    message(STATUS "installed vkrc's ${policy} library alone into ${PREFIX}-${policy}-only")
+  endforeach()
+elseif(STEP STREQUAL "one_policy")
+  # An installation holding only ONLY_POLICY's library: find_package succeeds, the
+  # user's vkrc::<ONLY_POLICY> works, and vkrc::vkrc exists only when it is that
+  # library (mt only with VKRC_THREAD_POLICY=multi).
+  if(ONLY_POLICY STREQUAL "st")
+    build_and_run_consumer(${WORK_DIR}/st st -DVKRC_CONSUMER_MODE=package -DCMAKE_PREFIX_PATH=${PREFIX}-st-only)
+    build_and_run_consumer(${WORK_DIR}/st-named st -DVKRC_CONSUMER_MODE=package -DCMAKE_PREFIX_PATH=${PREFIX}-st-only
+                           -DVKRC_CONSUMER_TARGET=vkrc::st -DVKRC_THREAD_POLICY=multi -DVKRC_CONSUMER_EXPECT_NO_DEFAULT=ON)
+  else()
+    build_and_run_consumer(${WORK_DIR}/mt mt -DVKRC_CONSUMER_MODE=package -DCMAKE_PREFIX_PATH=${PREFIX}-mt-only
+                           -DVKRC_CONSUMER_TARGET=vkrc::mt -DVKRC_CONSUMER_EXPECT_NO_DEFAULT=ON)
+  endif()
 elseif(STEP STREQUAL "package")
   # vkrc::vkrc is vkrc::st by default and vkrc::mt with VKRC_THREAD_POLICY=multi.
   if("st" IN_LIST policies)

@@ -42,7 +42,7 @@ private:
 
 // Mirrors VkDescriptorPoolCreateInfo. With VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT
 // a dropped set returns to the pool once the GPU is done with it; without it
-// sets are reclaimed only by reset() or the pool's destruction.
+// sets are reclaimed only by reset_sets() or the pool's destruction.
 struct DescriptorPoolCreateInfo {
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     std::uint32_t max_sets = 0;
@@ -51,7 +51,7 @@ struct DescriptorPoolCreateInfo {
 
 class DescriptorSet;
 
-// Externally synchronised like VkDescriptorPool: allocate() and reset() take
+// Externally synchronised like VkDescriptorPool: allocate() and reset_sets() take
 // the pool's lock under the multi-thread policy.
 class DescriptorPool : public Handle<detail::DescriptorPoolState> {
 public:
