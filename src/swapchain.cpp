@@ -8,6 +8,76 @@
 
 VKRC_BEGIN_NAMESPACE
 
+namespace {
+
+// A Swapchain's hold on its surface: Vulkan allows one non-retired swapchain
+// per surface (SurfaceState::taken and ::releasing, under its mutex).
+struct SurfaceLease {
+    // Marks the surface taken; waits once for a previous swapchain's
+    // destruction still running, and throws UsageError when it stays.
+    static void take(const Surface& surface, const Device& device);
+    // From ~SwapchainState: the surface is free again, or releasing until the
+    // destruction of chain (the current Vulkan swapchain, if any) has run.
+    static void give_back(detail::SurfaceState& surface, detail::SwapchainChainState* chain) noexcept;
+    // From that last chain's destruction: the surface may be taken again.
+    static void end_release(detail::SurfaceState& surface) noexcept;
+};
+
+void SurfaceLease::take(const Surface& surface, const Device& device) {
+    auto& state = *surface.state();
+    for (bool waited = false;; waited = true) {
+        {
+            LockGuard lock(state.mutex);
+            if (state.taken) {
+                throw UsageError(
+                    "vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
+            }
+            if (!state.releasing) {
+                state.taken = true;
+                return;
+            }
+        }
+        if (waited) {
+            throw UsageError(
+                "vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
+                "Image holds one of its images, or another device has not destroyed it)");
+        }
+        // The previous Swapchain's Vulkan swapchain is not retired: its
+        // destruction must run before a new one can be made for the surface.
+        device.wait_idle();
+    }
+}
+
+void SurfaceLease::give_back(detail::SurfaceState& surface, detail::SwapchainChainState* chain) noexcept {
+    LockGuard lock(surface.mutex);
+    surface.taken = false;
+    if (chain) {
+        chain->last = true;
+        surface.releasing = true;
+    }
+}
+
+void SurfaceLease::end_release(detail::SurfaceState& surface) noexcept {
+    LockGuard lock(surface.mutex);
+    surface.releasing = false;
+}
+
+// The deferred destruction of one Vulkan swapchain; context is its
+// SurfaceState, whose reference it releases.
+void destroy_swapchain(detail::DeviceState& d, std::uint64_t bits, void* context) noexcept {
+    d.fn.vkDestroySwapchainKHR(d.device, detail::handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+    static_cast<detail::SurfaceState*>(context)->release();
+}
+
+void destroy_last_swapchain(detail::DeviceState& d, std::uint64_t bits, void* context) noexcept {
+    d.fn.vkDestroySwapchainKHR(d.device, detail::handle_from_bits<VkSwapchainKHR>(bits), nullptr);
+    auto* surface = static_cast<detail::SurfaceState*>(context);
+    SurfaceLease::end_release(*surface);
+    surface->release();
+}
+
+}  // namespace
+
 namespace detail {
 
 SwapchainChainState::~SwapchainChainState() {
@@ -32,37 +102,13 @@ SwapchainChainState::~SwapchainChainState() {
     // so no cycle): the surface must outlive the swapchain's destruction.
     SurfaceState* s = surface.state();
     s->add_ref();
-    if (last) {
-        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
-                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits),
-                                                                 nullptr);
-                                      auto* surface_state = static_cast<SurfaceState*>(context);
-                                      {
-                                          LockGuard lock(surface_state->mutex);
-                                          surface_state->releasing = false;
-                                      }
-                                      surface_state->release();
-                                  },
-                                  handle_bits(swapchain), s});
-    } else {
-        device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void* context) noexcept {
-                                      d.fn.vkDestroySwapchainKHR(d.device, handle_from_bits<VkSwapchainKHR>(bits),
-                                                                 nullptr);
-                                      static_cast<SurfaceState*>(context)->release();
-                                  },
-                                  handle_bits(swapchain), s});
-    }
+    device.destroy_after_gpu({last ? destroy_last_swapchain : destroy_swapchain, handle_bits(swapchain), s});
 }
 
 SwapchainState::~SwapchainState() {
     if (!surface) return;
-    LockGuard lock(surface.state()->mutex);
-    surface.state()->taken = false;
-    if (chain) {
-        // Set before the chain member is released (after this body).
-        chain->last = true;
-        surface.state()->releasing = true;
-    }
+    // Runs before the chain member is released (after this body).
+    SurfaceLease::give_back(*surface.state(), chain.get());
 }
 
 }  // namespace detail
@@ -94,50 +140,77 @@ void log(const detail::SwapchainState& s, const std::string& message) {
     if (s.info.log) s.info.log(("vkrc::Swapchain: " + message).c_str());
 }
 
-// Format, colour space and present mode: fixed for the swapchain's life,
-// so that pipelines made for its format stay valid across re-creation.
-void choose_format_and_mode(detail::SwapchainState& s) {
-    const auto& physical = s.queue.device().physical_device();
-    auto formats = s.surface.formats(physical);
-    if (formats.empty()) throw UsageError("vkrc::Swapchain::create: the surface reports no formats");
+// A choice and why it was made, for the log.
+template <class T>
+struct Choice {
+    T value;
     std::string reason;
-    if (formats.size() == 1 && formats[0].format == VK_FORMAT_UNDEFINED && !s.info.preferred_formats.empty()) {
-        s.surface_format = s.info.preferred_formats[0];
-        reason = "the surface accepts any format: the first preferred one";
-    } else {
-        s.surface_format = formats[0];
-        reason = "no preferred format is supported: the surface's first";
-        for (std::size_t i = 0; i < s.info.preferred_formats.size(); ++i) {
-            const auto& want = s.info.preferred_formats[i];
-            auto it = std::find_if(formats.begin(), formats.end(), [&](const VkSurfaceFormatKHR& f) {
-                return f.format == want.format && f.colorSpace == want.colorSpace;
-            });
-            if (it != formats.end()) {
-                s.surface_format = *it;
-                reason = "preferred format " + std::to_string(i + 1) + " of " +
-                         std::to_string(s.info.preferred_formats.size()) + ", the first the surface supports";
-                break;
-            }
+};
+
+// The first preferred format the surface supports, else the surface's first.
+Choice<VkSurfaceFormatKHR> choose_format(const std::vector<VkSurfaceFormatKHR>& formats,
+                                         const std::vector<VkSurfaceFormatKHR>& preferred) {
+    if (formats.size() == 1 && formats[0].format == VK_FORMAT_UNDEFINED && !preferred.empty()) {
+        return {preferred[0], "the surface accepts any format: the first preferred one"};
+    }
+    for (std::size_t i = 0; i < preferred.size(); ++i) {
+        const auto& want = preferred[i];
+        auto it = std::find_if(formats.begin(), formats.end(), [&](const VkSurfaceFormatKHR& f) {
+            return f.format == want.format && f.colorSpace == want.colorSpace;
+        });
+        if (it != formats.end()) {
+            return {*it, "preferred format " + std::to_string(i + 1) + " of " + std::to_string(preferred.size()) +
+                             ", the first the surface supports"};
         }
     }
+    return {formats[0], "no preferred format is supported: the surface's first"};
+}
+
+// requested if supported; IMMEDIATE and MAILBOX fall back to each other,
+// everything at last to FIFO (which every surface supports).
+VkPresentModeKHR choose_present_mode(const std::vector<VkPresentModeKHR>& modes, VkPresentModeKHR requested) {
+    std::vector<VkPresentModeKHR> order{requested};
+    if (requested == VK_PRESENT_MODE_IMMEDIATE_KHR) order.push_back(VK_PRESENT_MODE_MAILBOX_KHR);
+    if (requested == VK_PRESENT_MODE_MAILBOX_KHR) order.push_back(VK_PRESENT_MODE_IMMEDIATE_KHR);
+    for (auto mode : order) {
+        if (std::find(modes.begin(), modes.end(), mode) != modes.end()) return mode;
+    }
+    return VK_PRESENT_MODE_FIFO_KHR;
+}
+
+// The surface's extent, or (where it leaves that to the swapchain) the
+// application's, clamped to the surface's limits.
+Choice<VkExtent2D> choose_extent(const VkSurfaceCapabilitiesKHR& caps, VkExtent2D wanted) {
+    if (caps.currentExtent.width != UINT32_MAX) return {caps.currentExtent, "the surface's current extent"};
+    return {{std::clamp(wanted.width, caps.minImageExtent.width, caps.maxImageExtent.width),
+             std::clamp(wanted.height, caps.minImageExtent.height, caps.maxImageExtent.height)},
+            "the application's extent (the surface leaves it to the swapchain), clamped to its limits"};
+}
+
+std::uint32_t choose_image_count(const VkSurfaceCapabilitiesKHR& caps, std::uint32_t wanted) {
+    std::uint32_t count = std::max(wanted, caps.minImageCount);
+    return caps.maxImageCount != 0 ? std::min(count, caps.maxImageCount) : count;
+}
+
+// wanted if supported, else the lowest mode the surface supports.
+VkCompositeAlphaFlagBitsKHR choose_composite_alpha(const VkSurfaceCapabilitiesKHR& caps,
+                                                   VkCompositeAlphaFlagBitsKHR wanted) {
+    if (caps.supportedCompositeAlpha & wanted) return wanted;
+    for (std::uint32_t bit = 1; bit != 0 && bit <= caps.supportedCompositeAlpha; bit <<= 1) {
+        if (caps.supportedCompositeAlpha & bit) return static_cast<VkCompositeAlphaFlagBitsKHR>(bit);
+    }
+    return wanted;
+}
+
+void log_format(const detail::SwapchainState& s, const std::string& reason) {
     const bool srgb = s.surface_format.colorSpace == VK_COLOR_SPACE_SRGB_NONLINEAR_KHR;
     log(s, "format " + format_name(s.surface_format.format) + ", colour space " +
                (srgb ? std::string("SRGB_NONLINEAR") : std::to_string(s.surface_format.colorSpace)) + " (" + reason +
                ")");
+}
 
-    auto modes = s.surface.present_modes(physical);
+void log_present_mode(const detail::SwapchainState& s) {
     const VkPresentModeKHR requested = s.info.present_mode;
-    std::vector<VkPresentModeKHR> order{requested};
-    if (requested == VK_PRESENT_MODE_IMMEDIATE_KHR) order.push_back(VK_PRESENT_MODE_MAILBOX_KHR);
-    if (requested == VK_PRESENT_MODE_MAILBOX_KHR) order.push_back(VK_PRESENT_MODE_IMMEDIATE_KHR);
-    order.push_back(VK_PRESENT_MODE_FIFO_KHR);
-    s.present_mode = VK_PRESENT_MODE_FIFO_KHR;
-    for (auto mode : order) {
-        if (mode == VK_PRESENT_MODE_FIFO_KHR || std::find(modes.begin(), modes.end(), mode) != modes.end()) {
-            s.present_mode = mode;
-            break;
-        }
-    }
     std::string message = std::string("present mode ") + present_mode_name(s.present_mode);
     if (s.present_mode == requested) {
         message += " (as requested)";
@@ -148,114 +221,132 @@ void choose_format_and_mode(detail::SwapchainState& s) {
     log(s, message);
 }
 
+void log_images(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR& caps, const std::string& extent_reason,
+                bool replacing) {
+    log(s, std::to_string(s.images.size()) + " images (asked for " + std::to_string(s.info.min_image_count) +
+               ", the surface allows " + std::to_string(caps.minImageCount) + " to " +
+               (caps.maxImageCount ? std::to_string(caps.maxImageCount) : std::string("any number")) + "), extent " +
+               std::to_string(s.extent.width) + "x" + std::to_string(s.extent.height) + " (" + extent_reason + ")" +
+               (replacing ? ", replacing the previous swapchain" : ""));
+}
+
+// Format, colour space and present mode: fixed for the swapchain's life,
+// so that pipelines made for its format stay valid across re-creation.
+void choose_format_and_mode(detail::SwapchainState& s) {
+    const auto& physical = s.queue.device().physical_device();
+    auto formats = s.surface.formats(physical);
+    if (formats.empty()) throw UsageError("vkrc::Swapchain::create: the surface reports no formats");
+    auto format = choose_format(formats, s.info.preferred_formats);
+    s.surface_format = format.value;
+    log_format(s, format.reason);
+    s.present_mode = choose_present_mode(s.surface.present_modes(physical), s.info.present_mode);
+    log_present_mode(s);
+}
+
+void check_usage_supported(const VkSurfaceCapabilitiesKHR& caps, VkImageUsageFlags usage) {
+    if ((caps.supportedUsageFlags & usage) == usage) return;
+    throw UsageError("vkrc::Swapchain: the surface does not support image_usage " + std::to_string(usage) +
+                     " (supported: " + std::to_string(caps.supportedUsageFlags) + ")");
+}
+
+VkSwapchainCreateInfoKHR swapchain_create_info(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR& caps,
+                                               VkExtent2D extent) {
+    VkSwapchainCreateInfoKHR ci{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+    ci.surface = s.surface.vk();
+    ci.minImageCount = choose_image_count(caps, s.info.min_image_count);
+    ci.imageFormat = s.surface_format.format;
+    ci.imageColorSpace = s.surface_format.colorSpace;
+    ci.imageExtent = extent;
+    ci.imageArrayLayers = 1;
+    ci.imageUsage = s.info.image_usage;
+    ci.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    ci.preTransform = caps.currentTransform;
+    ci.compositeAlpha = choose_composite_alpha(caps, s.info.composite_alpha);
+    ci.presentMode = s.present_mode;
+    ci.clipped = s.info.clipped ? VK_TRUE : VK_FALSE;
+    ci.oldSwapchain = s.chain ? s.chain->swapchain : VK_NULL_HANDLE;
+    return ci;
+}
+
+// A new chain's images (borrowed, each keeping the chain alive) and views.
+struct ChainImages {
+    std::vector<Image> images;
+    std::vector<ImageView> views;
+};
+
+ChainImages wrap_images(const detail::SwapchainState& s, detail::SwapchainChainState& chain, VkExtent2D extent) {
+    const Device& device = s.queue.device();
+    std::uint32_t n = 0;
+    check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain.swapchain, &n, nullptr), "vkGetSwapchainImagesKHR");
+    std::vector<VkImage> raw(n);
+    check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain.swapchain, &n, raw.data()), "vkGetSwapchainImagesKHR");
+    ImageCreateInfo info;
+    info.format = s.surface_format.format;
+    info.extent = {extent.width, extent.height, 1};
+    info.usage = s.info.image_usage;
+    ChainImages out;
+    for (VkImage image : raw) {
+        auto wrapped = Image::adopt(device, image, info, Ownership::borrowed);
+        wrapped.state()->owner = detail::Ref<detail::RefCounted>::share(&chain);
+        out.views.push_back(ImageView::create(wrapped));
+        out.images.push_back(std::move(wrapped));
+        chain.render_done.push_back(Semaphore::create_binary(device));
+    }
+    return out;
+}
+
+// One acquire semaphore more than images, so that the next acquire
+// normally finds its semaphore's last frame long finished.
+void grow_acquire_ring(detail::SwapchainState& s, std::size_t image_count) {
+    while (s.acquire_semaphores.size() < image_count + 1) {
+        s.acquire_semaphores.push_back(Semaphore::create_binary(s.queue.device()));
+        s.acquire_done_values.push_back(0);
+    }
+}
+
+// After a failed creation: the old swapchain is retired even so; dropping
+// it lets the next attempt start without an oldSwapchain.
+void drop_chain(detail::SwapchainState& s) noexcept {
+    s.views.clear();
+    s.images.clear();
+    s.chain.reset();
+    s.needs_recreate = true;
+}
+
 // Creates the next Vulkan swapchain, retiring the current one. Under s.mutex.
 PresentStatus recreate_locked(detail::SwapchainState& s) {
     const Device& device = s.queue.device();
     const auto caps = s.surface.capabilities(device.physical_device());
-    VkExtent2D extent = caps.currentExtent;
-    const char* extent_reason = "the surface's current extent";
-    if (extent.width == UINT32_MAX) {
-        extent.width = std::clamp(s.info.extent.width, caps.minImageExtent.width, caps.maxImageExtent.width);
-        extent.height = std::clamp(s.info.extent.height, caps.minImageExtent.height, caps.maxImageExtent.height);
-        extent_reason = "the application's extent (the surface leaves it to the swapchain), clamped to its limits";
-    }
-    if (extent.width == 0 || extent.height == 0) {
+    const auto extent = choose_extent(caps, s.info.extent);
+    if (extent.value.width == 0 || extent.value.height == 0) {
         // A minimised window: no swapchain can have this extent. The current
         // one (if any) stays until the window has an area again.
         s.needs_recreate = true;
         return PresentStatus::zero_extent;
     }
-    if ((caps.supportedUsageFlags & s.info.image_usage) != s.info.image_usage) {
-        throw UsageError("vkrc::Swapchain: the surface does not support image_usage " +
-                         std::to_string(s.info.image_usage) +
-                         " (supported: " + std::to_string(caps.supportedUsageFlags) + ")");
-    }
-    std::uint32_t count = std::max(s.info.min_image_count, caps.minImageCount);
-    if (caps.maxImageCount != 0) count = std::min(count, caps.maxImageCount);
-    VkCompositeAlphaFlagBitsKHR alpha = s.info.composite_alpha;
-    if (!(caps.supportedCompositeAlpha & alpha)) {
-        for (std::uint32_t bit = 1; bit != 0 && bit <= caps.supportedCompositeAlpha; bit <<= 1) {
-            if (caps.supportedCompositeAlpha & bit) {
-                alpha = static_cast<VkCompositeAlphaFlagBitsKHR>(bit);
-                break;
-            }
-        }
-    }
-
-    VkSwapchainCreateInfoKHR create{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
-    create.surface = s.surface.vk();
-    create.minImageCount = count;
-    create.imageFormat = s.surface_format.format;
-    create.imageColorSpace = s.surface_format.colorSpace;
-    create.imageExtent = extent;
-    create.imageArrayLayers = 1;
-    create.imageUsage = s.info.image_usage;
-    create.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    create.preTransform = caps.currentTransform;
-    create.compositeAlpha = alpha;
-    create.presentMode = s.present_mode;
-    create.clipped = s.info.clipped ? VK_TRUE : VK_FALSE;
-    const bool replacing = static_cast<bool>(s.chain);
-    create.oldSwapchain = replacing ? s.chain->swapchain : VK_NULL_HANDLE;
-
+    check_usage_supported(caps, s.info.image_usage);
+    const VkSwapchainCreateInfoKHR ci = swapchain_create_info(s, caps, extent.value);
     detail::Ref<detail::SwapchainChainState> chain(new detail::SwapchainChainState);
     chain->queue = s.queue;
     chain->surface = s.surface;
-    VkResult created = device.fn().vkCreateSwapchainKHR(device.vk(), &create, nullptr, &chain->swapchain);
-    if (created != VK_SUCCESS) {
-        // The old swapchain is retired even when creation fails: drop it, so
-        // that the next attempt starts without an oldSwapchain.
-        s.views.clear();
-        s.images.clear();
-        s.chain.reset();
-        s.needs_recreate = true;
-        check(created, "vkCreateSwapchainKHR");
-    }
-    std::vector<Image> images;
-    std::vector<ImageView> views;
+    ChainImages made;
     try {
-        std::uint32_t n = 0;
-        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, nullptr),
-              "vkGetSwapchainImagesKHR");
-        std::vector<VkImage> raw(n);
-        check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain->swapchain, &n, raw.data()),
-              "vkGetSwapchainImagesKHR");
-        ImageCreateInfo info;
-        info.format = s.surface_format.format;
-        info.extent = {extent.width, extent.height, 1};
-        info.usage = s.info.image_usage;
-        for (VkImage image : raw) {
-            auto wrapped = Image::adopt(device, image, info, Ownership::borrowed);
-            wrapped.state()->owner = detail::Ref<detail::RefCounted>::share(chain.get());
-            views.push_back(ImageView::create(wrapped));
-            images.push_back(std::move(wrapped));
-            chain->render_done.push_back(Semaphore::create_binary(device));
-        }
-        // One acquire semaphore more than images, so that the next acquire
-        // normally finds its semaphore's last frame long finished.
-        while (s.acquire_semaphores.size() < n + 1) {
-            s.acquire_semaphores.push_back(Semaphore::create_binary(device));
-            s.acquire_done_values.push_back(0);
-        }
+        check(device.fn().vkCreateSwapchainKHR(device.vk(), &ci, nullptr, &chain->swapchain), "vkCreateSwapchainKHR");
+        made = wrap_images(s, *chain, extent.value);
+        grow_acquire_ring(s, made.images.size());
     } catch (...) {
-        s.views.clear();
-        s.images.clear();
-        s.chain.reset();
-        s.needs_recreate = true;
+        drop_chain(s);
         throw;
     }
     // The old images and views go; the old swapchain follows once no frame
     // holds its images (its destruction then waits for the GPU).
-    s.views = std::move(views);
-    s.images = std::move(images);
+    const bool replacing = static_cast<bool>(s.chain);
+    s.views = std::move(made.views);
+    s.images = std::move(made.images);
     s.chain = std::move(chain);
-    s.extent = extent;
+    s.extent = extent.value;
     s.needs_recreate = false;
-    log(s, std::to_string(s.images.size()) + " images (asked for " + std::to_string(s.info.min_image_count) +
-               ", the surface allows " + std::to_string(caps.minImageCount) + " to " +
-               (caps.maxImageCount ? std::to_string(caps.maxImageCount) : std::string("any number")) + "), extent " +
-               std::to_string(extent.width) + "x" + std::to_string(extent.height) + " (" + extent_reason + ")" +
-               (replacing ? ", replacing the previous swapchain" : ""));
+    log_images(s, caps, extent.reason, replacing);
     return PresentStatus::success;
 }
 
@@ -281,28 +372,7 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const Sw
                          " cannot present to the surface");
     }
     detail::Ref<detail::SwapchainState> state(new detail::SwapchainState);
-    auto& surface_state = *surface.state();
-    for (bool waited = false;; waited = true) {
-        {
-            LockGuard lock(surface_state.mutex);
-            if (surface_state.taken) {
-                throw UsageError(
-                    "vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
-            }
-            if (!surface_state.releasing) {
-                surface_state.taken = true;
-                break;
-            }
-        }
-        if (waited) {
-            throw UsageError(
-                "vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
-                "Image holds one of its images, or another device has not destroyed it)");
-        }
-        // The previous Swapchain's Vulkan swapchain is not retired: its
-        // destruction must run before a new one can be made for the surface.
-        device.wait_idle();
-    }
+    SurfaceLease::take(surface, device);
     state->surface = surface;  // from here the state's destructor gives the surface back
     state->queue = queue;
     state->info = info;
