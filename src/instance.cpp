@@ -20,20 +20,6 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debug_trampoline(VkDebugUtilsMessageSeverityFlagB
     return VK_FALSE;  // never abort the call that produced the message
 }
 
-template <class T, class F>
-std::vector<T> enumerate(F&& call, const char* what) {
-    std::uint32_t count = 0;
-    std::vector<T> items;
-    VkResult r;
-    do {
-        check(call(&count, nullptr), what);
-        items.resize(count);
-        r = check(call(&count, items.data()), what);
-    } while (r == VK_INCOMPLETE);
-    items.resize(count);
-    return items;
-}
-
 }  // namespace
 
 void print_debug_message(const DebugMessage& message) {
@@ -135,7 +121,7 @@ bool Instance::extension_enabled(const char* name) const noexcept {
 
 std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
-    auto props = enumerate<VkLayerProperties>(
+    auto props = detail::enumerate<VkLayerProperties>(
         [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
         "vkEnumerateInstanceLayerProperties");
     std::vector<Text> names;
@@ -145,7 +131,7 @@ std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_insta
 
 std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
-    auto props = enumerate<VkExtensionProperties>(
+    auto props = detail::enumerate<VkExtensionProperties>(
         [&](std::uint32_t* n, VkExtensionProperties* p) {
             return global.vkEnumerateInstanceExtensionProperties(nullptr, n, p);
         },
@@ -157,7 +143,7 @@ std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_i
 
 std::vector<PhysicalDevice> Instance::physical_devices() const {
     const auto& f = fn();
-    auto raws = enumerate<VkPhysicalDevice>(
+    auto raws = detail::enumerate<VkPhysicalDevice>(
         [&](std::uint32_t* n, VkPhysicalDevice* p) { return f.vkEnumeratePhysicalDevices(vk(), n, p); },
         "vkEnumeratePhysicalDevices");
     std::vector<PhysicalDevice> devices;
@@ -172,7 +158,7 @@ std::vector<PhysicalDevice> Instance::physical_devices() const {
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, nullptr);
         s.queue_families.resize(families);
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, s.queue_families.data());
-        auto exts = enumerate<VkExtensionProperties>(
+        auto exts = detail::enumerate<VkExtensionProperties>(
             [&](std::uint32_t* n, VkExtensionProperties* p) {
                 return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
             },

@@ -1,5 +1,7 @@
 #include "vkrc/surface.hpp"
 
+#include "text.hpp"
+
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
@@ -34,34 +36,20 @@ VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_de
 
 std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
-    std::vector<VkSurfaceFormatKHR> out;
-    VkResult r;
-    do {
-        std::uint32_t count = 0;
-        check(fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), &count, nullptr),
-              "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        out.resize(count);
-        r = check(fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), &count, out.data()),
-                  "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        out.resize(count);
-    } while (r == VK_INCOMPLETE);
-    return out;
+    return detail::enumerate<VkSurfaceFormatKHR>(
+        [&](std::uint32_t* n, VkSurfaceFormatKHR* p) {
+            return fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), n, p);
+        },
+        "vkGetPhysicalDeviceSurfaceFormatsKHR");
 }
 
 std::vector<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
-    std::vector<VkPresentModeKHR> out;
-    VkResult r;
-    do {
-        std::uint32_t count = 0;
-        check(fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), &count, nullptr),
-              "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        out.resize(count);
-        r = check(fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), &count, out.data()),
-                  "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        out.resize(count);
-    } while (r == VK_INCOMPLETE);
-    return out;
+    return detail::enumerate<VkPresentModeKHR>(
+        [&](std::uint32_t* n, VkPresentModeKHR* p) {
+            return fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), n, p);
+        },
+        "vkGetPhysicalDeviceSurfacePresentModesKHR");
 }
 
 VKRC_END_NAMESPACE

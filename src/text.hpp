@@ -18,5 +18,21 @@ void add_unique(std::vector<const char*>& names, const char* name);
 // The lower-case hexadecimal digits of v, without a prefix.
 std::string hex(std::uint64_t v);
 
+// Vulkan's two-call enumeration: call(&count, nullptr), then call(&count,
+// data) until it stops returning VK_INCOMPLETE; what names the function.
+template <class T, class F>
+std::vector<T> enumerate(F&& call, const char* what) {
+    std::uint32_t count = 0;
+    std::vector<T> items;
+    VkResult r;
+    do {
+        check(call(&count, nullptr), what);
+        items.resize(count);
+        r = check(call(&count, items.data()), what);
+    } while (r == VK_INCOMPLETE);
+    items.resize(count);
+    return items;
+}
+
 }  // namespace detail
 VKRC_END_NAMESPACE
