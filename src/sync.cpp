@@ -8,6 +8,15 @@ namespace {
 void require_device(const Device& device, const char* who) {
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
 }
+
+// After a wait or a status query: a signalled fence is no longer in flight.
+VkResult finish_fence_query(detail::FenceState& s, VkResult r, const char* name) {
+    if (r == VK_SUCCESS) {
+        s.in_flight = false;
+        s.note_signalled();
+    }
+    return s.device.state()->finish_call(r, name);
+}
 }  // namespace
 
 namespace detail {
@@ -58,22 +67,13 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
 
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
-    VkResult r = d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns);
-    if (r == VK_SUCCESS) {
-        state_->in_flight = false;
-        state_->note_signalled();
-    }
-    return d.state()->finish_call(r, "vkWaitForFences");
+    return finish_fence_query(*state_, d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns),
+                              "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
     const auto& d = state_->device;
-    VkResult r = d.fn().vkGetFenceStatus(d.vk(), state_->fence);
-    if (r == VK_SUCCESS) {
-        state_->in_flight = false;
-        state_->note_signalled();
-    }
-    return d.state()->finish_call(r, "vkGetFenceStatus");
+    return finish_fence_query(*state_, d.fn().vkGetFenceStatus(d.vk(), state_->fence), "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
