@@ -160,6 +160,15 @@ private:
     Node* spare_ = nullptr;
 };
 
+// Joins node's physical successor (free, out of its size class) to node.
+void merge_next_into(Node* node, NodeStore& nodes) noexcept {
+    Node* next = node->next_phys;
+    node->size += next->size;
+    node->next_phys = next->next_phys;
+    if (node->next_phys) node->next_phys->prev_phys = node;
+    nodes.recycle(next);
+}
+
 }  // namespace
 
 struct PoolAllocator::Impl {
@@ -408,18 +417,12 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
     // Merge with the free neighbours on both sides.
     if (Node* prev = node->prev_phys; prev && prev->free) {
         pool.remove_free(prev);
-        prev->size += node->size;
-        prev->next_phys = node->next_phys;
-        if (prev->next_phys) prev->next_phys->prev_phys = prev;
-        m.nodes.recycle(node);
+        merge_next_into(prev, m.nodes);
         node = prev;
     }
     if (Node* next = node->next_phys; next && next->free) {
         pool.remove_free(next);
-        node->size += next->size;
-        node->next_phys = next->next_phys;
-        if (node->next_phys) node->next_phys->prev_phys = node;
-        m.nodes.recycle(next);
+        merge_next_into(node, m.nodes);
     }
     pool.insert_free(node);
 
