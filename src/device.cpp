@@ -219,14 +219,14 @@ void destroy_raw_device(const PhysicalDevice& physical, VkDevice raw) noexcept {
 void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests) {
     VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
-    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+    VkSemaphoreCreateInfo ci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
     for (const auto& request : requests) {
         for (std::uint32_t i = 0; i < request.queue_priorities.size(); ++i) {
             auto& q = s.queues.emplace_back();
             q.family_index = request.queue_family_index;
             q.index = i;
             s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q.queue);
-            check(s.fn.vkCreateSemaphore(s.device, &info, nullptr, &q.semaphore), "vkCreateSemaphore");
+            check(s.fn.vkCreateSemaphore(s.device, &ci, nullptr, &q.semaphore), "vkCreateSemaphore");
         }
     }
 }
@@ -298,14 +298,14 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f11};
     features.features = info.enabled_features;
 
-    VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
-    create.queueCreateInfoCount = static_cast<std::uint32_t>(queue_infos.size());
-    create.pQueueCreateInfos = queue_infos.data();
-    create.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
-    create.ppEnabledExtensionNames = extensions.data();
+    VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
+    ci.queueCreateInfoCount = static_cast<std::uint32_t>(queue_infos.size());
+    ci.pQueueCreateInfos = queue_infos.data();
+    ci.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    ci.ppEnabledExtensionNames = extensions.data();
 
     VkDevice raw = VK_NULL_HANDLE;
-    check(physical.fn().vkCreateDevice(physical.vk(), &create, nullptr, &raw), "vkCreateDevice");
+    check(physical.fn().vkCreateDevice(physical.vk(), &ci, nullptr, &raw), "vkCreateDevice");
     detail::Ref<detail::DeviceState> state;
     try {
         make_device(physical, raw, Ownership::owned, requests, extensions, state);

@@ -76,16 +76,16 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     messenger_info.pUserData = &s.debug_callback;
     messenger_info.pNext = info.next;
 
-    VkInstanceCreateInfo create{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-    create.pNext = messenger ? &messenger_info : info.next;
-    create.pApplicationInfo = &app;
-    create.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
-    create.ppEnabledLayerNames = layers.data();
-    create.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
-    create.ppEnabledExtensionNames = extensions.data();
+    VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    ci.pNext = messenger ? &messenger_info : info.next;
+    ci.pApplicationInfo = &app;
+    ci.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+    ci.ppEnabledLayerNames = layers.data();
+    ci.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    ci.ppEnabledExtensionNames = extensions.data();
 
     VkInstance raw = VK_NULL_HANDLE;
-    check(global.vkCreateInstance(&create, nullptr, &raw), "vkCreateInstance");
+    check(global.vkCreateInstance(&ci, nullptr, &raw), "vkCreateInstance");
 
     // From here the state owns the instance: an exception below destroys it.
     s.instance = raw;

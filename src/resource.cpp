@@ -98,17 +98,17 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
                              std::to_string(largest) + " bytes)");
         }
     }
-    VkBufferCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, info.next};
-    create.flags = info.flags;
-    create.size = info.size;
-    create.usage = info.usage;
-    create.sharingMode = info.sharing_mode;
-    create.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
-    create.pQueueFamilyIndices = info.queue_family_indices.data();
+    VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.size = info.size;
+    ci.usage = info.usage;
+    ci.sharingMode = info.sharing_mode;
+    ci.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
+    ci.pQueueFamilyIndices = info.queue_family_indices.data();
 
     // The state owns the buffer from here, so a failure below destroys it.
     auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
-    check(device.fn().vkCreateBuffer(device.vk(), &create, nullptr, &state->buffer), "vkCreateBuffer");
+    check(device.fn().vkCreateBuffer(device.vk(), &ci, nullptr, &state->buffer), "vkCreateBuffer");
     AllocationRequest request;
     request.intent = info.memory;
     request.dedicated_buffer = state->buffer;
@@ -156,23 +156,23 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
         throw UsageError("vkrc::Image::create: mip_levels and array_layers must be at least 1");
     }
     if (info.usage == 0) throw UsageError("vkrc::Image::create: usage is 0");
-    VkImageCreateInfo create{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, info.next};
-    create.flags = info.flags;
-    create.imageType = info.image_type;
-    create.format = info.format;
-    create.extent = info.extent;
-    create.mipLevels = info.mip_levels;
-    create.arrayLayers = info.array_layers;
-    create.samples = info.samples;
-    create.tiling = info.tiling;
-    create.usage = info.usage;
-    create.sharingMode = info.sharing_mode;
-    create.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
-    create.pQueueFamilyIndices = info.queue_family_indices.data();
-    create.initialLayout = info.initial_layout;
+    VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.imageType = info.image_type;
+    ci.format = info.format;
+    ci.extent = info.extent;
+    ci.mipLevels = info.mip_levels;
+    ci.arrayLayers = info.array_layers;
+    ci.samples = info.samples;
+    ci.tiling = info.tiling;
+    ci.usage = info.usage;
+    ci.sharingMode = info.sharing_mode;
+    ci.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
+    ci.pQueueFamilyIndices = info.queue_family_indices.data();
+    ci.initialLayout = info.initial_layout;
 
     auto state = image_state(device, info, Ownership::owned);
-    check(device.fn().vkCreateImage(device.vk(), &create, nullptr, &state->image), "vkCreateImage");
+    check(device.fn().vkCreateImage(device.vk(), &ci, nullptr, &state->image), "vkCreateImage");
     AllocationRequest request;
     request.intent = info.memory;
     request.dedicated_image = state->image;
@@ -197,18 +197,18 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
 
 ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info) {
     if (!image) throw UsageError("vkrc::ImageView::create: the Image handle is empty");
-    VkImageViewCreateInfo create{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.next};
-    create.flags = info.flags;
-    create.image = image.vk();
-    create.viewType = info.view_type;
-    create.format = info.format == VK_FORMAT_UNDEFINED ? image.format() : info.format;
-    create.components = info.components;
-    create.subresourceRange = info.subresource_range;
-    if (create.subresourceRange.aspectMask == 0) create.subresourceRange.aspectMask = format_aspects(create.format);
+    VkImageViewCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.image = image.vk();
+    ci.viewType = info.view_type;
+    ci.format = info.format == VK_FORMAT_UNDEFINED ? image.format() : info.format;
+    ci.components = info.components;
+    ci.subresourceRange = info.subresource_range;
+    if (ci.subresourceRange.aspectMask == 0) ci.subresourceRange.aspectMask = format_aspects(ci.format);
     // Free checks (create is a cold path): the range within the image, the
     // format the image's or, with MUTABLE_FORMAT_BIT, one of the same texel size.
     constexpr const char* who = "vkrc::ImageView::create";
-    const auto& r = create.subresourceRange;
+    const auto& r = ci.subresourceRange;
     auto range_fits = [](std::uint32_t base, std::uint32_t count, std::uint32_t total) {
         return base < total && (count == VK_REMAINING_MIP_LEVELS || (count != 0 && count <= total - base));
     };
@@ -224,66 +224,66 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
             (r.layerCount == VK_REMAINING_ARRAY_LAYERS ? std::string("remaining") : std::to_string(r.layerCount)) +
             " are outside the image's " + std::to_string(image.array_layers()) + " layers");
     }
-    if (create.format != image.format()) {
+    if (ci.format != image.format()) {
         if (!(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT)) {
-            throw UsageError(std::string(who) + ": format " + detail::enum_text(create.format) +
+            throw UsageError(std::string(who) + ": format " + detail::enum_text(ci.format) +
                              " differs from the image's " + detail::enum_text(image.format()) +
                              " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
         }
-        const std::uint32_t view_texel = format_texel_size(create.format);
+        const std::uint32_t view_texel = format_texel_size(ci.format);
         const std::uint32_t image_texel = format_texel_size(image.format());
         if (view_texel != 0 && image_texel != 0 && view_texel != image_texel) {
-            throw UsageError(std::string(who) + ": format " + detail::enum_text(create.format) + " has " +
+            throw UsageError(std::string(who) + ": format " + detail::enum_text(ci.format) + " has " +
                              std::to_string(view_texel) + "-byte texels, the image's format " +
                              detail::enum_text(image.format()) + " has " + std::to_string(image_texel));
         }
     }
     detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
     const auto& device = image.device();
-    check(device.fn().vkCreateImageView(device.vk(), &create, nullptr, &state->view), "vkCreateImageView");
+    check(device.fn().vkCreateImageView(device.vk(), &ci, nullptr, &state->view), "vkCreateImageView");
     state->image = image;
-    state->format = create.format;
-    state->range = create.subresourceRange;
+    state->format = ci.format;
+    state->range = ci.subresourceRange;
     return ImageView(std::move(state));
 }
 
 BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& info) {
     if (!buffer) throw UsageError("vkrc::BufferView::create: the Buffer handle is empty");
     if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::BufferView::create: format is VK_FORMAT_UNDEFINED");
-    VkBufferViewCreateInfo create{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO, info.next};
-    create.flags = info.flags;
-    create.buffer = buffer.vk();
-    create.format = info.format;
-    create.offset = info.offset;
-    create.range = info.range;
+    VkBufferViewCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.buffer = buffer.vk();
+    ci.format = info.format;
+    ci.offset = info.offset;
+    ci.range = info.range;
     detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
     const auto& device = buffer.device();
-    check(device.fn().vkCreateBufferView(device.vk(), &create, nullptr, &state->view), "vkCreateBufferView");
+    check(device.fn().vkCreateBufferView(device.vk(), &ci, nullptr, &state->view), "vkCreateBufferView");
     state->buffer = buffer;
     return BufferView(std::move(state));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     if (!device) throw UsageError("vkrc::Sampler::create: the Device handle is empty");
-    VkSamplerCreateInfo create{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.next};
-    create.flags = info.flags;
-    create.magFilter = info.mag_filter;
-    create.minFilter = info.min_filter;
-    create.mipmapMode = info.mipmap_mode;
-    create.addressModeU = info.address_mode_u;
-    create.addressModeV = info.address_mode_v;
-    create.addressModeW = info.address_mode_w;
-    create.mipLodBias = info.mip_lod_bias;
-    create.anisotropyEnable = info.anisotropy_enable ? VK_TRUE : VK_FALSE;
-    create.maxAnisotropy = info.max_anisotropy;
-    create.compareEnable = info.compare_enable ? VK_TRUE : VK_FALSE;
-    create.compareOp = info.compare_op;
-    create.minLod = info.min_lod;
-    create.maxLod = info.max_lod;
-    create.borderColor = info.border_color;
-    create.unnormalizedCoordinates = info.unnormalized_coordinates ? VK_TRUE : VK_FALSE;
+    VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.magFilter = info.mag_filter;
+    ci.minFilter = info.min_filter;
+    ci.mipmapMode = info.mipmap_mode;
+    ci.addressModeU = info.address_mode_u;
+    ci.addressModeV = info.address_mode_v;
+    ci.addressModeW = info.address_mode_w;
+    ci.mipLodBias = info.mip_lod_bias;
+    ci.anisotropyEnable = info.anisotropy_enable ? VK_TRUE : VK_FALSE;
+    ci.maxAnisotropy = info.max_anisotropy;
+    ci.compareEnable = info.compare_enable ? VK_TRUE : VK_FALSE;
+    ci.compareOp = info.compare_op;
+    ci.minLod = info.min_lod;
+    ci.maxLod = info.max_lod;
+    ci.borderColor = info.border_color;
+    ci.unnormalizedCoordinates = info.unnormalized_coordinates ? VK_TRUE : VK_FALSE;
     detail::Ref<detail::SamplerState> state(new detail::SamplerState);
-    check(device.fn().vkCreateSampler(device.vk(), &create, nullptr, &state->sampler), "vkCreateSampler");
+    check(device.fn().vkCreateSampler(device.vk(), &ci, nullptr, &state->sampler), "vkCreateSampler");
     state->device = device;
     return Sampler(std::move(state));
 }

@@ -33,12 +33,12 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
         std::snprintf(hex, sizeof hex, "0x%08x", magic);
         throw UsageError(std::string(who) + ": not SPIR-V (magic number " + hex + ", expected 0x07230203)");
     }
-    VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    info.codeSize = bytes;
-    info.pCode = static_cast<const std::uint32_t*>(code);
+    VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    ci.codeSize = bytes;
+    ci.pCode = static_cast<const std::uint32_t*>(code);
     s = detail::Ref<detail::ShaderModuleState>(new detail::ShaderModuleState);
     s->device = device;
-    check(device.fn().vkCreateShaderModule(device.vk(), &info, nullptr, &s->module), "vkCreateShaderModule");
+    check(device.fn().vkCreateShaderModule(device.vk(), &ci, nullptr, &s->module), "vkCreateShaderModule");
 }
 }  // namespace
 

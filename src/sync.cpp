@@ -47,11 +47,11 @@ QueryPoolState::~QueryPoolState() { defer_destroy<&DeviceFunctions::vkDestroyQue
 
 Fence Fence::create(const Device& device, bool signaled) {
     require_device(device, "vkrc::Fence::create");
-    VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    if (signaled) info.flags = VK_FENCE_CREATE_SIGNALED_BIT;
+    VkFenceCreateInfo ci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    if (signaled) ci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
     detail::Ref<detail::FenceState> s(new detail::FenceState);
     s->device = device;
-    check(device.fn().vkCreateFence(device.vk(), &info, nullptr, &s->fence), "vkCreateFence");
+    check(device.fn().vkCreateFence(device.vk(), &ci, nullptr, &s->fence), "vkCreateFence");
     return Fence(std::move(s));
 }
 
@@ -89,11 +89,11 @@ void make_semaphore(const Device& device, SemaphoreType type, std::uint64_t init
     VkSemaphoreTypeCreateInfo type_info{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type_info.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     type_info.initialValue = initial;
-    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-    if (type == SemaphoreType::timeline) info.pNext = &type_info;
+    VkSemaphoreCreateInfo ci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    if (type == SemaphoreType::timeline) ci.pNext = &type_info;
     s->device = device;
     s->type = type;
-    check(device.fn().vkCreateSemaphore(device.vk(), &info, nullptr, &s->semaphore), "vkCreateSemaphore");
+    check(device.fn().vkCreateSemaphore(device.vk(), &ci, nullptr, &s->semaphore), "vkCreateSemaphore");
 }
 }  // namespace
 
@@ -159,11 +159,11 @@ VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
 
 Event Event::create(const Device& device, bool device_only) {
     require_device(device, "vkrc::Event::create");
-    VkEventCreateInfo info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
-    if (device_only) info.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
+    VkEventCreateInfo ci{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+    if (device_only) ci.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
     detail::Ref<detail::EventState> s(new detail::EventState);
     s->device = device;
-    check(device.fn().vkCreateEvent(device.vk(), &info, nullptr, &s->event), "vkCreateEvent");
+    check(device.fn().vkCreateEvent(device.vk(), &ci, nullptr, &s->event), "vkCreateEvent");
     return Event(std::move(s));
 }
 
