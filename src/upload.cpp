@@ -140,6 +140,10 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
     Buffer staging = staging_buffer(buffer.device(), data.size(), MemoryUsage::upload);
     staging.allocation().write(0, data);
     OneTimeCommands commands(queue);
+    // Earlier submissions' reads and writes of the buffer end before the copy
+    // writes it (as in upload_image).
+    commands.memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     VkBufferCopy region{0, offset, data.size()};
     commands.fn().vkCmdCopyBuffer(commands.cmd(), staging.vk(), buffer.vk(), 1, &region);
     // Later submissions see the copy (their commands are in the second scope).

@@ -15,7 +15,8 @@ VKRC_BEGIN_NAMESPACE
 std::uint32_t format_texel_size(VkFormat format) noexcept;
 
 // Copies data to buffer at offset through a staging buffer. The buffer needs
-// VK_BUFFER_USAGE_TRANSFER_DST_BIT. Later submits on any queue see the data.
+// VK_BUFFER_USAGE_TRANSFER_DST_BIT. The copy waits for earlier submissions on
+// the queue to finish with the buffer; later submits on any queue see the data.
 void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data);
 
 // Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
