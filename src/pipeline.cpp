@@ -209,6 +209,8 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Shad
     const char* who = "vkrc::ComputePipeline::create";
     require(static_cast<bool>(layout), who, "the PipelineLayout handle is empty");
     require(static_cast<bool>(module), who, "the ShaderModule handle is empty");
+    require(module.device() == layout.device(), who,
+            "the ShaderModule belongs to another device than the pipeline layout");
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;

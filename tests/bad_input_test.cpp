@@ -3,6 +3,8 @@
 // message, including the object tracker's leak reports at teardown).
 #include "support/vk_test.hpp"
 
+#include "shaders/fill_pattern.comp.h"
+
 #include <array>
 #include <cstring>
 #include <functional>
@@ -80,6 +82,14 @@ TEST_F(VulkanTest, WritingPastTheEndOfAMappingIsRejected) {
                        {"vkrc::Allocation::write"});
 }
 #endif
+
+TEST_F(VulkanTest, ComputePipelineRejectsAShaderOfAnotherDevice) {
+    auto other = vkrc::Device::create(physical_device);
+    auto layout = vkrc::PipelineLayout::create(device, {});
+    auto module = vkrc::ShaderModule::create(other, vkrc_shaders::fill_pattern_comp);
+    expect_usage_error([&] { vkrc::ComputePipeline::create(layout, module); },
+                       {"vkrc::ComputePipeline::create", "another device"});
+}
 
 TEST_F(VulkanTest, ObjectsOfOneDeviceAreRejectedByAnother) {
     auto other = vkrc::Device::create(physical_device);
