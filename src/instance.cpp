@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -57,8 +58,8 @@ Instance Instance::create() { return create(InstanceCreateInfo{}); }
 Instance Instance::create(const InstanceCreateInfo& info) {
     auto global = GlobalFunctions::load(info.get_instance_proc_addr);
 
-    std::vector<const char*> layers = info.enabled_layer_names;
-    std::vector<const char*> extensions = info.enabled_extension_names;
+    std::vector<const char*> layers(info.enabled_layer_names.begin(), info.enabled_layer_names.end());
+    std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (info.validation) {
         detail::add_unique(layers, validation_layer);
         detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -106,7 +107,7 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     s.api_version = info.api_version;
     s.global_fn = global;
     s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
-    s.enabled_extensions.assign(extensions.begin(), extensions.end());
+    for (const char* e : extensions) s.enabled_extensions.push_back(e);
     if (messenger) {
         messenger_info.pNext = nullptr;
         check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
@@ -133,7 +134,7 @@ bool Instance::extension_enabled(const char* name) const noexcept {
     return detail::contains(state_->enabled_extensions, name);
 }
 
-std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+List<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = enumerate<VkLayerProperties>(
         [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
@@ -143,7 +144,7 @@ std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_insta
     return names;
 }
 
-std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+List<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = enumerate<VkExtensionProperties>(
         [&](std::uint32_t* n, VkExtensionProperties* p) {
@@ -155,7 +156,7 @@ std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_i
     return names;
 }
 
-std::vector<PhysicalDevice> Instance::physical_devices() const {
+List<PhysicalDevice> Instance::physical_devices() const {
     const auto& f = fn();
     auto raws = enumerate<VkPhysicalDevice>(
         [&](std::uint32_t* n, VkPhysicalDevice* p) { return f.vkEnumeratePhysicalDevices(vk(), n, p); },
@@ -177,7 +178,7 @@ std::vector<PhysicalDevice> Instance::physical_devices() const {
                 return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
             },
             "vkEnumerateDeviceExtensionProperties");
-        for (const auto& e : exts) s.extensions.emplace_back(e.extensionName);
+        for (const auto& e : exts) s.extensions.push_back(e.extensionName);
         devices.push_back(std::move(device));
     }
     return devices;

@@ -1,4 +1,5 @@
 #include "vkrc/surface.hpp"
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -32,7 +33,7 @@ VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_de
     return caps;
 }
 
-std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
+List<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
     std::vector<VkSurfaceFormatKHR> out;
     VkResult r;
@@ -48,7 +49,7 @@ std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_
     return out;
 }
 
-std::vector<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
+List<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
     std::vector<VkPresentModeKHR> out;
     VkResult r;
