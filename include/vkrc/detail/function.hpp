@@ -29,7 +29,7 @@ public:
     Function() noexcept = default;
     Function(decltype(nullptr)) noexcept {}
     template <class F>
-        requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(std::forward<Args>(args)...); }
+    requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(std::forward<Args>(args)...); }
     Function(F f) : callable_(new Holder<F>(std::move(f))) {}
     Function(const Function& other) : callable_(other.callable_ ? other.callable_->clone() : nullptr) {}
     Function(Function&& other) noexcept : callable_(std::exchange(other.callable_, nullptr)) {}
@@ -53,7 +53,8 @@ private:
     struct Holder final : Callable {
         explicit Holder(F&& callable) : f(std::move(callable)) {}
         R call(Args&&... args) override {
-            if constexpr (detail::same_type<R, void>) f(std::forward<Args>(args)...);  // drops a result, as std::function does
+            if constexpr (detail::same_type<R, void>)
+                f(std::forward<Args>(args)...);  // drops a result, as std::function does
             else return f(std::forward<Args>(args)...);
         }
         Callable* clone() const override { return new Holder(F(f)); }

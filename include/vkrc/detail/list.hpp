@@ -20,22 +20,24 @@ template <class T>
 class List {
 public:
     List() noexcept = default;
-    List(std::initializer_list<T> items) { append_copies(items.begin(), items.size()); }
-    List(const T* items, std::size_t count) { append_copies(items, count); }
+    // The constructors delegate to List() so that, should a copy throw, the
+    // destructor frees what was made.
+    List(std::initializer_list<T> items) : List() { append_copies(items.begin(), items.size()); }
+    List(const T* items, std::size_t count) : List() { append_copies(items, count); }
     // Any contiguous range of T: std::vector, std::array, std::span, List.
     template <class Range>
-        requires requires(const Range& r) {
-            static_cast<const T*>(r.data());
-            r.size();
-        }
-    List(const Range& items) {
-        append_copies(items.data(), items.size());
+    requires requires(const Range& r) {
+        static_cast<const T*>(r.data());
+        r.size();
     }
+    List(const Range& items) : List() { append_copies(items.data(), items.size()); }
     // count value-initialised elements, made in place (T need not be movable).
-    explicit List(std::size_t count) : data_(allocate(count)), capacity_(count) {
+    explicit List(std::size_t count) : List() {
+        data_ = allocate(count);
+        capacity_ = count;
         for (; size_ < count; ++size_) new (data_ + size_) T();
     }
-    List(const List& other) { append_copies(other.data_, other.size_); }
+    List(const List& other) : List() { append_copies(other.data_, other.size_); }
     List(List&& other) noexcept { swap(other); }
     List& operator=(const List& other) {
         if (this != &other) List(other).swap(*this);
@@ -113,7 +115,7 @@ public:
 
 private:
     static T* allocate(std::size_t count) { return static_cast<T*>(::operator new(count * sizeof(T))); }
-    // Copies count items to the end; leaves the list whole if a copy throws.
+    // Copies count items to the end; a copy that throws leaves those made before it.
     void append_copies(const T* items, std::size_t count) {
         reserve(size_ + count);
         for (std::size_t i = 0; i < count; ++i, ++size_) new (data_ + size_) T(items[i]);
