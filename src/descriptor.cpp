@@ -3,6 +3,7 @@
 #include "enum_names.hpp"
 
 #include <string>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -76,7 +77,7 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout) const 
     ai.descriptorPool = p.pool;
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &raw_layout;
-    thread_local std::vector<VkDescriptorSet> ready;
+    thread_local List<VkDescriptorSet> ready;
     LockGuard lock(p.mutex);
     ready.clear();
     p.pending.take_ready(d, ready);

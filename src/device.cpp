@@ -7,6 +7,7 @@
 #include <atomic>  // std::memory_order for detail::Atomic
 #include <cstring>
 #include <string>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -99,7 +100,7 @@ VkResult DeviceState::signal_submitted_work(QueueState& q, std::uint64_t& value)
     return VK_SUCCESS;
 }
 
-void DeviceState::submitted_snapshot(std::vector<std::uint64_t>& out) {
+void DeviceState::submitted_snapshot(List<std::uint64_t>& out) {
     out.resize(queues.size());
     for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].timeline.covering_value();
 }
@@ -118,7 +119,7 @@ bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
 // ---------------------------------------------------------------- DeferredDestructor
 
 void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept {
-    std::vector<DeferredAction> ready;
+    List<DeferredAction> ready;
     bool run_now = false;
     {
         LockGuard lock(mutex_);
@@ -129,7 +130,7 @@ void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction a
             try {
                 // Needs the values of work submitted so far; a batch queued
                 // while the same work was pending is shared.
-                std::vector<std::uint64_t> values;
+                List<std::uint64_t> values;
                 device.submitted_snapshot(values);
                 if (batches_.empty() || batches_.back().wait_values != values) {
                     batches_.push_back(Batch{std::move(values), {}});
@@ -152,7 +153,7 @@ void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction a
     for (auto& a : ready) a.run(device, a.handle, a.context);
 }
 
-void DeferredDestructor::take_ready(DeviceState& device, std::vector<DeferredAction>& out) {
+void DeferredDestructor::take_ready(DeviceState& device, List<DeferredAction>& out) {
     if (batches_.empty()) return;
     const bool all = device.idle_now();
     auto done = [&](const Batch& batch) {
@@ -172,14 +173,14 @@ void DeferredDestructor::take_ready(DeviceState& device, std::vector<DeferredAct
     out.reserve(out.size() + actions);
     for (; batches > 0; --batches) {
         auto& batch = batches_.front();
-        out.insert(out.end(), batch.actions.begin(), batch.actions.end());
+        out.append(batch.actions.data(), batch.actions.size());
         count_.fetch_sub(batch.actions.size(), std::memory_order_relaxed);
         batches_.pop_front();
     }
 }
 
 void DeferredDestructor::collect(DeviceState& device) noexcept {
-    std::vector<DeferredAction> ready;
+    List<DeferredAction> ready;
     {
         if (count_.load(std::memory_order_relaxed) == 0) return;
         LockGuard lock(mutex_);
@@ -220,9 +221,13 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
     VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     VkSemaphoreCreateInfo ci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
+    std::size_t count = 0;
+    for (const auto& request : requests) count += request.queue_priorities.size();
+    s.queues = List<detail::QueueState>(count);  // in place: QueueState does not move
+    std::size_t next = 0;
     for (const auto& request : requests) {
         for (std::uint32_t i = 0; i < request.queue_priorities.size(); ++i) {
-            auto& q = s.queues.emplace_back();
+            auto& q = s.queues[next++];
             q.family_index = request.queue_family_index;
             q.index = i;
             s.fn.vkGetDeviceQueue(s.device, request.queue_family_index, i, &q.queue);
@@ -240,7 +245,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
     s.ownership = ownership;
     s.physical_device = physical;
     s.fn = DeviceFunctions::load(physical.fn().vkGetDeviceProcAddr, raw);
-    s.enabled_extensions.assign(extensions.begin(), extensions.end());
+    for (const char* e : extensions) s.enabled_extensions.push_back(e);
     init_queues(s, queues);
 }
 
@@ -250,7 +255,7 @@ Device Device::create(const PhysicalDevice& physical) { return create(physical, 
 
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");
-    std::vector<QueueRequest> requests = info.queue_requests;
+    std::vector<QueueRequest> requests(info.queue_requests.begin(), info.queue_requests.end());
     if (requests.empty()) {
         int family = physical.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
         if (family < 0) throw UsageError("vkrc::Device::create: no queue family with graphics and compute");
@@ -276,7 +281,7 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
         queue_infos.push_back(q);
     }
 
-    std::vector<const char*> extensions = info.enabled_extension_names;
+    std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
         detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }

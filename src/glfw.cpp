@@ -31,12 +31,12 @@ void init() {
 
 }  // namespace
 
-std::vector<const char*> required_instance_extensions() {
+List<const char*> required_instance_extensions() {
     init();
     std::uint32_t count = 0;
     const char** names = glfwGetRequiredInstanceExtensions(&count);
     if (!names) throw_glfw("vkrc::glfw: glfwGetRequiredInstanceExtensions");
-    return std::vector<const char*>(names, names + count);
+    return List<const char*>(names, count);
 }
 
 Surface create_surface(const Instance& instance, GLFWwindow* window) {
@@ -96,7 +96,8 @@ WindowSurface create_window_surface(const WindowCreateInfo& window_info, Instanc
     WindowSurface out;
     out.window = Window::create(window_info);
     for (const char* name : required_instance_extensions()) {
-        detail::add_unique(instance_info.enabled_extension_names, name);
+        auto& names = instance_info.enabled_extension_names;
+        if (!detail::contains(names, name)) names.push_back(name);
     }
     out.instance = Instance::create(instance_info);
     out.surface = create_surface(out.instance, out.window.get());

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <string>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -72,7 +73,7 @@ PresentStatus HeadlessPresenter::present(const Frame& frame) {
     return PresentStatus::success;
 }
 
-std::vector<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
+List<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
     auto& s = *state_;
     Image image;
     {

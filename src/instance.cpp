@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -43,8 +44,8 @@ Instance Instance::create() { return create(InstanceCreateInfo{}); }
 Instance Instance::create(const InstanceCreateInfo& info) {
     auto global = GlobalFunctions::load(info.get_instance_proc_addr);
 
-    std::vector<const char*> layers = info.enabled_layer_names;
-    std::vector<const char*> extensions = info.enabled_extension_names;
+    std::vector<const char*> layers(info.enabled_layer_names.begin(), info.enabled_layer_names.end());
+    std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (info.validation) {
         detail::add_unique(layers, validation_layer);
         detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
@@ -92,7 +93,7 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     s.api_version = info.api_version;
     s.global_fn = global;
     s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
-    s.enabled_extensions.assign(extensions.begin(), extensions.end());
+    for (const char* e : extensions) s.enabled_extensions.push_back(e);
     if (messenger) {
         messenger_info.pNext = nullptr;
         check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
@@ -119,7 +120,7 @@ bool Instance::extension_enabled(const char* name) const noexcept {
     return detail::contains(state_->enabled_extensions, name);
 }
 
-std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+List<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = detail::enumerate<VkLayerProperties>(
         [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
@@ -129,7 +130,7 @@ std::vector<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_insta
     return names;
 }
 
-std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+List<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     auto props = detail::enumerate<VkExtensionProperties>(
         [&](std::uint32_t* n, VkExtensionProperties* p) {
@@ -141,7 +142,7 @@ std::vector<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_i
     return names;
 }
 
-std::vector<PhysicalDevice> Instance::physical_devices() const {
+List<PhysicalDevice> Instance::physical_devices() const {
     const auto& f = fn();
     auto raws = detail::enumerate<VkPhysicalDevice>(
         [&](std::uint32_t* n, VkPhysicalDevice* p) { return f.vkEnumeratePhysicalDevices(vk(), n, p); },
@@ -163,7 +164,7 @@ std::vector<PhysicalDevice> Instance::physical_devices() const {
                 return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
             },
             "vkEnumerateDeviceExtensionProperties");
-        for (const auto& e : exts) s.extensions.emplace_back(e.extensionName);
+        for (const auto& e : exts) s.extensions.push_back(e.extensionName);
         devices.push_back(std::move(device));
     }
     return devices;

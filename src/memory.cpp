@@ -5,6 +5,7 @@
 #include "memory_internal.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -103,7 +104,8 @@ DeviceAllocator& AllocatorRegistry::default_allocator() {
     LockGuard lock(mutex_);
     if (!default_) {
         auto pool = make_allocator<PoolAllocator>();
-        allocators_.insert(allocators_.begin(), pool);
+        allocators_.push_back(pool);
+        std::rotate(allocators_.begin(), allocators_.end() - 1, allocators_.end());  // the default one first
         default_ = pool.get();
     }
     return *default_;

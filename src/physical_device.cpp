@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -37,7 +38,7 @@ int PhysicalDevice::find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_s
     return -1;
 }
 
-std::vector<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
+List<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
     std::vector<std::string> reasons;
     const auto& props = properties();
     if (props.apiVersion < req.min_api_version) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 #include <system_error>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -177,7 +178,7 @@ PipelineCache PipelineCache::load(const Device& device, const char* file) {
     return create(device, data);
 }
 
-std::vector<std::byte> PipelineCache::data() const {
+List<std::byte> PipelineCache::data() const {
     const auto& d = state_->device;
     std::size_t size = 0;
     check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, nullptr), "vkGetPipelineCacheData");
@@ -290,7 +291,7 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::render_pass(const RenderPass& 
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(std::span<const VkFormat> color_formats,
                                                             VkFormat depth_format, VkFormat stencil_format) {
-    color_formats_.assign(color_formats.begin(), color_formats.end());
+    color_formats_ = color_formats;
     depth_format_ = depth_format;
     stencil_format_ = stencil_format;
     return *this;

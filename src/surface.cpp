@@ -1,4 +1,5 @@
 #include "vkrc/surface.hpp"
+#include <vector>
 
 #include "text.hpp"
 
@@ -34,7 +35,7 @@ VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_de
     return caps;
 }
 
-std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
+List<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
     return detail::enumerate<VkSurfaceFormatKHR>(
         [&](std::uint32_t* n, VkSurfaceFormatKHR* p) {
@@ -43,7 +44,7 @@ std::vector<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_
         "vkGetPhysicalDeviceSurfaceFormatsKHR");
 }
 
-std::vector<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
+List<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
     const auto& fn = instance().fn();
     return detail::enumerate<VkPresentModeKHR>(
         [&](std::uint32_t* n, VkPresentModeKHR* p) {

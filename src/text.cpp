@@ -6,11 +6,11 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-bool contains(const std::vector<Text>& names, const char* name) noexcept {
+bool contains(std::span<const Text> names, const char* name) noexcept {
     return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-bool contains(const std::vector<const char*>& names, const char* name) noexcept {
+bool contains(std::span<const char* const> names, const char* name) noexcept {
     return std::any_of(names.begin(), names.end(), [&](const char* n) { return std::strcmp(n, name) == 0; });
 }
 

@@ -7,6 +7,7 @@
 
 #include <string>
 #include <type_traits>
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -153,8 +154,7 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
     commands.submit_and_wait();
 }
 
-std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset,
-                                       VkDeviceSize size) {
+List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) {
     constexpr const char* who = "vkrc::download_buffer";
     check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "VK_BUFFER_USAGE_TRANSFER_SRC_BIT", who);
     if (offset > buffer.size() || size > buffer.size() - offset) {
@@ -233,8 +233,8 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
     commands.submit_and_wait();
 }
 
-std::vector<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout,
-                                      std::uint32_t mip_level, std::uint32_t array_layer) {
+List<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout, std::uint32_t mip_level,
+                               std::uint32_t array_layer) {
     constexpr const char* who = "vkrc::download_image";
     check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "VK_IMAGE_USAGE_TRANSFER_SRC_BIT", who);
     if (mip_level >= image.mip_levels() || array_layer >= image.array_layers()) {

@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <vector>
 
 namespace {
 

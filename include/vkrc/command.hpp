@@ -228,7 +228,7 @@ public:
     std::uint32_t queue_family_index = 0;
     mutable Mutex mutex;
     PoolFreeList<VkCommandBuffer> pending;  // under mutex
-    std::vector<VkCommandBuffer> scratch;   // under mutex
+    List<VkCommandBuffer> scratch;          // under mutex
 };
 
 class CommandBufferState final : public RefCounted {

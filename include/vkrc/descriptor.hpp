@@ -5,7 +5,7 @@
 #include "vkrc/resource.hpp"
 
 #include <span>
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -26,7 +26,7 @@ struct DescriptorSetLayoutBinding {
 // Mirrors VkDescriptorSetLayoutCreateInfo.
 struct DescriptorSetLayoutCreateInfo {
     VkDescriptorSetLayoutCreateFlags flags = 0;
-    std::vector<DescriptorSetLayoutBinding> bindings{};
+    List<DescriptorSetLayoutBinding> bindings{};
 };
 
 class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
@@ -46,7 +46,7 @@ private:
 struct DescriptorPoolCreateInfo {
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     std::uint32_t max_sets = 0;
-    std::vector<VkDescriptorPoolSize> pool_sizes{};
+    List<VkDescriptorPoolSize> pool_sizes{};
 };
 
 class DescriptorSet;
@@ -107,7 +107,7 @@ public:
     Device device;
     VkDescriptorSetLayout layout = VK_NULL_HANDLE;
     // For checking writes against the layout.
-    std::vector<DescriptorSetLayoutBinding> bindings;
+    List<DescriptorSetLayoutBinding> bindings;
 };
 
 class DescriptorPoolState final : public RefCounted {

@@ -3,7 +3,7 @@
 
 #include "vkrc/instance.hpp"
 
-#include <deque>
+#include "vkrc/detail/list.hpp"
 #include <span>
 
 VKRC_BEGIN_NAMESPACE
@@ -18,7 +18,7 @@ class QueueState;
 // Queues wanted from one family (VkDeviceQueueCreateInfo).
 struct QueueRequest {
     std::uint32_t queue_family_index = 0;
-    std::vector<float> queue_priorities = {1.0f};
+    List<float> queue_priorities = {1.0f};
 };
 
 // Mirrors VkDeviceCreateInfo. vkrc always turns on timelineSemaphore,
@@ -27,8 +27,8 @@ struct QueueRequest {
 // feature in the structs below. vkrc fills their sType and pNext.
 struct DeviceCreateInfo {
     // Empty: one queue from the first family with graphics and compute.
-    std::vector<QueueRequest> queue_requests{};
-    std::vector<const char*> enabled_extension_names{};
+    List<QueueRequest> queue_requests{};
+    List<const char*> enabled_extension_names{};
     VkPhysicalDeviceFeatures enabled_features{};
     VkPhysicalDeviceVulkan11Features vulkan11_features{};
     VkPhysicalDeviceVulkan12Features vulkan12_features{};
@@ -222,14 +222,14 @@ public:
 
 private:
     // Moves the actions whose work has completed to out; may throw bad_alloc.
-    void take_ready(DeviceState& device, std::vector<DeferredAction>& out);
+    void take_ready(DeviceState& device, List<DeferredAction>& out);
 
     struct Batch {
-        std::vector<std::uint64_t> wait_values;  // per queue
-        std::vector<DeferredAction> actions;
+        List<std::uint64_t> wait_values;  // per queue
+        List<DeferredAction> actions;
     };
     mutable Mutex mutex_;
-    std::deque<Batch> batches_;
+    List<Batch> batches_;
     // Read without the lock by collect() to skip it when nothing is queued.
     Atomic<std::size_t> count_{0};
 };
@@ -247,7 +247,7 @@ public:
 
 private:
     Mutex mutex_;
-    std::vector<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
+    List<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
     DeviceAllocator* default_ = nullptr;
 };
 
@@ -291,7 +291,7 @@ public:
     // be freed under their pool's lock rather than by a DeferredAction: the
     // covering values of every queue (out is resized to the queue count), and
     // whether the GPU has completed the work they stand for.
-    void submitted_snapshot(std::vector<std::uint64_t>& out);
+    void submitted_snapshot(List<std::uint64_t>& out);
     bool reached(std::span<const std::uint64_t> snapshot) noexcept;
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
@@ -300,8 +300,8 @@ public:
     DeviceFunctions fn;
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
-    std::vector<Text> enabled_extensions;
-    std::deque<QueueState> queues;  // a deque: Queue handles point into it
+    List<Text> enabled_extensions;
+    List<QueueState> queues;  // made once, never grows: Queue handles point into it
     Atomic<bool> lost{false};
     DeferredDestructor deferred;
     AllocatorRegistry allocators;

@@ -16,7 +16,7 @@ namespace glfw {
 // Initialises GLFW and returns the instance extensions its surfaces need
 // (names owned by GLFW, valid until it terminates). Throws std::runtime_error
 // when GLFW or its Vulkan support is unavailable (no display, no loader).
-std::vector<const char*> required_instance_extensions();
+List<const char*> required_instance_extensions();
 
 // A surface for window (glfwCreateWindowSurface), destroyed by vkrc. The
 // instance needs required_instance_extensions(); the window must outlive the

@@ -4,9 +4,9 @@
 #include "vkrc/error.hpp"
 #include "vkrc/functions.hpp"
 #include "vkrc/handle.hpp"
-#include "vkrc/detail/light_std.hpp"  // std::function
+#include "vkrc/detail/function.hpp"
 
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -24,7 +24,7 @@ struct DebugMessage {
     const char* message_id_name{};  // may be null
     const char* message{};
 };
-using DebugCallback = std::function<void(const DebugMessage&)>;
+using DebugCallback = Function<void(const DebugMessage&)>;
 
 // Writes "vkrc [warning|error|info|verbose] <id>: <message>" to stderr.
 void print_debug_message(const DebugMessage& message);
@@ -34,8 +34,8 @@ struct InstanceCreateInfo {
     const char* application_name = "vkrc application";
     std::uint32_t application_version = 0;
     std::uint32_t api_version = VK_API_VERSION_1_3;
-    std::vector<const char*> enabled_layer_names{};
-    std::vector<const char*> enabled_extension_names{};
+    List<const char*> enabled_layer_names{};
+    List<const char*> enabled_extension_names{};
     // Adds VK_LAYER_KHRONOS_validation and VK_EXT_debug_utils.
     bool validation = false;
     // Installs a debug-utils messenger for the instance's whole life (and for
@@ -67,11 +67,11 @@ public:
     std::uint32_t api_version() const noexcept;
     bool extension_enabled(const char* name) const noexcept;
 
-    std::vector<PhysicalDevice> physical_devices() const;
+    List<PhysicalDevice> physical_devices() const;
 
     // Names of the available instance layers / extensions (for choosing what to enable).
-    static std::vector<Text> available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
-    static std::vector<Text> available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+    static List<Text> available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+    static List<Text> available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
 
 private:
     using Handle::Handle;
@@ -82,11 +82,11 @@ private:
 struct DeviceRequirements {
     std::uint32_t min_api_version = VK_API_VERSION_1_3;
     VkQueueFlags queue_flags = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
-    std::vector<const char*> required_extensions{};
+    List<const char*> required_extensions{};
     // A queue family of the chosen device must be able to present to it.
     VkSurfaceKHR present_surface = VK_NULL_HANDLE;
     // Devices of earlier types in this list win; CPU devices (lavapipe) are accepted.
-    std::vector<VkPhysicalDeviceType> preferred_types = {
+    List<VkPhysicalDeviceType> preferred_types = {
         VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
         VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_CPU, VK_PHYSICAL_DEVICE_TYPE_OTHER};
     // Only a device whose name contains this text (e.g. from an environment variable).
@@ -97,15 +97,15 @@ struct DeviceRequirements {
 // device with the reasons it was rejected.
 class NoSuitableDeviceError : public std::exception {
 public:
-    NoSuitableDeviceError(Text message, std::vector<Text> rejections)
+    NoSuitableDeviceError(Text message, List<Text> rejections)
         : what_(std::move(message)), rejections_(std::move(rejections)) {}
     const char* what() const noexcept override { return what_.c_str(); }
     // One line per rejected device: "<name>: <reason>; <reason>".
-    const std::vector<Text>& rejections() const noexcept { return rejections_; }
+    const List<Text>& rejections() const noexcept { return rejections_; }
 
 private:
     Text what_;
-    std::vector<Text> rejections_;
+    List<Text> rejections_;
 };
 
 // A physical device; keeps its Instance alive. Properties are read once.
@@ -119,14 +119,14 @@ public:
     // does not build and destroy a default DeviceRequirements (bench/header_cost).
     static PhysicalDevice select(const Instance& instance);
     // The reasons this device fails the requirements; empty when it meets them.
-    std::vector<Text> unmet_requirements(const DeviceRequirements& requirements) const;
+    List<Text> unmet_requirements(const DeviceRequirements& requirements) const;
 
     VkPhysicalDevice vk() const noexcept;
     const Instance& instance() const noexcept;
     const InstanceFunctions& fn() const noexcept;
     const VkPhysicalDeviceProperties& properties() const noexcept;
     const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept;
-    const std::vector<VkQueueFamilyProperties>& queue_families() const noexcept;
+    const List<VkQueueFamilyProperties>& queue_families() const noexcept;
     const char* name() const noexcept { return properties().deviceName; }
     bool supports_extension(const char* name) const noexcept;
     // First family with all the flags (and presentation to surface if given), or -1.
@@ -148,7 +148,7 @@ public:
     std::uint32_t api_version = 0;
     GlobalFunctions global_fn;
     InstanceFunctions fn;
-    std::vector<Text> enabled_extensions;
+    List<Text> enabled_extensions;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     DebugCallback debug_callback;  // the messengers' user data: the state never moves
 };
@@ -159,8 +159,8 @@ public:
     VkPhysicalDevice physical_device = VK_NULL_HANDLE;
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory_properties{};
-    std::vector<VkQueueFamilyProperties> queue_families;
-    std::vector<Text> extensions;
+    List<VkQueueFamilyProperties> queue_families;
+    List<Text> extensions;
 };
 
 }  // namespace detail
@@ -177,7 +177,7 @@ inline const VkPhysicalDeviceProperties& PhysicalDevice::properties() const noex
 inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties() const noexcept {
     return state_->memory_properties;
 }
-inline const std::vector<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const noexcept {
+inline const List<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const noexcept {
     return state_->queue_families;
 }
 

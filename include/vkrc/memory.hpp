@@ -10,12 +10,9 @@
 
 #include "vkrc/device.hpp"
 
-#include <array>
 #include <cstddef>
 #include <cstring>
-#include <limits>
 #include <span>
-#include <type_traits>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -100,7 +97,7 @@ struct HeapStatistics {
 };
 
 struct AllocatorStatistics {
-    std::array<HeapStatistics, VK_MAX_MEMORY_HEAPS> heaps{};
+    HeapStatistics heaps[VK_MAX_MEMORY_HEAPS]{};
     std::uint32_t heap_count = 0;
     std::uint64_t vk_allocate_calls = 0;  // vkAllocateMemory calls made so far
     HeapStatistics total() const noexcept;
@@ -250,7 +247,7 @@ private:
 // without overflowing.
 inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
                                VkDeviceSize size) {
-    if (element != 0 && count > std::numeric_limits<VkDeviceSize>::max() / element) [[unlikely]] {
+    if (element != 0 && count > ~VkDeviceSize(0) / element) [[unlikely]] {
         throw_out_of_range(who, offset, count, element, size);
     }
     const VkDeviceSize bytes = VkDeviceSize(count) * element;
@@ -265,7 +262,8 @@ inline void check_mapped_range(const char* who, VkDeviceSize offset, std::size_t
 template <class T>
 inline void write_mapped(const char* who, const AllocationState* s, std::byte* mapped, VkDeviceSize size, bool coherent,
                          VkDeviceSize offset, const T* data, std::size_t count) {
-    static_assert(std::is_trivially_copyable_v<T>, "mapped writes copy bytes");
+    // The compilers' built-in trait: <type_traits> is parsed by every user of vkrc.
+    static_assert(__is_trivially_copyable(T), "mapped writes copy bytes");
 #if VKRC_RUNTIME_CHECKS
     check_mapped_range(who, offset, count, sizeof(T), size);
 #else
@@ -358,7 +356,7 @@ public:
     // Invalidates the bytes on non-coherent memory, then copies them out.
     template <class T>
     void read(VkDeviceSize offset, T* out, std::size_t count) const {
-        static_assert(std::is_trivially_copyable_v<T>, "mapped reads copy bytes");
+        static_assert(__is_trivially_copyable(T), "mapped reads copy bytes");  // see write_mapped
         auto& s = *state_;
         if (!s.info.mapped) [[unlikely]]
             detail::throw_not_host_visible("vkrc::Allocation::read");

@@ -5,7 +5,7 @@
 #include "vkrc/shader.hpp"
 
 #include <span>
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -19,8 +19,8 @@ class PipelineCacheState;
 
 // Mirrors VkPipelineLayoutCreateInfo.
 struct PipelineLayoutCreateInfo {
-    std::vector<DescriptorSetLayout> set_layouts{};
-    std::vector<VkPushConstantRange> push_constant_ranges{};
+    List<DescriptorSetLayout> set_layouts{};
+    List<VkPushConstantRange> push_constant_ranges{};
 };
 
 class PipelineLayout : public Handle<detail::PipelineLayoutState> {
@@ -37,19 +37,19 @@ private:
 
 // Mirrors VkSubpassDescription (graphics subpasses).
 struct SubpassDescription {
-    std::vector<VkAttachmentReference> input_attachments{};
-    std::vector<VkAttachmentReference> color_attachments{};
-    std::vector<VkAttachmentReference> resolve_attachments{};  // empty or one per colour attachment
+    List<VkAttachmentReference> input_attachments{};
+    List<VkAttachmentReference> color_attachments{};
+    List<VkAttachmentReference> resolve_attachments{};  // empty or one per colour attachment
     // attachment VK_ATTACHMENT_UNUSED (the default): no depth/stencil attachment.
     VkAttachmentReference depth_stencil_attachment{VK_ATTACHMENT_UNUSED, VK_IMAGE_LAYOUT_UNDEFINED};
-    std::vector<std::uint32_t> preserve_attachments{};
+    List<std::uint32_t> preserve_attachments{};
 };
 
 // Mirrors VkRenderPassCreateInfo.
 struct RenderPassCreateInfo {
-    std::vector<VkAttachmentDescription> attachments{};
-    std::vector<SubpassDescription> subpasses{};
-    std::vector<VkSubpassDependency> dependencies{};
+    List<VkAttachmentDescription> attachments{};
+    List<SubpassDescription> subpasses{};
+    List<VkSubpassDependency> dependencies{};
 };
 
 class RenderPass : public Handle<detail::RenderPassState> {
@@ -67,7 +67,7 @@ private:
 // Mirrors VkFramebufferCreateInfo.
 struct FramebufferCreateInfo {
     RenderPass render_pass{};
-    std::vector<ImageView> attachments{};
+    List<ImageView> attachments{};
     std::uint32_t width = 0;
     std::uint32_t height = 0;
     std::uint32_t layers = 1;
@@ -100,7 +100,7 @@ public:
     VkPipelineCache vk() const noexcept;
     bool loaded_from_file() const noexcept;
     // vkGetPipelineCacheData.
-    std::vector<std::byte> data() const;
+    List<std::byte> data() const;
     // Writes data() to file (replacing it); throws std::system_error on I/O failure.
     void save(const char* file) const;
 
@@ -179,9 +179,9 @@ private:
         const char* entry_point;
     };
     PipelineLayout layout_;
-    std::vector<Stage> stages_;
-    std::vector<VkVertexInputBindingDescription> bindings_;
-    std::vector<VkVertexInputAttributeDescription> attributes_;
+    List<Stage> stages_;
+    List<VkVertexInputBindingDescription> bindings_;
+    List<VkVertexInputAttributeDescription> attributes_;
     VkPrimitiveTopology topology_ = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
     VkPolygonMode polygon_mode_ = VK_POLYGON_MODE_FILL;
     VkCullModeFlags cull_mode_ = VK_CULL_MODE_BACK_BIT;
@@ -199,10 +199,10 @@ private:
         VK_BLEND_OP_ADD,
         VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
     VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
-    std::vector<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
+    List<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
     RenderPass render_pass_;
     std::uint32_t subpass_ = 0;
-    std::vector<VkFormat> color_formats_;
+    List<VkFormat> color_formats_;
     VkFormat depth_format_ = VK_FORMAT_UNDEFINED;
     VkFormat stencil_format_ = VK_FORMAT_UNDEFINED;
 };
@@ -221,14 +221,14 @@ public:
     ~RenderPassState() override;
     Device device;
     VkRenderPass render_pass = VK_NULL_HANDLE;
-    std::vector<std::uint32_t> color_counts;  // per subpass
+    List<std::uint32_t> color_counts;  // per subpass
 };
 
 class FramebufferState final : public RefCounted {
 public:
     ~FramebufferState() override;
     RenderPass render_pass;
-    std::vector<ImageView> attachments;
+    List<ImageView> attachments;
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
     VkExtent2D extent{};
 };

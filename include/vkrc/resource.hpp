@@ -3,7 +3,7 @@
 
 #include "vkrc/memory.hpp"
 
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -21,7 +21,7 @@ struct BufferCreateInfo {
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
-    std::vector<std::uint32_t> queue_family_indices{};
+    List<std::uint32_t> queue_family_indices{};
     MemoryIntent memory{};
     // Null: the device's default allocator (a PoolAllocator).
     SharedAllocator allocator{};
@@ -62,7 +62,7 @@ struct ImageCreateInfo {
     VkImageTiling tiling = VK_IMAGE_TILING_OPTIMAL;
     VkImageUsageFlags usage = 0;
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
-    std::vector<std::uint32_t> queue_family_indices{};
+    List<std::uint32_t> queue_family_indices{};
     VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
     MemoryIntent memory{};
     SharedAllocator allocator{};

@@ -28,8 +28,8 @@ public:
     // vkGetPhysicalDeviceSurfaceCapabilitiesKHR.
     VkSurfaceCapabilitiesKHR capabilities(const PhysicalDevice& physical_device) const;
     // vkGetPhysicalDeviceSurfaceFormatsKHR / PresentModesKHR.
-    std::vector<VkSurfaceFormatKHR> formats(const PhysicalDevice& physical_device) const;
-    std::vector<VkPresentModeKHR> present_modes(const PhysicalDevice& physical_device) const;
+    List<VkSurfaceFormatKHR> formats(const PhysicalDevice& physical_device) const;
+    List<VkPresentModeKHR> present_modes(const PhysicalDevice& physical_device) const;
 
 private:
     using Handle::Handle;

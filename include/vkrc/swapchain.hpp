@@ -102,8 +102,8 @@ protected:
 struct SwapchainCreateInfo {
     // Tried in order; the first the surface supports wins, otherwise the
     // surface's first format.
-    std::vector<VkSurfaceFormatKHR> preferred_formats = {{VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
-                                                         {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
+    List<VkSurfaceFormatKHR> preferred_formats = {{VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
+                                                  {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
     // IMMEDIATE falls back to MAILBOX, MAILBOX to IMMEDIATE, both then to
     // FIFO (which every surface supports).
     VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
@@ -117,7 +117,7 @@ struct SwapchainCreateInfo {
     // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
     VkExtent2D extent{};
     // Receives the choices made and why, at creation and every re-creation.
-    std::function<void(const char*)> log{};
+    Function<void(const char*)> log{};
 };
 
 // A swapchain for one Surface, re-created in place. Keeps its Surface,
@@ -198,7 +198,7 @@ public:
     std::uint32_t last_presented() const noexcept;
     // Waits for the image's rendering (the queue's submitted work) and copies
     // it out: extent.width * extent.height texels, top row first.
-    std::vector<std::byte> read_back(std::uint32_t image_index) const;
+    List<std::byte> read_back(std::uint32_t image_index) const;
     // New images of this extent from the next acquire (frames holding the
     // old ones keep them alive).
     void resize(VkExtent2D extent);
@@ -221,7 +221,7 @@ public:
     VkSwapchainKHR swapchain = VK_NULL_HANDLE;
     // Signalled by the rendering of image i, waited by its present; reused
     // only when image i is acquired again.
-    std::vector<Semaphore> render_done;
+    List<Semaphore> render_done;
     bool presented = false;  // under the owning SwapchainState's mutex
     // Not retired when its Swapchain went: its destruction ends the surface's
     // SurfaceState::releasing.
@@ -235,12 +235,12 @@ public:
     Surface surface;
     SwapchainCreateInfo info;
     Ref<SwapchainChainState> chain;  // null until the surface has an area
-    std::vector<Image> images;
-    std::vector<ImageView> views;
+    List<Image> images;
+    List<ImageView> views;
     // Ring of acquire semaphores, each reused once the queue has reached the
     // value recorded when the frame that waited on it was presented.
-    std::vector<Semaphore> acquire_semaphores;
-    std::vector<std::uint64_t> acquire_done_values;
+    List<Semaphore> acquire_semaphores;
+    List<std::uint64_t> acquire_done_values;
     std::uint32_t next_acquire = 0;
     VkSurfaceFormatKHR surface_format{};
     VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
@@ -253,8 +253,8 @@ class HeadlessPresenterState final : public RefCounted {
 public:
     Queue queue;
     HeadlessPresenterCreateInfo info;
-    std::vector<Image> images;
-    std::vector<ImageView> views;
+    List<Image> images;
+    List<ImageView> views;
     std::uint64_t acquired = 0;  // under mutex
     // Written by present without the lock: present then touches no state it
     // must read first (its frame is checked against the frame's own fields).

@@ -6,7 +6,7 @@
 
 #include "vkrc/resource.hpp"
 
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -20,8 +20,7 @@ std::uint32_t format_texel_size(VkFormat format) noexcept;
 void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data);
 
 // Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
-std::vector<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset,
-                                       VkDeviceSize size);
+List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size);
 
 struct ImageUploadInfo {
     // The image's layout before the upload; UNDEFINED discards its contents.
@@ -43,7 +42,7 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
 // Copies one mip level of one array layer of a colour image (needs
 // VK_IMAGE_USAGE_TRANSFER_SRC_BIT), tightly packed. The image is in layout
 // and is left in it.
-std::vector<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout,
-                                      std::uint32_t mip_level = 0, std::uint32_t array_layer = 0);
+List<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout,
+                               std::uint32_t mip_level = 0, std::uint32_t array_layer = 0);
 
 VKRC_END_NAMESPACE

@@ -35,6 +35,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #ifndef TEAPOT_VKRC_FACTORY
 #  error "TEAPOT_VKRC_FACTORY must name this copy's factory (make_vkrc_st_variant or make_vkrc_mt_variant)"
@@ -177,7 +178,7 @@ public:
         f.fence.wait();
         f.fence.unsignal();
         f.submitted = false;
-        const std::vector<std::byte> pixels = offscreen_.read_back(offscreen_.last_presented());
+        const vkrc::List<std::byte> pixels = offscreen_.read_back(offscreen_.last_presented());
         const auto* bytes = reinterpret_cast<const std::uint8_t*>(pixels.data());
         std::vector<std::uint8_t> image(bytes, bytes + pixels.size());
         to_rgba(image, offscreen_.format());
@@ -245,7 +246,7 @@ private:
         VkFormat format = colour_format;
         if (config_.window) {
             vkrc::SwapchainCreateInfo info;
-            info.preferred_formats.assign(std::begin(window_formats), std::end(window_formats));
+            info.preferred_formats = vkrc::List<VkSurfaceFormatKHR>(window_formats, std::size(window_formats));
             info.present_mode = VK_PRESENT_MODE_IMMEDIATE_KHR;
             info.min_image_count = static_cast<std::uint32_t>(config_.frames_in_flight + 1);
             info.extent = {config_.width, config_.height};  // where the surface leaves it to the swapchain

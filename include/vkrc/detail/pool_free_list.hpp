@@ -10,8 +10,7 @@
 
 #include "vkrc/device.hpp"
 
-#include <deque>
-#include <vector>
+#include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
 namespace detail {
@@ -30,10 +29,10 @@ public:
     }
     // Caller holds the pool's lock. Moves the handles whose GPU work has
     // completed into out, in the order they were pushed.
-    void take_ready(DeviceState& device, std::vector<VkHandle>& out) {
+    void take_ready(DeviceState& device, List<VkHandle>& out) {
         while (!batches_.empty() && device.reached(batches_.front().wait_values)) {
             auto& h = batches_.front().handles;
-            out.insert(out.end(), h.begin(), h.end());
+            out.append(h.data(), h.size());
             batches_.pop_front();
         }
     }
@@ -47,11 +46,11 @@ public:
 
 private:
     struct Batch {
-        std::vector<std::uint64_t> wait_values;
-        std::vector<VkHandle> handles;
+        List<std::uint64_t> wait_values;
+        List<VkHandle> handles;
     };
-    std::deque<Batch> batches_;
-    std::vector<std::uint64_t> scratch_;
+    List<Batch> batches_;
+    List<std::uint64_t> scratch_;
 };
 
 }  // namespace detail
