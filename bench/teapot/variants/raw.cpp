@@ -41,7 +41,7 @@ void check(VkResult result, const char* call) {
     X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) X(vkQueueSubmit2)                      \
     X(vkCmdPipelineBarrier2) X(vkCmdBeginRendering) X(vkCmdEndRendering) X(vkCmdBindPipeline)                     \
     X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdBindDescriptorSets) X(vkCmdBindVertexBuffers)                   \
-    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)                \
+    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBuffer) \
     X(vkCreateSemaphore) X(vkDestroySemaphore) X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR)                   \
     X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) X(vkQueuePresentKHR)
 // clang-format on
@@ -58,6 +58,60 @@ struct Allocation {
     void* mapped = nullptr;
 };
 
+// The helpers a careful C programmer writes once.
+
+// An image barrier on the first mip level and layer of one aspect.
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout old_layout,
+                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
+                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
+                                    VkAccessFlags2 dst_access) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    b.oldLayout = old_layout;
+    b.newLayout = new_layout;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    return b;
+}
+
+// Records the image barriers into cmd with vkCmdPipelineBarrier2.
+void pipeline_barrier(PFN_vkCmdPipelineBarrier2 barrier, VkCommandBuffer cmd,
+                      std::span<const VkImageMemoryBarrier2> images,
+                      std::span<const VkBufferMemoryBarrier2> buffers = {}) {
+    VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dependency.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+    dependency.pImageMemoryBarriers = images.data();
+    dependency.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+    dependency.pBufferMemoryBarriers = buffers.data();
+    barrier(cmd, &dependency);
+}
+
+// Begins a one-time-submit recording of cmd after resetting its pool.
+void begin_one_time(const DeviceFunctions& fn, VkDevice device, VkCommandPool pool, VkCommandBuffer cmd) {
+    check(fn.vkResetCommandPool(device, pool, 0), "vkResetCommandPool");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(fn.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+}
+
+// Ends cmd, submits it signalling fence, waits for the fence and resets it.
+void submit_and_wait(const DeviceFunctions& fn, VkDevice device, VkQueue queue, VkCommandBuffer cmd, VkFence fence) {
+    check(fn.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+    VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cmd_info.commandBuffer = cmd;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.commandBufferInfoCount = 1;
+    submit.pCommandBufferInfos = &cmd_info;
+    check(fn.vkQueueSubmit2(queue, 1, &submit, fence), "vkQueueSubmit2");
+    check(fn.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    check(fn.vkResetFences(device, 1, &fence), "vkResetFences");
+}
+
 template <bool Direct>
 class RawVariant final : public Variant {
 public:
@@ -65,7 +119,6 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
@@ -120,35 +173,18 @@ public:
         check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin),
               "vkBeginCommandBuffer");
 
-        VkImageMemoryBarrier2 to_render[2]{};
-        to_render[0].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-        to_render[0].srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_render[0].dstStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_render[0].dstAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_render[0].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        to_render[0].newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        to_render[0].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[0].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[0].image = target_.image;
-        to_render[0].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        to_render[1].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-        to_render[1].srcStageMask =
+        const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-        to_render[1].srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-        to_render[1].dstStageMask =
-            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-        to_render[1].dstAccessMask =
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-        to_render[1].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        to_render[1].newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-        to_render[1].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[1].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[1].image = depth_.image;
-        to_render[1].subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dependency.imageMemoryBarrierCount = 2;
-        dependency.pImageMemoryBarriers = to_render;
-        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &dependency);
+        const VkImageMemoryBarrier2 to_render[2] = {
+            image_barrier(target_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0,
+                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
+            image_barrier(
+                depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT)};
+        pipeline_barrier(call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2), cmd, to_render);
 
         VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
         colour.imageView = target_.view;
@@ -189,20 +225,11 @@ public:
         }
         call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
 
-        VkImageMemoryBarrier2 to_present{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        to_present.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_present.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_present.dstStageMask = VK_PIPELINE_STAGE_2_NONE;
-        to_present.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        to_present.newLayout = target_.present_layout;
-        to_present.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_present.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_present.image = target_.image;
-        to_present.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkDependencyInfo present_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        present_dependency.imageMemoryBarrierCount = 1;
-        present_dependency.pImageMemoryBarriers = &to_present;
-        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &present_dependency);
+        const VkImageMemoryBarrier2 to_present =
+            image_barrier(target_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          target_.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                          VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+        pipeline_barrier(call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2), cmd, {&to_present, 1});
         check(call(&DeviceFunctions::vkEndCommandBuffer, ::vkEndCommandBuffer)(cmd), "vkEndCommandBuffer");
     }
 
@@ -255,7 +282,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
 
@@ -269,64 +296,14 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         present_to_window_ = config_.window;
-        drain();
-        // Copy the presented image to the readback buffer with a one-off
-        // command buffer from the slot's pool (idle after the drain).
-        Frame& f = frames_[slot_];
-        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
-        f.submitted = false;
-        check(fn_.vkResetCommandPool(device_, f.pool, 0), "vkResetCommandPool");
-        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        check(fn_.vkBeginCommandBuffer(f.cmd, &begin), "vkBeginCommandBuffer");
-        VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
-        to_copy.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_copy.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_copy.image = ring_[presented_image_].image;
-        to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dependency.imageMemoryBarrierCount = 1;
-        dependency.pImageMemoryBarriers = &to_copy;
-        fn_.vkCmdPipelineBarrier2(f.cmd, &dependency);
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {config_.width, config_.height, 1};
-        fn_.vkCmdCopyImageToBuffer(f.cmd, ring_[presented_image_].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   readback_buffer_, 1, &region);
-        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.buffer = readback_buffer_;
-        to_host.size = VK_WHOLE_SIZE;
-        VkDependencyInfo host_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        host_dependency.bufferMemoryBarrierCount = 1;
-        host_dependency.pBufferMemoryBarriers = &to_host;
-        fn_.vkCmdPipelineBarrier2(f.cmd, &host_dependency);
-        check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
-        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmd_info.commandBuffer = f.cmd;
-        VkSubmitInfo2 submit_info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit_info.commandBufferInfoCount = 1;
-        submit_info.pCommandBufferInfos = &cmd_info;
-        check(fn_.vkQueueSubmit2(queue_, 1, &submit_info, f.fence), "vkQueueSubmit2");
-        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
-        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        std::vector<std::uint8_t> image(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
-        to_rgba(image, colour_format_);
-        return image;
+        return read_back_ring_image();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return render_reference_frame(t);  // presented images are not ours to read
+        return read_back_ring_image();
     }
 
     std::string device_name() const override { return device_name_; }
@@ -367,6 +344,44 @@ private:
     Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
         if constexpr (Direct) return fn_.*member;
         else return exported;
+    }
+
+    // Drains, then copies the ring image last presented to the readback
+    // buffer with a one-off command buffer from the last frame's slot.
+    std::vector<std::uint8_t> read_back_ring_image() {
+        drain();
+        Frame& f = frames_[slot_];
+        if (f.submitted) {
+            check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+            check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+            f.submitted = false;
+        }
+        begin_one_time(fn_, device_, f.pool, f.cmd);
+        const VkImage image = ring_[presented_image_].image;
+        const VkImageMemoryBarrier2 to_copy = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {config_.width, config_.height, 1};
+        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
+        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = readback_buffer_;
+        to_host.size = VK_WHOLE_SIZE;
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {}, {&to_host, 1});
+        submit_and_wait(fn_, device_, queue_, f.cmd, f.fence);
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        std::vector<std::uint8_t> image_bytes(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
+        to_rgba(image_bytes, colour_format_);
+        return image_bytes;
     }
 
     void create_instance() {
@@ -443,24 +458,44 @@ private:
         queue_info.queueFamilyIndex = queue_family_;
         queue_info.queueCount = 1;
         queue_info.pQueuePriorities = &priority;
+        // The features and extensions vkrc::Device enables (setup parity):
+        // synchronization2, dynamicRendering, maintenance4, timelineSemaphore,
+        // VK_EXT_memory_budget where supported.
         VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
         features13.synchronization2 = VK_TRUE;
         features13.dynamicRendering = VK_TRUE;
+        features13.maintenance4 = VK_TRUE;
+        VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+        features12.pNext = &features13;
+        features12.timelineSemaphore = VK_TRUE;
         VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-        info.pNext = &features13;
+        info.pNext = &features12;
         info.queueCreateInfoCount = 1;
         info.pQueueCreateInfos = &queue_info;
-        const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
-        if (config_.window) {
-            info.enabledExtensionCount = 1;
-            info.ppEnabledExtensionNames = &swapchain_extension;
-        }
+        std::vector<const char*> extensions;
+        if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+        if (supports_device_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME))
+            extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+        info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+        info.ppEnabledExtensionNames = extensions.data();
         check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
         // The pointers for raw-direct's hot path and for the untimed helpers.
 #define TEAPOT_LOAD(name) fn_.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device_, #name));
         TEAPOT_DEVICE_FUNCTIONS(TEAPOT_LOAD)
 #undef TEAPOT_LOAD
         fn_.vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    }
+
+    bool supports_device_extension(const char* name) const {
+        std::uint32_t count = 0;
+        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, nullptr),
+              "vkEnumerateDeviceExtensionProperties");
+        std::vector<VkExtensionProperties> extensions(count);
+        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, extensions.data()),
+              "vkEnumerateDeviceExtensionProperties");
+        for (const VkExtensionProperties& e : extensions)
+            if (std::strcmp(e.extensionName, name) == 0) return true;
+        return false;
     }
 
     std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted) const {
@@ -491,10 +526,62 @@ private:
         return buffer;
     }
 
+    // A device-local buffer filled through a host-visible staging buffer
+    // (what vkrc::upload_buffer does), with a one-off command pool and fence.
     template <typename T>
     VkBuffer create_filled_buffer(const std::vector<T>& data, VkBufferUsageFlags usage, Allocation& allocation) {
-        VkBuffer buffer = create_buffer(data.size() * sizeof(T), usage, allocation);
-        std::memcpy(allocation.mapped, data.data(), data.size() * sizeof(T));
+        const VkDeviceSize size = data.size() * sizeof(T);
+        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        info.size = size;
+        info.usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        VkBuffer buffer;
+        check(fn_.vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
+        VkMemoryRequirements requirements;
+        fn_.vkGetBufferMemoryRequirements(device_, buffer, &requirements);
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, 0);
+        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = type;
+        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &allocation.memory), "vkAllocateMemory");
+        check(fn_.vkBindBufferMemory(device_, buffer, allocation.memory, 0), "vkBindBufferMemory");
+
+        Allocation staging_memory;
+        VkBuffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, staging_memory);
+        std::memcpy(staging_memory.mapped, data.data(), size);
+        VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+        pool_info.queueFamilyIndex = queue_family_;
+        VkCommandPool pool;
+        check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &pool), "vkCreateCommandPool");
+        VkCommandBufferAllocateInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+        cmd_info.commandPool = pool;
+        cmd_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        cmd_info.commandBufferCount = 1;
+        VkCommandBuffer cmd;
+        check(fn_.vkAllocateCommandBuffers(device_, &cmd_info, &cmd), "vkAllocateCommandBuffers");
+        VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VkFence fence;
+        check(fn_.vkCreateFence(device_, &fence_info, nullptr, &fence), "vkCreateFence");
+        begin_one_time(fn_, device_, pool, cmd);
+        VkBufferCopy region{0, 0, size};
+        fn_.vkCmdCopyBuffer(cmd, staging, buffer, 1, &region);
+        // Visible to every later command (vertex input and index reads).
+        VkBufferMemoryBarrier2 to_read{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_read.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_read.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_read.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        to_read.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
+        to_read.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_read.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_read.buffer = buffer;
+        to_read.size = VK_WHOLE_SIZE;
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, cmd, {}, {&to_read, 1});
+        submit_and_wait(fn_, device_, queue_, cmd, fence);
+        fn_.vkDestroyFence(device_, fence, nullptr);
+        fn_.vkDestroyCommandPool(device_, pool, nullptr);
+        fn_.vkDestroyBuffer(device_, staging, nullptr);
+        fn_.vkFreeMemory(device_, staging_memory.memory, nullptr);
         return buffer;
     }
 
@@ -755,6 +842,7 @@ private:
         auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
         VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
         VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pool.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;  // as every variant's pool
         pool.maxSets = slots;
         pool.poolSizeCount = 1;
         pool.pPoolSizes = &pool_size;

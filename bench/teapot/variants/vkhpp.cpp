@@ -28,7 +28,6 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
@@ -154,7 +153,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { device_->waitIdle(); }
 
@@ -168,12 +167,26 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         present_to_window_ = config_.window;
+        return read_back_ring_image();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return render_reference_frame(t);  // presented images are not ours to read
+        return read_back_ring_image();
+    }
+
+    // Drains, then copies the ring image last presented to the readback
+    // buffer with a one-off command buffer from the last frame's slot.
+    std::vector<std::uint8_t> read_back_ring_image() {
         drain();
         Frame& f = frames_[slot_];
-        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
-        device_->resetFences(*f.fence);
-        f.submitted = false;
+        if (f.submitted) {
+            (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+            device_->resetFences(*f.fence);
+            f.submitted = false;
+        }
         f.pool.reset();
         const vk::raii::CommandBuffer& cmd = f.cmd;
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
@@ -294,9 +307,17 @@ private:
         vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
         std::vector<const char*> extensions;
         if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
-        vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> chain(
-            vk::DeviceCreateInfo({}, queue_info, {}, extensions),
-            vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
+        // The features and extensions vkrc::Device enables (setup parity).
+        for (const vk::ExtensionProperties& e : physical_device_->enumerateDeviceExtensionProperties())
+            if (std::string_view(e.extensionName.data()) == VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)
+                extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+        vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features, vk::PhysicalDeviceVulkan13Features>
+            chain(vk::DeviceCreateInfo({}, queue_info, {}, extensions),
+                  vk::PhysicalDeviceVulkan12Features().setTimelineSemaphore(true),
+                  vk::PhysicalDeviceVulkan13Features()
+                      .setSynchronization2(true)
+                      .setDynamicRendering(true)
+                      .setMaintenance4(true));
         device_.emplace(*physical_device_, chain.get<vk::DeviceCreateInfo>());
         queue_.emplace(*device_, queue_family_, 0);
     }
@@ -323,10 +344,37 @@ private:
         return b;
     }
 
+    // A device-local buffer filled through a host-visible staging buffer
+    // (what vkrc::upload_buffer does), with a one-off command pool and fence.
     template <typename T>
     Buffer create_filled_buffer(const std::vector<T>& data, vk::BufferUsageFlags usage) {
-        Buffer b = create_buffer(data.size() * sizeof(T), usage);
-        std::memcpy(b.mapped, data.data(), data.size() * sizeof(T));
+        const vk::DeviceSize size = data.size() * sizeof(T);
+        Buffer b;
+        b.buffer =
+            vk::raii::Buffer(*device_, vk::BufferCreateInfo({}, size, usage | vk::BufferUsageFlagBits::eTransferDst));
+        vk::MemoryRequirements requirements = b.buffer.getMemoryRequirements();
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, {});
+        b.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
+        b.buffer.bindMemory(*b.memory, 0);
+
+        Buffer staging = create_buffer(size, vk::BufferUsageFlagBits::eTransferSrc);
+        std::memcpy(staging.mapped, data.data(), size);
+        vk::raii::CommandPool pool(*device_,
+                                   vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eTransient, queue_family_));
+        vk::raii::CommandBuffer cmd = std::move(vk::raii::CommandBuffers(
+            *device_, vk::CommandBufferAllocateInfo(*pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
+        vk::raii::Fence fence(*device_, vk::FenceCreateInfo());
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        cmd.copyBuffer(*staging.buffer, *b.buffer, vk::BufferCopy(0, 0, size));
+        vk::BufferMemoryBarrier2 to_read(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                         vk::PipelineStageFlagBits2::eAllCommands, vk::AccessFlagBits2::eMemoryRead,
+                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *b.buffer, 0, VK_WHOLE_SIZE);
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, to_read, {}));
+        cmd.end();
+        vk::CommandBufferSubmitInfo cmd_info(*cmd);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *fence);
+        (void)device_->waitForFences(*fence, VK_TRUE, UINT64_MAX);
         return b;
     }
 

@@ -54,7 +54,6 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         create_device();
@@ -156,7 +155,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { device_.wait_idle(); }
 
@@ -171,12 +170,25 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         presenter_ = timed;
+        return read_back_offscreen();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return render_reference_frame(t);  // presented images are not ours to read
+        return read_back_offscreen();
+    }
+
+    // Drains, then reads back the headless presenter's last presented image.
+    std::vector<std::uint8_t> read_back_offscreen() {
         drain();
         Frame& f = frames_[slot_];
-        f.fence.wait();
-        f.fence.unsignal();
-        f.submitted = false;
+        if (f.submitted) {
+            f.fence.wait();
+            f.fence.unsignal();
+            f.submitted = false;
+        }
         const std::vector<std::byte> pixels = offscreen_.read_back(offscreen_.last_presented());
         const auto* bytes = reinterpret_cast<const std::uint8_t*>(pixels.data());
         std::vector<std::uint8_t> image(bytes, bytes + pixels.size());
@@ -318,8 +330,10 @@ private:
 
     void create_frames() {
         const auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
-        descriptor_pool_ = vkrc::DescriptorPool::create(
-            device_, {.flags = 0, .max_sets = slots, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots}}});
+        descriptor_pool_ =
+            vkrc::DescriptorPool::create(device_, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT,
+                                                   .max_sets = slots,
+                                                   .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots}}});
         frames_.resize(slots);
         for (std::uint32_t i = 0; i < slots; ++i) {
             Frame& f = frames_[i];

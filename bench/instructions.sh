@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# Instructions per call of every per-frame stage of every teapot variant,
+# counted by valgrind's callgrind: deterministic where timers are noise.
+#
+#   bench/instructions.sh TEAPOT CSV [teapot options...]
+#
+# TEAPOT is a built bench/teapot (Release for figures worth quoting), CSV the
+# file to write (variant,stage,calls,instructions,instructions_per_call,
+# ratio_to_ref; the reference is raw-direct); the options go to
+# `teapot --instructions` (e.g. --variants vkrc-st,vkrc-mt --frames 50
+# --teapots 25; --frames is the number of calls counted per stage). Each
+# stage of each variant is collected on its own (callgrind client requests
+# around that stage's call, main thread only) and dumped; the dumps are
+# parsed here. Prints the table too.
+set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: bench/instructions.sh TEAPOT CSV [teapot options...]" >&2
+  exit 2
+fi
+teapot=$1
+csv=$2
+shift 2
+valgrind=${VALGRIND:-valgrind}
+if ! command -v "$valgrind" >/dev/null 2>&1; then
+  echo "instructions.sh: FAILED: valgrind not found (install the Debian package valgrind," \
+       "scripts/install-deps.sh does)" >&2
+  exit 1
+fi
+dumps=$(mktemp -d /tmp/teapot-callgrind.XXXXXX)
+trap 'rm -rf "$dumps"' EXIT
+"$valgrind" --tool=callgrind --collect-atstart=no --callgrind-out-file="$dumps/callgrind.out" \
+  "$teapot" --instructions "$@" >"$dumps/log" 2>&1 || {
+  cat "$dumps/log" >&2
+  echo "instructions.sh: FAILED: teapot --instructions under callgrind" >&2
+  exit 1
+}
+python3 - "$dumps" "$csv" <<'PY'
+import glob, os, re, sys
+dumps, csv = sys.argv[1], sys.argv[2]
+rows = {}
+for path in glob.glob(os.path.join(dumps, "callgrind.out*")):
+    desc, total = None, None
+    with open(path, errors="replace") as f:
+        for line in f:
+            m = re.match(r"desc: Trigger: Client Request: teapot (.*)", line)
+            if m:
+                desc = dict(kv.split("=", 1) for kv in m.group(1).split())
+            m = re.match(r"(?:summary|totals): (\d+)", line)
+            if m:
+                total = int(m.group(1))
+    if desc and total is not None:
+        rows[(desc["variant"], desc["stage"])] = (int(desc["calls"]), total)
+if not rows:
+    sys.exit("instructions.sh: FAILED: no per-stage dumps (teapot built without valgrind/callgrind.h?)")
+order = ["acquire", "uniform", "command", "submit", "present", "wait", "update"]
+variants = []
+for v, _ in sorted(rows, key=lambda k: k[0]):
+    if v not in variants:
+        variants.append(v)
+if "raw-direct" in variants:
+    variants.remove("raw-direct")
+    variants.insert(0, "raw-direct")
+os.makedirs(os.path.dirname(os.path.abspath(csv)), exist_ok=True)
+with open(csv, "w") as out:
+    out.write("variant,stage,calls,instructions,instructions_per_call,ratio_to_ref\n")
+    print(f"{'stage':8} {'variant':16} {'calls':>6} {'instructions':>14} {'per_call':>12} {'ratio':>8}")
+    for stage in order:
+        ref = rows.get(("raw-direct", stage))
+        for v in variants:
+            if (v, stage) not in rows:
+                continue
+            calls, total = rows[(v, stage)]
+            per = total / calls
+            ratio = "" if not ref or ref[1] == 0 else f"{per / (ref[1] / ref[0]):.4f}"
+            out.write(f"{v},{stage},{calls},{total},{per:.1f},{ratio}\n")
+            print(f"{stage:8} {v:16} {calls:6} {total:14} {per:12.1f} {ratio:>8}")
+print(f"CSV in {csv}")
+PY
