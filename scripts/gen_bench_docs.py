@@ -76,6 +76,15 @@ def table(result):
                 continue
             out.append(f"| {stage} | {r['variant']} | {float(r['median_us']):.3f} | {r['above_floor_ns']} | "
                        f"{fmt_ratio(r)} | {('<= ' + r['target']) if r['target'] else ''} | {r['verdict']} |")
+    control = {r["stage"]: r for r in rows if r["variant"] == "raw-direct-control"}
+    notes = []
+    for stage in ("command", "submit", "wait"):
+        c = control.get(stage)
+        if c:
+            ok = float(c["ref_ci_low"]) >= 0.99 and float(c["ref_ci_high"]) <= 1.01
+            notes.append(f"{stage} {fmt_ratio(c)} ({'within' if ok else 'not within'} 1 ± 0.01)")
+    out.append("")
+    out.append("A/A control (raw-direct against itself): " + "; ".join(notes) + ".")
     images = [r for r in rows if r["stage"] == "image"]
     bad = [r["variant"] for r in images if float(r["median_us"]) != 0]
     checked = images[0]["frames"] if images else "0"
