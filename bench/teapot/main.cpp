@@ -413,6 +413,13 @@ ConfigRun measure_configuration(const Options& options, const PlannedConfig& pla
         }
         const double t_last = t_round + double(frames_run - 1) * frame_step;
         const std::vector<std::uint8_t> reference = variants[0]->read_back_last_frame(t_last);
+        if (config.window) {
+            // The presented image must also be the offscreen frame at that t.
+            auto [differing, channel] = compare_images(variants[0]->render_reference_frame(t_last), reference);
+            if (differing) ++result.variants[0].image_mismatch_blocks;
+            result.variants[0].worst_pixels = std::max(result.variants[0].worst_pixels, differing);
+            result.variants[0].worst_channel = std::max(result.variants[0].worst_channel, channel);
+        }
         for (std::size_t v = 0; v < n; ++v) {
             VariantRun& r = result.variants[v];
             auto [differing, channel] =

@@ -302,8 +302,83 @@ public:
     }
 
     std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return render_reference_frame(t);  // presented images are not ours to read
+        if (config_.window) return read_back_presented_frame(t);
         return read_back_ring_image();
+    }
+
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to the readback buffer (the swapchain has
+    // TRANSFER_SRC usage) between its rendering and its presentation: the
+    // submission renders (waiting on the acquire semaphore), then a one-off
+    // copy goes PRESENT_SRC -> TRANSFER_SRC -> PRESENT_SRC and signals the
+    // render-done semaphore that present waits on.
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+        drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (swapchain_extent_.width != config_.width || swapchain_extent_.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
+        Frame& f = frames_[slot_];
+        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmd_info.commandBuffer = f.cmd;
+        VkSemaphoreSubmitInfo wait_info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        wait_info.semaphore = f.acquire_semaphore;
+        wait_info.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        VkSubmitInfo2 render{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        render.waitSemaphoreInfoCount = 1;
+        render.pWaitSemaphoreInfos = &wait_info;
+        render.commandBufferInfoCount = 1;
+        render.pCommandBufferInfos = &cmd_info;
+        check(fn_.vkQueueSubmit2(queue_, 1, &render, f.fence), "vkQueueSubmit2");
+        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+
+        begin_one_time(fn_, device_, f.pool, f.cmd);
+        const VkImage image = swapchain_images_[image_];
+        const VkImageMemoryBarrier2 to_copy = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {swapchain_extent_.width, swapchain_extent_.height, 1};
+        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
+        const VkImageMemoryBarrier2 back = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+            VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
+        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = readback_buffer_;
+        to_host.size = VK_WHOLE_SIZE;
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&back, 1}, {&to_host, 1});
+        check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
+        cmd_info.commandBuffer = f.cmd;
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        signal.semaphore = render_done_[image_];
+        signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        VkSubmitInfo2 copy{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        copy.commandBufferInfoCount = 1;
+        copy.pCommandBufferInfos = &cmd_info;
+        copy.signalSemaphoreInfoCount = 1;
+        copy.pSignalSemaphoreInfos = &signal;
+        check(fn_.vkQueueSubmit2(queue_, 1, &copy, f.fence), "vkQueueSubmit2");
+        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        std::vector<std::uint8_t> bytes(pixels,
+                                        pixels + std::size_t(swapchain_extent_.width) * swapchain_extent_.height * 4);
+        to_rgba(bytes, colour_format_);
+        present();
+        wait();
+        drain();
+        return bytes;
     }
 
     std::string device_name() const override { return device_name_; }
@@ -691,7 +766,7 @@ private:
         info.imageColorSpace = surface_format_.colorSpace;
         info.imageExtent = extent;
         info.imageArrayLayers = 1;
-        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check
         info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
         info.preTransform = caps.currentTransform;
         info.compositeAlpha = composite_alpha(caps);

@@ -173,8 +173,61 @@ public:
     }
 
     std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return render_reference_frame(t);  // presented images are not ours to read
+        if (config_.window) return read_back_presented_frame(t);
         return read_back_ring_image();
+    }
+
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to the readback buffer between its rendering and
+    // its presentation (as raw.cpp's read_back_presented_frame).
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+        drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (swapchain_extent_.width != config_.width || swapchain_extent_.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
+        Frame& f = frames_[slot_];
+        vk::CommandBufferSubmitInfo cmd_info(*f.cmd);
+        vk::SemaphoreSubmitInfo wait(*f.acquire_semaphore, 0, vk::PipelineStageFlagBits2::eColorAttachmentOutput);
+        queue_->submit2(vk::SubmitInfo2({}, wait, cmd_info, {}), *f.fence);
+        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+        device_->resetFences(*f.fence);
+        f.pool.reset();
+        const vk::raii::CommandBuffer& cmd = f.cmd;
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        const vk::Image image = swapchain_images_[image_];
+        vk::ImageMemoryBarrier2 to_copy(vk::PipelineStageFlagBits2::eNone, {}, vk::PipelineStageFlagBits2::eCopy,
+                                        vk::AccessFlagBits2::eTransferRead, vk::ImageLayout::ePresentSrcKHR,
+                                        vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                        VK_QUEUE_FAMILY_IGNORED, image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_copy));
+        vk::BufferImageCopy region(0, 0, 0, {vk::ImageAspectFlagBits::eColor, 0, 0, 1}, {0, 0, 0},
+                                   {swapchain_extent_.width, swapchain_extent_.height, 1});
+        cmd.copyImageToBuffer(image, vk::ImageLayout::eTransferSrcOptimal, *readback_.buffer, region);
+        vk::ImageMemoryBarrier2 back(vk::PipelineStageFlagBits2::eCopy, {}, vk::PipelineStageFlagBits2::eNone, {},
+                                     vk::ImageLayout::eTransferSrcOptimal, vk::ImageLayout::ePresentSrcKHR,
+                                     VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, image,
+                                     {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        vk::BufferMemoryBarrier2 to_host(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                         vk::PipelineStageFlagBits2::eHost, vk::AccessFlagBits2::eHostRead,
+                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *readback_.buffer, 0,
+                                         VK_WHOLE_SIZE);
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, to_host, back));
+        cmd.end();
+        vk::SemaphoreSubmitInfo signal(*render_done_[image_], 0, vk::PipelineStageFlagBits2::eAllCommands);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, signal), *f.fence);
+        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+        device_->resetFences(*f.fence);
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        std::vector<std::uint8_t> bytes(pixels,
+                                        pixels + std::size_t(swapchain_extent_.width) * swapchain_extent_.height * 4);
+        to_rgba(bytes, VkFormat(colour_format_));
+        present();
+        this->wait();
+        drain();
+        return bytes;
     }
 
     // Drains, then copies the ring image last presented to the readback
@@ -444,8 +497,8 @@ private:
         if (extent.width == 0 || extent.height == 0) return false;
         vk::SwapchainCreateInfoKHR info(
             {}, **surface_, swapchain_image_request(config_, caps), surface_format_.format, surface_format_.colorSpace,
-            vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment, vk::SharingMode::eExclusive, {},
-            vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
+            vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+            vk::SharingMode::eExclusive, {}, vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
             vk::CompositeAlphaFlagBitsKHR(composite_alpha(caps)), present_mode_, true, *swapchain_);
         swapchain_views_.clear();
         render_done_.clear();
