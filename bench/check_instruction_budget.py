@@ -18,7 +18,7 @@ args = parser.parse_args()
 
 per_call = {}
 with open(args.csv) as f:
-    for row in csv.DictReader(f):
+    for row in csv.DictReader(line for line in f if not line.startswith("#")):
         per_call[(row["variant"], row["stage"])] = float(row["instructions_per_call"])
 
 failures, lines = [], []

@@ -34,6 +34,16 @@ trap 'rm -rf "$dumps"' EXIT
   echo "instructions.sh: FAILED: teapot --instructions under callgrind" >&2
   exit 1
 }
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
+{
+  echo "# device: ${device:-${DEVICE:-unknown}}"
+  echo "# driver: $(dpkg-query -W -f='mesa-vulkan-drivers ${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+  echo "# date: $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "# command: bench/instructions.sh TEAPOT CSV $*"
+  echo "# git: $(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$(dirname "$teapot")/../CMakeCache.txt" | cut -d= -f2 || true)"
+} >"$dumps/header"
 python3 - "$dumps" "$csv" <<'PY'
 import glob, os, re, sys
 dumps, csv = sys.argv[1], sys.argv[2]
@@ -62,6 +72,7 @@ if "raw-direct" in variants:
     variants.insert(0, "raw-direct")
 os.makedirs(os.path.dirname(os.path.abspath(csv)), exist_ok=True)
 with open(csv, "w") as out:
+    out.write(open(os.path.join(dumps, "header")).read())
     out.write("variant,stage,calls,instructions,instructions_per_call,ratio_to_ref\n")
     print(f"{'stage':8} {'variant':16} {'calls':>6} {'instructions':>14} {'per_call':>12} {'ratio':>8}")
     for stage in order:

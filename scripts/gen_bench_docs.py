@@ -97,9 +97,41 @@ def table(result):
     return out
 
 
-def results(pattern):
+def results(pattern, kind="median_us"):
+    # kind: a column that tells the CSV's kind (median_us: a timed run;
+    # instructions_per_call: bench/instructions.sh).
     files = sorted(glob.glob(os.path.join(ROOT, "docs", "results", "*.csv")))
-    return [r for r in map(load, files) if re.search(pattern, r["meta"].get("device", ""), re.I)]
+    return [r for r in map(load, files)
+            if r["rows"] and kind in r["rows"][0] and re.search(pattern, r["meta"].get("device", ""), re.I)]
+
+
+def instructions(pattern, pending):
+    found = results(pattern, "instructions_per_call")
+    if not found:
+        return [pending]
+    out = []
+    for r in found:
+        m = r["meta"]
+        variants = variants_of(r["rows"])
+        get = {(x["variant"], x["stage"]): x for x in r["rows"]}
+        stages = [s for s in STAGES if any((v, s) in get for v in variants)]
+        out += [f"Device: {m.get('device', '?')}; driver: {m.get('driver', '?')}; date: {m.get('date', '?')}; "
+                f"git: {m.get('git', '?')}; build: {m.get('build', '?')}. Data: `{r['path']}`.", "",
+                f"    {m.get('command', '?')}", "",
+                "Instructions per call (ratio to raw-direct):", "",
+                "| stage | " + " | ".join(variants) + " |", "|---|" + "---:|" * len(variants)]
+        for s in stages:
+            cells = []
+            for v in variants:
+                x = get.get((v, s))
+                if not x:
+                    cells.append("")
+                    continue
+                ratio = f" ({float(x['ratio_to_ref']):.2f})" if x["ratio_to_ref"] and v != "raw-direct" else ""
+                cells.append(f"{float(x['instructions_per_call']):.0f}{ratio}")
+            out.append(f"| {s} | " + " | ".join(cells) + " |")
+        out.append("")
+    return out[:-1]
 
 
 def section(pattern, pending):
@@ -144,6 +176,7 @@ BLOCKS = {
         "committed data, so they are removed. `bench/device_run.sh` produces the CSVs; committed under "
         "docs/results/, they appear here."),
     "readme-teapot": readme_row,
+    "teapot-instructions": lambda: instructions("", "No instruction counts in docs/results/ yet."),
 }
 
 

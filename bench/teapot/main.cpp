@@ -926,6 +926,7 @@ int count_instructions(const Options& options) {
     for (const std::string& name : options.variants) {
         std::unique_ptr<Variant> variant = make_variant(name);
         variant->init(config, scene);
+        if (name == options.variants.front()) std::printf("device: %s\n", variant->device_name().c_str());
         double t = 0;
         variant->update(t);
         for (int f = 0; f < warmup_frames; ++f) timed_frame(*variant, t += frame_step);
