@@ -27,7 +27,7 @@
 //     measure the API rather than the display's rate; FIFO is the one every
 //     surface has), minImageCount frames_in_flight + 1 clamped to the
 //     surface's limits, the surface's current extent (Config width x height
-//     where the surface leaves it to the swapchain), COLOR_ATTACHMENT usage,
+//     where the surface leaves it to the swapchain), COLOR_ATTACHMENT and TRANSFER_SRC (image check) usage,
 //     opaque composite alpha where supported, clipped. One binary
 //     "render done" semaphore per swapchain image. vkrc's Swapchain applies
 //     the same rule from its SwapchainCreateInfo.
@@ -75,8 +75,11 @@
 //   * Last frame (read_back_last_frame, the per-block image check): after a
 //     block and drain(), the image the last timed frame rendered is read back
 //     (headless: the ring image last presented, still TRANSFER_SRC_OPTIMAL;
-//     windowed: the frame is rendered again at the same t through the
-//     offscreen path, as the reference frame).
+//     windowed: one more frame at the same t through the window's stages,
+//     its swapchain image, created with TRANSFER_SRC usage for this, copied
+//     to the readback buffer between rendering and presentation: a second,
+//     untimed submission PRESENT_SRC -> TRANSFER_SRC -> PRESENT_SRC that
+//     signals the render-done semaphore the present waits on).
 //   * Reference frame (render_reference_frame, the image check): in both
 //     modes it is rendered offscreen through the headless path of the stages
 //     above, into a ring image of Config width x height (windowed: a ring of
