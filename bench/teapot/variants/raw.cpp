@@ -120,7 +120,7 @@ public:
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
         draws_.resize(config.teapots);
-        index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        mesh_.index_count = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
         create_instance();
         create_device();
@@ -142,19 +142,19 @@ public:
             return;
         }
         for (;;) {
-            if (swapchain_stale_) recreate_swapchain();
+            if (window_sc_.stale) recreate_swapchain();
             VkResult result = call(&DeviceFunctions::vkAcquireNextImageKHR, ::vkAcquireNextImageKHR)(
-                device_, swapchain_, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
+                device_, window_sc_.swapchain, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
             if (result == VK_ERROR_OUT_OF_DATE_KHR) {
-                swapchain_stale_ = true;
+                window_sc_.stale = true;
                 continue;
             }
             if (result == VK_SUBOPTIMAL_KHR)
-                swapchain_stale_ = true;  // the image is still usable: re-created after its present
+                window_sc_.stale = true;  // the image is still usable: re-created after its present
             else check(result, "vkAcquireNextImageKHR");
             break;
         }
-        target_ = {swapchain_images_[image_], swapchain_views_[image_], swapchain_extent_,
+        target_ = {window_sc_.images[image_], window_sc_.views[image_], window_sc_.extent,
                    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
     }
 
@@ -213,15 +213,16 @@ public:
         call(&DeviceFunctions::vkCmdSetScissor, ::vkCmdSetScissor)(cmd, 0, 1, &scissor);
         call(&DeviceFunctions::vkCmdBindDescriptorSets, ::vkCmdBindDescriptorSets)(
             cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_layout_, 0, 1, &f.descriptor_set, 0, nullptr);
-        VkBuffer vertex_buffers[2] = {positions_, normals_};
+        VkBuffer vertex_buffers[2] = {mesh_.positions, mesh_.normals};
         VkDeviceSize offsets[2] = {0, 0};
         call(&DeviceFunctions::vkCmdBindVertexBuffers, ::vkCmdBindVertexBuffers)(cmd, 0, 2, vertex_buffers, offsets);
-        call(&DeviceFunctions::vkCmdBindIndexBuffer, ::vkCmdBindIndexBuffer)(cmd, indices_, 0, VK_INDEX_TYPE_UINT16);
+        call(&DeviceFunctions::vkCmdBindIndexBuffer, ::vkCmdBindIndexBuffer)(cmd, mesh_.indices, 0,
+                                                                             VK_INDEX_TYPE_UINT16);
         auto push = call(&DeviceFunctions::vkCmdPushConstants, ::vkCmdPushConstants);
         auto draw = call(&DeviceFunctions::vkCmdDrawIndexed, ::vkCmdDrawIndexed);
         for (const PushConstants& d : draws_) {
             push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof d, &d);
-            draw(cmd, index_count_, 1, 0, 0, 0);
+            draw(cmd, mesh_.index_count, 1, 0, 0, 0);
         }
         call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
 
@@ -245,7 +246,7 @@ public:
         if (present_to_window_) {
             wait.semaphore = f.acquire_semaphore;
             wait.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-            signal.semaphore = render_done_[image_];
+            signal.semaphore = window_sc_.render_done[image_];
             signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
             submit.waitSemaphoreInfoCount = 1;
             submit.pWaitSemaphoreInfos = &wait;
@@ -260,13 +261,13 @@ public:
         if (present_to_window_) {
             VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
             info.waitSemaphoreCount = 1;
-            info.pWaitSemaphores = &render_done_[image_];
+            info.pWaitSemaphores = &window_sc_.render_done[image_];
             info.swapchainCount = 1;
-            info.pSwapchains = &swapchain_;
+            info.pSwapchains = &window_sc_.swapchain;
             info.pImageIndices = &image_;
             VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(queue_, &info);
             if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
-                swapchain_stale_ = true;  // re-created at the next acquire
+                window_sc_.stale = true;  // re-created at the next acquire
             else check(result, "vkQueuePresentKHR");
         }
         presented_image_ = image_;
@@ -318,7 +319,7 @@ public:
         acquire();
         uniform();
         command();
-        if (swapchain_extent_.width != config_.width || swapchain_extent_.height != config_.height)
+        if (window_sc_.extent.width != config_.width || window_sc_.extent.height != config_.height)
             throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
         Frame& f = frames_[slot_];
         VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
@@ -336,14 +337,14 @@ public:
         check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
 
         begin_one_time(fn_, device_, f.pool, f.cmd);
-        const VkImage image = swapchain_images_[image_];
+        const VkImage image = window_sc_.images[image_];
         const VkImageMemoryBarrier2 to_copy = image_barrier(
             image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {swapchain_extent_.width, swapchain_extent_.height, 1};
+        region.imageExtent = {window_sc_.extent.width, window_sc_.extent.height, 1};
         fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
         const VkImageMemoryBarrier2 back = image_barrier(
             image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
@@ -361,7 +362,7 @@ public:
         check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
         cmd_info.commandBuffer = f.cmd;
         VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        signal.semaphore = render_done_[image_];
+        signal.semaphore = window_sc_.render_done[image_];
         signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
         VkSubmitInfo2 copy{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
         copy.commandBufferInfoCount = 1;
@@ -373,7 +374,7 @@ public:
         check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
         const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
         std::vector<std::uint8_t> bytes(pixels,
-                                        pixels + std::size_t(swapchain_extent_.width) * swapchain_extent_.height * 4);
+                                        pixels + std::size_t(window_sc_.extent.width) * window_sc_.extent.height * 4);
         to_rgba(bytes, colour_format_);
         present();
         wait();
@@ -386,9 +387,9 @@ public:
     const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
 
     std::string presentation() const override {
-        return config_.window
-                   ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(), swapchain_extent_)
-                   : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
+        return config_.window ? swapchain_presentation(colour_format_, window_sc_.present_mode,
+                                                       window_sc_.images.size(), window_sc_.extent)
+                              : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
     }
 
 private:
@@ -404,6 +405,25 @@ private:
         VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
         VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
         bool submitted = false;
+    };
+    // The mesh: three device-local buffers filled by a staging upload.
+    struct MeshBuffers {
+        VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE, indices = VK_NULL_HANDLE;
+        Allocation positions_memory, normals_memory, indices_memory;
+        std::uint32_t index_count = 0;
+    };
+    // Windowed: the surface, the swapchain by the convention's rule and its
+    // per-image objects.
+    struct WindowSwapchain {
+        VkSurfaceKHR surface = VK_NULL_HANDLE;
+        VkSurfaceFormatKHR surface_format{};
+        VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+        VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+        VkExtent2D extent{};
+        std::vector<VkImage> images;
+        std::vector<VkImageView> views;
+        std::vector<VkSemaphore> render_done;  // one per swapchain image
+        bool stale = false;                    // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
     };
     // What this frame renders into: a ring image or a swapchain image.
     struct Target {
@@ -484,7 +504,8 @@ private:
         }
         check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
         if (config_.window)
-            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &surface_), "glfwCreateWindowSurface");
+            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &window_sc_.surface),
+                  "glfwCreateWindowSurface");
         if (config_.validation) {
             auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
@@ -510,7 +531,7 @@ private:
             for (std::uint32_t i = 0; i < family_count; ++i) {
                 VkBool32 presents = VK_TRUE;
                 if (config_.window)
-                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, surface_, &presents),
+                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, window_sc_.surface, &presents),
                           "vkGetPhysicalDeviceSurfaceSupportKHR");
                 if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && presents) {
                     physical_device_ = candidate;
@@ -661,9 +682,10 @@ private:
     }
 
     void create_geometry(const Mesh& mesh) {
-        positions_ = create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, positions_memory_);
-        normals_ = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, normals_memory_);
-        indices_ = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, indices_memory_);
+        mesh_.positions =
+            create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.positions_memory);
+        mesh_.normals = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.normals_memory);
+        mesh_.indices = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, mesh_.indices_memory);
         uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
         uniform_buffer_ =
             create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, uniform_);
@@ -725,8 +747,8 @@ private:
     }
 
     void create_depth() {
-        depth_extent_ = {std::max(config_.width, swapchain_extent_.width),
-                         std::max(config_.height, swapchain_extent_.height)};
+        depth_extent_ = {std::max(config_.width, window_sc_.extent.width),
+                         std::max(config_.height, window_sc_.extent.height)};
         depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
                               depth_extent_);
     }
@@ -735,19 +757,19 @@ private:
     // mode are chosen once: the pipeline is made for the format.
     void create_swapchain() {
         std::uint32_t count = 0;
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, nullptr),
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, nullptr),
               "vkGetPhysicalDeviceSurfaceFormatsKHR");
         std::vector<VkSurfaceFormatKHR> formats(count);
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, formats.data()),
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, formats.data()),
               "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        surface_format_ = choose_window_format(formats);
-        colour_format_ = surface_format_.format;
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, nullptr),
+        window_sc_.surface_format = choose_window_format(formats);
+        colour_format_ = window_sc_.surface_format.format;
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, nullptr),
               "vkGetPhysicalDeviceSurfacePresentModesKHR");
         std::vector<VkPresentModeKHR> modes(count);
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, modes.data()),
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, modes.data()),
               "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        present_mode_ = choose_present_mode(modes);
+        window_sc_.present_mode = choose_present_mode(modes);
         while (!build_swapchain()) wait_window_events();
     }
 
@@ -755,62 +777,63 @@ private:
     // one (the device is idle); false while the surface has no area.
     bool build_swapchain() {
         VkSurfaceCapabilitiesKHR caps;
-        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, surface_, &caps),
+        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, window_sc_.surface, &caps),
               "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
         const VkExtent2D extent = swapchain_extent(config_, caps);
         if (extent.width == 0 || extent.height == 0) return false;
         VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
-        info.surface = surface_;
+        info.surface = window_sc_.surface;
         info.minImageCount = swapchain_image_request(config_, caps);
-        info.imageFormat = surface_format_.format;
-        info.imageColorSpace = surface_format_.colorSpace;
+        info.imageFormat = window_sc_.surface_format.format;
+        info.imageColorSpace = window_sc_.surface_format.colorSpace;
         info.imageExtent = extent;
         info.imageArrayLayers = 1;
         info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check
         info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
         info.preTransform = caps.currentTransform;
         info.compositeAlpha = composite_alpha(caps);
-        info.presentMode = present_mode_;
+        info.presentMode = window_sc_.present_mode;
         info.clipped = VK_TRUE;
-        info.oldSwapchain = swapchain_;
+        info.oldSwapchain = window_sc_.swapchain;
         VkSwapchainKHR swapchain = VK_NULL_HANDLE;
         const VkResult result = fn_.vkCreateSwapchainKHR(device_, &info, nullptr, &swapchain);
         destroy_swapchain();  // retired even if the creation failed
         check(result, "vkCreateSwapchainKHR");
-        swapchain_ = swapchain;
+        window_sc_.swapchain = swapchain;
         std::uint32_t count = 0;
-        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, nullptr), "vkGetSwapchainImagesKHR");
-        swapchain_images_.resize(count);
-        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, swapchain_images_.data()),
+        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, nullptr), "vkGetSwapchainImagesKHR");
+        window_sc_.images.resize(count);
+        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, window_sc_.images.data()),
               "vkGetSwapchainImagesKHR");
         VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-        for (VkImage image : swapchain_images_) {
-            swapchain_views_.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
-            render_done_.push_back(VK_NULL_HANDLE);
-            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &render_done_.back()), "vkCreateSemaphore");
+        for (VkImage image : window_sc_.images) {
+            window_sc_.views.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
+            window_sc_.render_done.push_back(VK_NULL_HANDLE);
+            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &window_sc_.render_done.back()),
+                  "vkCreateSemaphore");
         }
-        swapchain_extent_ = extent;
+        window_sc_.extent = extent;
         return true;
     }
 
     void recreate_swapchain() {
         check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle");
         while (!build_swapchain()) wait_window_events();
-        if (swapchain_extent_.width > depth_extent_.width || swapchain_extent_.height > depth_extent_.height) {
+        if (window_sc_.extent.width > depth_extent_.width || window_sc_.extent.height > depth_extent_.height) {
             destroy_image(depth_);
             create_depth();
         }
-        swapchain_stale_ = false;
+        window_sc_.stale = false;
     }
 
     void destroy_swapchain() {
-        for (VkImageView view : swapchain_views_) fn_.vkDestroyImageView(device_, view, nullptr);
-        for (VkSemaphore semaphore : render_done_) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
-        swapchain_views_.clear();
-        render_done_.clear();
-        swapchain_images_.clear();
-        if (swapchain_) fn_.vkDestroySwapchainKHR(device_, swapchain_, nullptr);
-        swapchain_ = VK_NULL_HANDLE;
+        for (VkImageView view : window_sc_.views) fn_.vkDestroyImageView(device_, view, nullptr);
+        for (VkSemaphore semaphore : window_sc_.render_done) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
+        window_sc_.views.clear();
+        window_sc_.render_done.clear();
+        window_sc_.images.clear();
+        if (window_sc_.swapchain) fn_.vkDestroySwapchainKHR(device_, window_sc_.swapchain, nullptr);
+        window_sc_.swapchain = VK_NULL_HANDLE;
     }
 
     VkShaderModule create_shader(std::span<const std::uint32_t> code) {
@@ -974,14 +997,15 @@ private:
                 fn_.vkDestroyBuffer(device_, buffer, nullptr);
                 fn_.vkFreeMemory(device_, allocation.memory, nullptr);  // unmaps implicitly
             };
-            destroy_buffer(positions_, positions_memory_);
-            destroy_buffer(normals_, normals_memory_);
-            destroy_buffer(indices_, indices_memory_);
+            destroy_buffer(mesh_.positions, mesh_.positions_memory);
+            destroy_buffer(mesh_.normals, mesh_.normals_memory);
+            destroy_buffer(mesh_.indices, mesh_.indices_memory);
             destroy_buffer(uniform_buffer_, uniform_);
             destroy_buffer(readback_buffer_, readback_);
             fn_.vkDestroyDevice(device_, nullptr);
         }
-        if (surface_) vkDestroySurfaceKHR(instance_, surface_, nullptr);  // before the window (a member) goes
+        if (window_sc_.surface)
+            vkDestroySurfaceKHR(instance_, window_sc_.surface, nullptr);  // before the window (a member) goes
         if (messenger_) {
             auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -993,7 +1017,6 @@ private:
     Config config_;
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
-    std::uint32_t index_count_ = 0;
 
     BenchWindow window_;  // windowed only; outlives the surface (destroy() runs first)
     VkInstance instance_ = VK_NULL_HANDLE;
@@ -1007,8 +1030,7 @@ private:
     DeviceFunctions fn_;
     VkQueue queue_ = VK_NULL_HANDLE;
 
-    VkBuffer positions_ = VK_NULL_HANDLE, normals_ = VK_NULL_HANDLE, indices_ = VK_NULL_HANDLE;
-    Allocation positions_memory_, normals_memory_, indices_memory_;
+    MeshBuffers mesh_;
     VkBuffer uniform_buffer_ = VK_NULL_HANDLE;
     Allocation uniform_;
     VkDeviceSize uniform_stride_ = 0;
@@ -1019,16 +1041,8 @@ private:
     VkExtent2D depth_extent_{};
     VkFormat colour_format_ = colour_format;  // windowed: the swapchain's
 
-    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-    VkSurfaceFormatKHR surface_format_{};
-    VkPresentModeKHR present_mode_ = VK_PRESENT_MODE_FIFO_KHR;
-    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
-    VkExtent2D swapchain_extent_{};
-    std::vector<VkImage> swapchain_images_;
-    std::vector<VkImageView> swapchain_views_;
-    std::vector<VkSemaphore> render_done_;  // one per swapchain image
-    bool swapchain_stale_ = false;          // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
-    bool present_to_window_ = false;        // windowed, except for the reference frame
+    WindowSwapchain window_sc_;       // windowed only
+    bool present_to_window_ = false;  // windowed, except for the reference frame
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;
