@@ -14,12 +14,14 @@ parser.add_argument("--budget", action="append", required=True, help="VARIANT:PC
 parser.add_argument("--relative", default="command,submit,wait")
 parser.add_argument("--absolute", default="acquire,uniform,present")
 parser.add_argument("--reference", default="raw-direct")
+parser.add_argument("--column", default="instructions_per_call",
+                    help="instructions_per_call (all, on the calling thread) or outside_driver_per_call")
 args = parser.parse_args()
 
 per_call = {}
 with open(args.csv) as f:
     for row in csv.DictReader(line for line in f if not line.startswith("#")):
-        per_call[(row["variant"], row["stage"])] = float(row["instructions_per_call"])
+        per_call[(row["variant"], row["stage"])] = float(row[args.column])
 
 failures, lines = [], []
 for budget in args.budget:

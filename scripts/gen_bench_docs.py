@@ -118,7 +118,8 @@ def instructions(pattern, pending):
         out += [f"Device: {m.get('device', '?')}; driver: {m.get('driver', '?')}; date: {m.get('date', '?')}; "
                 f"git: {m.get('git', '?')}; build: {m.get('build', '?')}. Data: `{r['path']}`.", "",
                 f"    {m.get('command', '?')}", "",
-                "Instructions per call (ratio to raw-direct):", "",
+                "Instructions per call (ratio to raw-direct); after the semicolon, those outside the driver "
+                "(the calls into the ICD and its libraries subtracted):", "",
                 "| stage | " + " | ".join(variants) + " |", "|---|" + "---:|" * len(variants)]
         for s in stages:
             cells = []
@@ -128,7 +129,12 @@ def instructions(pattern, pending):
                     cells.append("")
                     continue
                 ratio = f" ({float(x['ratio_to_ref']):.2f})" if x["ratio_to_ref"] and v != "raw-direct" else ""
-                cells.append(f"{float(x['instructions_per_call']):.0f}{ratio}")
+                cell = f"{float(x['instructions_per_call']):.0f}{ratio}"
+                if x.get("outside_driver_per_call"):
+                    o = float(x["outside_driver_per_call"])
+                    ratio = x["outside_driver_ratio_to_ref"]
+                    cell += f"; {o:.0f}" + (f" ({float(ratio):.2f})" if ratio and v != "raw-direct" else "")
+                cells.append(cell)
             out.append(f"| {s} | " + " | ".join(cells) + " |")
         out.append("")
     return out[:-1]
