@@ -1,13 +1,31 @@
-// The teapot draw-loop benchmark (issue 6): every variant draws the same
-// scene; stage times are measured in interleaved blocks, summarized against
-// raw with bootstrap intervals, and every variant's image is checked against
-// raw's. Run with --help for the options.
+// The teapot draw-loop benchmark (issues 6 and 12): every variant draws the
+// same scene; stage times are measured in interleaved blocks in shuffled
+// order, in --runs fresh processes, and summarized as block-wise ratios to
+// the reference raw-direct with intervals bootstrapped over blocks; an A/A
+// control (raw-direct-control) shows what the method resolves. Every
+// variant's last timed frame of every block is compared byte for byte with
+// raw-direct's. Run with --help for the options.
+//
+// The program is five steps (run() below): plan the configurations, run them
+// (in this process, or in --runs child processes that write their blocks to
+// files), analyse the pooled blocks, report (table, CSV, plots), exit status.
 #include "harness/plot.hpp"
 #include "harness/stats.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
+#include <sys/wait.h>
 #include <unistd.h>
+
+#if __has_include(<valgrind/callgrind.h>)
+#  include <valgrind/callgrind.h>
+#  define TEAPOT_HAS_CALLGRIND 1
+#else
+#  define CALLGRIND_TOGGLE_COLLECT
+#  define CALLGRIND_DUMP_STATS_AT(x)
+#  define RUNNING_ON_VALGRIND 0
+#  define TEAPOT_HAS_CALLGRIND 0
+#endif
 
 #include <algorithm>
 #include <chrono>
@@ -18,7 +36,9 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -28,51 +48,88 @@ namespace teapot {
 namespace {
 
 constexpr const char* stage_names[] = {"preinit", "acquire", "uniform", "command", "submit",
-                                       "present", "wait",    "update",  "frame"};
-constexpr int stage_count = 9;             // preinit, the seven per-frame stages, their sum
+                                       "present", "wait",    "update",  "frame",   "floor"};
+constexpr int stage_count = 10;            // preinit, the seven per-frame stages, their sum, the floor
 constexpr int frame_stages = 7;            // acquire .. update
 constexpr int frame_stage = 8;             // the sum of the seven
+constexpr int floor_stage = 9;             // an empty timed region, measured every frame
 constexpr double frame_step = 1.0 / 60.0;  // simulated seconds per frame
-constexpr double reference_time = 1.25;    // the image check's fixed time
+constexpr double reference_time = 1.25;    // the reference frame's time (PNG, tessellation error)
 constexpr int block_frames = 25;           // measured frames per variant per block
 constexpr int warmup_frames = 30;          // per variant, before the first block
 constexpr int preinit_rounds = 5;          // timed inits per variant
 constexpr int finest_tessellation = 32;    // the image error's reference level
+constexpr const char* reference_name = "raw-direct";
+constexpr const char* control_name = "raw-direct-control";
+
+// The overhead budget of issue 12 on the stages a timer resolves: the
+// interval's upper bound must be within it (and the control within 1 +- 0.01).
+std::optional<double> target_ratio(const std::string& variant, int stage) {
+    const std::string s = stage_names[stage];
+    if (s != "command" && s != "submit" && s != "wait") return std::nullopt;
+    if (variant == "vkrc-st") return 1.01;
+    if (variant == "vkrc-mt") return 1.03;
+    return std::nullopt;
+}
 
 struct Options {
     int frames = 2500;
+    int runs = 3;
     std::vector<std::string> variants;
     Config config;
     bool sweep = false;
+    bool instructions = false;
     std::string csv;
-    std::string png_dir = "teapot_png";
+    std::string out_dir;
+    std::optional<std::uint64_t> seed;
+    // Hidden: set by the parent for each child process.
+    std::string worker_out;
+    int worker_index = 0;
 };
+
+std::string default_out_dir() {
+    // Under the build directory: next to the executable (build/bench/teapot_out).
+    std::error_code error;
+    std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+    if (error) return "teapot_out";
+    return (exe.parent_path() / "teapot_out").string();
+}
 
 [[noreturn]] void usage(const std::string& problem) {
     std::fprintf(stderr,
                  "teapot: %s\n"
-                 "usage: teapot [--frames N] [--variants a,b,...] [--teapots N] [--frames-in-flight N]\n"
-                 "              [--uniform-writes N] [--tessellation N] [--sweep] [--csv PATH]\n"
-                 "              [--png-dir DIR] [--size WxH] [--validation] [--window]\n"
+                 "usage: teapot [--frames N] [--runs N] [--seed N] [--variants a,b,...] [--teapots N]\n"
+                 "              [--frames-in-flight N] [--uniform-writes N] [--tessellation N] [--sweep]\n"
+                 "              [--csv PATH] [--out-dir DIR] [--size WxH] [--validation] [--window]\n"
+                 "              [--instructions]\n"
+                 "--runs N: N fresh processes (default 3), their blocks pooled; --seed fixes the shuffles\n"
+                 "--out-dir: plots, frames and the CSV (default: teapot_out next to this executable);\n"
+                 "           --png-dir is the old name\n"
                  "--window: each variant presents to its own window through a swapchain (needs a display,\n"
                  "          e.g. tests/with_xvfb.sh); the default renders headless into a ring of images\n"
-                 "variants:",
+                 "--instructions: for callgrind (bench/instructions.sh): --frames calls of each stage per\n"
+                 "          variant, each stage collected on its own and dumped\n"
+                 "variants (raw-direct, the reference, and its A/A control always run):",
                  problem.c_str());
     for (const auto& entry : variant_registry()) std::fprintf(stderr, " %s", std::string(entry.name).c_str());
     std::fprintf(stderr, "\n");
     std::exit(2);
 }
 
-int positive(const std::string& option, const std::string& value) {
+long long integer(const std::string& option, const std::string& value, long long low, long long high) {
     char* end = nullptr;
-    long v = std::strtol(value.c_str(), &end, 10);
-    if (*end != '\0' || v < 1 || v > 1000000) usage(option + " needs a positive integer, not '" + value + "'");
-    return int(v);
+    long long v = std::strtoll(value.c_str(), &end, 10);
+    if (value.empty() || *end != '\0' || v < low || v > high)
+        usage(option + " needs an integer in [" + std::to_string(low) + ", " + std::to_string(high) + "], not '" +
+              value + "'");
+    return v;
 }
+
+int positive(const std::string& option, const std::string& value) { return int(integer(option, value, 1, 1000000)); }
 
 Options parse(int argc, char** argv) {
     Options o;
-    for (const auto& entry : variant_registry()) o.variants.emplace_back(entry.name);
+    bool variants_given = false;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -80,7 +137,10 @@ Options parse(int argc, char** argv) {
             return argv[++i];
         };
         if (a == "--frames") o.frames = positive(a, value());
+        else if (a == "--runs") o.runs = positive(a, value());
+        else if (a == "--seed") o.seed = std::uint64_t(integer(a, value(), 0, (1LL << 62)));
         else if (a == "--variants") {
+            variants_given = true;
             o.variants.clear();
             std::stringstream list(value());
             for (std::string name; std::getline(list, name, ',');) {
@@ -96,8 +156,9 @@ Options parse(int argc, char** argv) {
         else if (a == "--uniform-writes") o.config.uniform_writes = positive(a, value());
         else if (a == "--tessellation") o.config.tessellation = positive(a, value());
         else if (a == "--sweep") o.sweep = true;
+        else if (a == "--instructions") o.instructions = true;
         else if (a == "--csv") o.csv = value();
-        else if (a == "--png-dir") o.png_dir = value();
+        else if (a == "--out-dir" || a == "--png-dir") o.out_dir = value();
         else if (a == "--size") {
             std::string v = value();
             auto x = v.find('x');
@@ -106,12 +167,21 @@ Options parse(int argc, char** argv) {
             o.config.height = std::uint32_t(positive(a, v.substr(x + 1)));
         } else if (a == "--validation") o.config.validation = true;
         else if (a == "--window") o.config.window = true;
+        else if (a == "--worker-out") o.worker_out = value();
+        else if (a == "--worker-index") o.worker_index = int(integer(a, value(), 0, 1000000));
         else if (a == "--help" || a == "-h") usage("help");
         else usage("unknown option '" + a + "'");
     }
-    // The reference variant comes first so every ratio has its denominator.
-    std::stable_partition(o.variants.begin(), o.variants.end(),
-                          [](const std::string& n) { return n == variant_registry().front().name; });
+    if (!variants_given)
+        for (const auto& entry : variant_registry()) o.variants.emplace_back(entry.name);
+    // The reference first, then its control (timing runs): every ratio has
+    // its denominator and every image its comparison.
+    std::erase(o.variants, std::string(reference_name));
+    std::erase(o.variants, std::string(control_name));
+    if (!o.instructions) o.variants.insert(o.variants.begin(), control_name);
+    o.variants.insert(o.variants.begin(), reference_name);
+    if (o.out_dir.empty()) o.out_dir = default_out_dir();
+    if (o.csv.empty()) o.csv = o.out_dir + "/teapot.csv";
     return o;
 }
 
@@ -121,30 +191,45 @@ std::string config_tag(const Config& c) {
     return tag;
 }
 
-struct VariantResult {
+// ---- The data one process measures -------------------------------------
+
+using Block = std::vector<double>;  // microseconds, one sample per frame (preinit: one per round)
+
+struct VariantRun {
     std::string name;
-    std::vector<double> stage_us[stage_count];  // preinit holds preinit_rounds samples
-    std::vector<std::uint8_t> image;
     std::string presentation;
-    std::size_t differing_pixels = 0;
-    int max_channel_difference = 0;
+    std::vector<Block> blocks[stage_count];
+    int image_blocks = 0;             // blocks whose last frame was compared
+    int image_mismatch_blocks = 0;    // ... and differed from raw-direct's
+    std::size_t worst_pixels = 0;     // most differing pixels in one block
+    int worst_channel = 0;            // largest channel difference seen
+    std::vector<std::uint8_t> image;  // the reference frame (this process only)
 };
 
-struct ConfigResult {
+struct ConfigRun {
     Config config;
     int frames = 0;
-    std::vector<VariantResult> variants;
-    std::optional<GeometricError> geometric;
-    double error_pixels = 0;  // geometric max error projected to pixels
+    std::vector<VariantRun> variants;  // in Options::variants order: reference first
     std::optional<std::size_t> image_error_pixels;
     int image_error_channel = 0;
 };
 
+struct RunData {
+    std::string device;
+    std::uint64_t seed = 0;
+    std::vector<ConfigRun> configs;
+};
+
+struct PlannedConfig {
+    Config config;
+    int frames = 0;
+};
+
 std::pair<std::size_t, int> compare_images(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b) {
-    if (a.size() != b.size()) return {a.size() / 4, 255};
+    if (a.size() != b.size()) return {std::max(a.size(), b.size()) / 4, 255};
     std::size_t differing = 0;
     int max_difference = 0;
-    for (std::size_t p = 0; p < a.size(); p += 4) {
+    for (std::size_t p = 0; p + 3 < a.size(); p += 4) {
         int d = 0;
         for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(int(a[p + c]) - int(b[p + c])));
         if (d) ++differing;
@@ -182,65 +267,112 @@ private:
     bool tty_;
 };
 
-ConfigResult run_configuration(const Options& options, const Config& config, int frames, std::map<int, Mesh>& meshes,
-                               int index, int total) {
+// ---- Step 1: plan -------------------------------------------------------
+
+// The configurations: the one given, or the sweep, varying one setting at a
+// time from the given one. Larger scenes get proportionally fewer frames (at
+// least 40) so a sweep stays within minutes.
+std::vector<PlannedConfig> plan(const Options& options) {
+    std::vector<PlannedConfig> configs{{options.config, options.frames}};
+    if (!options.sweep) return configs;
+    auto add = [&](Config c) {
+        for (const PlannedConfig& existing : configs)
+            if (config_tag(existing.config) == config_tag(c)) return;
+        int scaled = std::max(40, int(std::int64_t(options.frames) * 25 / std::max(25, c.teapots)));
+        configs.push_back({c, std::min(options.frames, scaled)});
+    };
+    auto vary = [&](auto field, std::initializer_list<int> values) {
+        for (int value : values) {
+            Config c = options.config;
+            c.*field = value;
+            add(c);
+        }
+    };
+    vary(&Config::teapots, {25, 250, 2500});
+    vary(&Config::frames_in_flight, {1, 2});
+    vary(&Config::uniform_writes, {1, 1000});
+    vary(&Config::tessellation, {2, 4, 8, 16, 32});
+    return configs;
+}
+
+// ---- Step 2: run --------------------------------------------------------
+
+std::unique_ptr<Variant> make_variant(const std::string& name) {
+    for (const auto& entry : variant_registry())
+        if (entry.name == name) return entry.make();
+    throw std::runtime_error("no variant " + name);
+}
+
+// One frame of a variant through the stages, timed: marks[0..1] is the
+// empty region (the floor), then one mark after each stage.
+struct FrameTimes {
+    double stage_us[stage_count] = {};
+};
+
+FrameTimes timed_frame(Variant& variant, double t_next) {
     using clock = std::chrono::steady_clock;
+    clock::time_point marks[frame_stages + 2];
+    marks[0] = clock::now();
+    marks[1] = clock::now();
+    variant.acquire();
+    marks[2] = clock::now();
+    variant.uniform();
+    marks[3] = clock::now();
+    variant.command();
+    marks[4] = clock::now();
+    variant.submit();
+    marks[5] = clock::now();
+    variant.present();
+    marks[6] = clock::now();
+    variant.wait();
+    marks[7] = clock::now();
+    variant.update(t_next);
+    marks[8] = clock::now();
+    auto us = [](clock::time_point a, clock::time_point b) {
+        return std::chrono::duration<double, std::micro>(b - a).count();
+    };
+    FrameTimes f;
+    for (int s = 0; s < frame_stages; ++s) f.stage_us[s + 1] = us(marks[s + 1], marks[s + 2]);
+    f.stage_us[frame_stage] = us(marks[1], marks[8]);
+    f.stage_us[floor_stage] = us(marks[0], marks[1]);
+    return f;
+}
+
+template <typename Rng>
+std::vector<std::size_t> shuffled_order(std::size_t n, Rng& rng) {
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::shuffle(order.begin(), order.end(), rng);
+    return order;
+}
+
+ConfigRun measure_configuration(const Options& options, const PlannedConfig& planned, std::map<int, Mesh>& meshes,
+                                std::mt19937_64& rng, int index, int total, std::string& device) {
+    const Config& config = planned.config;
     auto mesh_it = meshes.find(config.tessellation);
     if (mesh_it == meshes.end())
         mesh_it = meshes.emplace(config.tessellation, tessellate(newell_teapot(), config.tessellation)).first;
     SceneData scene{&mesh_it->second, camera(config.teapots, config.width, config.height)};
 
-    ConfigResult result;
+    ConfigRun result;
     result.config = config;
-    result.frames = frames;
-    std::vector<std::unique_ptr<Variant>> variants(options.variants.size());
-    std::vector<std::uint64_t> frame_counters(options.variants.size(), 0);
-    for (const std::string& name : options.variants) {
-        VariantResult r;
-        r.name = name;
-        result.variants.push_back(std::move(r));
-    }
-    // preinit: an untimed round first (the process's first instance pays for
-    // loading the driver), then preinit_rounds timed ones in rotating order,
-    // tearing down all but the last round's variants.
-    for (int round = 0; round <= preinit_rounds; ++round)
-        for (std::size_t k = 0; k < variants.size(); ++k) {
-            std::size_t v = (k + std::size_t(round)) % variants.size();
-            variants[v].reset();
-            for (const auto& entry : variant_registry())
-                if (entry.name == options.variants[v]) variants[v] = entry.make();
-            auto start = clock::now();
-            variants[v]->init(config, scene);
-            double us = std::chrono::duration<double, std::micro>(clock::now() - start).count();
-            if (round > 0) result.variants[v].stage_us[0].push_back(us);
-        }
+    result.frames = planned.frames;
+    const std::size_t n = options.variants.size();
+    std::vector<std::unique_ptr<Variant>> variants(n);
+    for (const std::string& name : options.variants) result.variants.push_back({.name = name});
 
-    // One frame of variant v; records its stages unless discarded.
-    auto run_frame = [&](std::size_t v, bool record) {
-        Variant& variant = *variants[v];
-        double t_next = double(++frame_counters[v]) * frame_step;
-        clock::time_point marks[frame_stages + 1];
-        marks[0] = clock::now();
-        variant.acquire();
-        marks[1] = clock::now();
-        variant.uniform();
-        marks[2] = clock::now();
-        variant.command();
-        marks[3] = clock::now();
-        variant.submit();
-        marks[4] = clock::now();
-        variant.present();
-        marks[5] = clock::now();
-        variant.wait();
-        marks[6] = clock::now();
-        variant.update(t_next);
-        marks[7] = clock::now();
-        if (!record) return;
-        auto& stages = result.variants[v].stage_us;
-        for (int s = 0; s < frame_stages; ++s)
-            stages[s + 1].push_back(std::chrono::duration<double, std::micro>(marks[s + 1] - marks[s]).count());
-        stages[frame_stage].push_back(std::chrono::duration<double, std::micro>(marks[7] - marks[0]).count());
-    };
+    // preinit: an untimed round first (the process's first instance pays for
+    // loading the driver), then preinit_rounds timed ones, each in a
+    // shuffled device-creation order, tearing down all but the last round's.
+    for (int round = 0; round <= preinit_rounds; ++round)
+        for (std::size_t v : shuffled_order(n, rng)) {
+            variants[v].reset();
+            variants[v] = make_variant(options.variants[v]);
+            auto start = std::chrono::steady_clock::now();
+            variants[v]->init(config, scene);
+            double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+            if (round > 0) result.variants[v].blocks[0].push_back({us});
+        }
 
     // Windowed: the variant about to run goes on top (harness/window.hpp says why).
     auto bring_to_front = [&](std::size_t v) {
@@ -250,249 +382,519 @@ ConfigResult run_configuration(const Options& options, const Config& config, int
     };
 
     Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
-    for (std::size_t v = 0; v < variants.size(); ++v) {
+    for (std::size_t v : shuffled_order(n, rng)) {
         bring_to_front(v);
         variants[v]->update(0.0);
-        for (int f = 0; f < warmup_frames; ++f) run_frame(v, false);
+        for (int f = 0; f < warmup_frames; ++f) timed_frame(*variants[v], double(f + 1) * frame_step);
         variants[v]->drain();
     }
-    // Interleaved blocks, the starting variant rotating from block to block
-    // so that no variant always follows the same one. Each block begins on
-    // an idle device, so its first frames_in_flight frames (refilling the
-    // queue) are discarded too.
-    int blocks = (frames + block_frames - 1) / block_frames;
+    // Interleaved blocks in a shuffled order per round. Every variant
+    // renders the same times in a round, starting on an idle device, so the
+    // first frames_in_flight frames (refilling the queue) are not recorded.
+    // After the round, each variant's last timed frame (all at the same t)
+    // is read back and compared with the reference's.
+    const int blocks = (planned.frames + block_frames - 1) / block_frames;
+    double t_round = double(warmup_frames) * frame_step;
     for (int b = 0; b < blocks; ++b) {
-        int in_block = std::min(block_frames, frames - b * block_frames);
-        for (std::size_t k = 0; k < variants.size(); ++k) {
-            std::size_t v = (k + std::size_t(b)) % variants.size();
+        const int in_block = std::min(block_frames, planned.frames - b * block_frames);
+        const int frames_run = config.frames_in_flight + in_block;
+        for (std::size_t v : shuffled_order(n, rng)) {
             bring_to_front(v);  // untimed, between blocks
-            for (int f = 0; f < config.frames_in_flight; ++f) run_frame(v, false);
-            for (int f = 0; f < in_block; ++f) run_frame(v, true);
-            variants[v]->drain();
+            Variant& variant = *variants[v];
+            variant.update(t_round);
+            Block block[stage_count];
+            for (int f = 0; f < frames_run; ++f) {
+                FrameTimes times = timed_frame(variant, t_round + double(f + 1) * frame_step);
+                if (f < config.frames_in_flight) continue;
+                for (int s = 1; s < stage_count; ++s) block[s].push_back(times.stage_us[s]);
+            }
+            variant.drain();
+            for (int s = 1; s < stage_count; ++s) result.variants[v].blocks[s].push_back(std::move(block[s]));
         }
+        const double t_last = t_round + double(frames_run - 1) * frame_step;
+        const std::vector<std::uint8_t> reference = variants[0]->read_back_last_frame(t_last);
+        if (config.window) {
+            // The presented image must also be the offscreen frame at that t.
+            auto [differing, channel] = compare_images(variants[0]->render_reference_frame(t_last), reference);
+            if (differing) ++result.variants[0].image_mismatch_blocks;
+            result.variants[0].worst_pixels = std::max(result.variants[0].worst_pixels, differing);
+            result.variants[0].worst_channel = std::max(result.variants[0].worst_channel, channel);
+        }
+        for (std::size_t v = 0; v < n; ++v) {
+            VariantRun& r = result.variants[v];
+            auto [differing, channel] =
+                compare_images(v ? variants[v]->read_back_last_frame(t_last) : reference, reference);
+            ++r.image_blocks;
+            if (differing) ++r.image_mismatch_blocks;
+            r.worst_pixels = std::max(r.worst_pixels, differing);
+            r.worst_channel = std::max(r.worst_channel, channel);
+        }
+        t_round += double(frames_run + 1) * frame_step;
         progress.show(b + 1, blocks);
     }
 
-    for (std::size_t v = 0; v < variants.size(); ++v) {
+    for (std::size_t v = 0; v < n; ++v) {
         result.variants[v].presentation = variants[v]->presentation();
         result.variants[v].image = variants[v]->render_reference_frame(reference_time);
         auto [differing, channel] = compare_images(result.variants[v].image, result.variants[0].image);
-        result.variants[v].differing_pixels = differing;
-        result.variants[v].max_channel_difference = channel;
+        ++result.variants[v].image_blocks;
+        if (differing) ++result.variants[v].image_mismatch_blocks;
+        result.variants[v].worst_pixels = std::max(result.variants[v].worst_pixels, differing);
+        result.variants[v].worst_channel = std::max(result.variants[v].worst_channel, channel);
     }
-    if (index == 0) std::printf("device: %s\n", variants[0]->device_name().c_str());
+    if (device.empty()) device = variants[0]->device_name();
     variants.clear();  // teardown, inside the validation check
     return result;
 }
 
-void print_table(const ConfigResult& r) {
-    const Config& c = r.config;
-    std::printf(
-        "\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %ux%u, "
-        "%d frames per variant\n",
-        c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
-        std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, r.frames);
-    std::printf("presentation: %s\n", r.variants[0].presentation.c_str());
-    for (const VariantResult& v : r.variants)
-        if (v.presentation != r.variants[0].presentation)
-            std::printf("presentation of %s DIFFERS: %s\n", v.name.c_str(), v.presentation.c_str());
-    std::printf("%-8s %-11s %11s %11s %11s %8s %19s\n", "stage", "variant", "median_us", "p5_us", "p95_us", "ratio",
-                "95% CI");
-    for (int s = 0; s < stage_count; ++s)
-        for (const VariantResult& v : r.variants) {
-            Summary sum = summarize(v.stage_us[s]);
-            Ratio ratio = bootstrap_ratio(v.stage_us[s], r.variants[0].stage_us[s]);
-            std::printf("%-8s %-11s %11.2f %11.2f %11.2f %8.3f   [%6.3f, %6.3f]\n", stage_names[s], v.name.c_str(),
-                        sum.median, sum.p5, sum.p95, ratio.ratio, ratio.low, ratio.high);
-        }
-    for (const VariantResult& v : r.variants)
-        std::printf("image    %-11s %s (%zu pixels differ from %s, max channel difference %d)\n", v.name.c_str(),
-                    v.differing_pixels == 0 ? "identical" : "DIFFERS", v.differing_pixels, r.variants[0].name.c_str(),
-                    v.max_channel_difference);
-    if (r.geometric)
-        std::printf("geometric error: max %.3g, rms %.3g model units; max %.3g pixels at the nearest teapot\n",
-                    r.geometric->max, r.geometric->rms, r.error_pixels);
+void write_frames(const std::string& dir, const ConfigRun& r) {
+    for (const VariantRun& v : r.variants)
+        write_png(dir + "/frame_" + config_tag(r.config) + "_" + v.name + ".png", r.config.width, r.config.height,
+                  v.image);
 }
 
-// The issue's columns first, then the speed-against-error columns (filled
-// for the configurations that vary only the tessellation). frames is the
-// number of samples behind the row: preinit_rounds for preinit.
-void write_csv(const std::string& path, const std::vector<ConfigResult>& results) {
+// Every configuration in this process, with the sweep's image error (each
+// level's reference frame against the finest level's).
+RunData measure(const Options& options, const std::vector<PlannedConfig>& configs, std::uint64_t seed) {
+    RunData data;
+    data.seed = seed;
+    std::mt19937_64 rng(seed);
+    std::map<int, Mesh> meshes;
+    for (std::size_t i = 0; i < configs.size(); ++i)
+        data.configs.push_back(
+            measure_configuration(options, configs[i], meshes, rng, int(i), int(configs.size()), data.device));
+    Config finest_config = options.config;
+    finest_config.tessellation = finest_tessellation;
+    const ConfigRun* finest = nullptr;
+    for (const ConfigRun& r : data.configs)
+        if (config_tag(r.config) == config_tag(finest_config)) finest = &r;
+    for (ConfigRun& r : data.configs) {
+        Config level = options.config;
+        level.tessellation = r.config.tessellation;
+        if (!finest || config_tag(r.config) != config_tag(level)) continue;
+        auto [differing, channel] = compare_images(r.variants[0].image, finest->variants[0].image);
+        r.image_error_pixels = differing;
+        r.image_error_channel = channel;
+    }
+    if (options.worker_index == 0) {
+        std::filesystem::create_directories(options.out_dir);
+        for (const ConfigRun& r : data.configs) write_frames(options.out_dir, r);
+    }
+    return data;
+}
+
+// A child's blocks travel to the parent as text, one line per block.
+void save(const RunData& data, const std::string& path) {
+    std::ofstream out(path);
+    out.precision(17);
+    out << "teapot-run 1\nseed " << data.seed << "\ndevice " << data.device << "\n";
+    for (const ConfigRun& r : data.configs) {
+        const Config& c = r.config;
+        out << "config " << c.teapots << ' ' << c.frames_in_flight << ' ' << c.uniform_writes << ' ' << c.tessellation
+            << ' ' << c.width << ' ' << c.height << ' ' << r.frames << ' '
+            << (r.image_error_pixels ? std::int64_t(*r.image_error_pixels) : -1) << ' ' << r.image_error_channel
+            << "\n";
+        for (const VariantRun& v : r.variants) {
+            out << "variant " << v.name << ' ' << v.image_blocks << ' ' << v.image_mismatch_blocks << ' '
+                << v.worst_pixels << ' ' << v.worst_channel << "\npresentation " << v.presentation << "\n";
+            for (int s = 0; s < stage_count; ++s)
+                for (const Block& block : v.blocks[s]) {
+                    out << "block " << s << ' ' << block.size();
+                    for (double x : block) out << ' ' << x;
+                    out << "\n";
+                }
+        }
+    }
+    out << "end\n";
+    if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+RunData load(const std::string& path, const Config& base) {
+    std::ifstream in(path);
+    RunData data;
+    bool complete = false;
+    for (std::string line; std::getline(in, line);) {
+        std::istringstream fields(line);
+        std::string key;
+        fields >> key;
+        auto rest = [&] {
+            std::string text;
+            std::getline(fields >> std::ws, text);
+            return text;
+        };
+        if (key == "seed") fields >> data.seed;
+        else if (key == "device") data.device = rest();
+        else if (key == "config") {
+            ConfigRun r;
+            r.config = base;
+            std::int64_t image_error = -1;
+            fields >> r.config.teapots >> r.config.frames_in_flight >> r.config.uniform_writes >>
+                r.config.tessellation >> r.config.width >> r.config.height >> r.frames >> image_error >>
+                r.image_error_channel;
+            if (image_error >= 0) r.image_error_pixels = std::size_t(image_error);
+            data.configs.push_back(std::move(r));
+        } else if (key == "variant") {
+            VariantRun v;
+            fields >> v.name >> v.image_blocks >> v.image_mismatch_blocks >> v.worst_pixels >> v.worst_channel;
+            data.configs.back().variants.push_back(std::move(v));
+        } else if (key == "presentation") data.configs.back().variants.back().presentation = rest();
+        else if (key == "block") {
+            int stage = 0;
+            std::size_t count = 0;
+            fields >> stage >> count;
+            Block block(count);
+            for (double& x : block) fields >> x;
+            if (stage < 0 || stage >= stage_count || !fields) throw std::runtime_error("bad block line in " + path);
+            data.configs.back().variants.back().blocks[stage].push_back(std::move(block));
+        } else if (key == "end") complete = true;
+    }
+    if (!complete) throw std::runtime_error(path + " is incomplete");
+    return data;
+}
+
+// --runs N > 1: this program again, N times in turn, each a fresh process
+// with fresh devices and its own seed, writing its blocks to a file.
+std::vector<RunData> run_processes(const Options& options, int argc, char** argv, std::uint64_t seed) {
+    if (options.runs == 1) return {measure(options, plan(options), seed)};
+    const std::string exe = std::filesystem::read_symlink("/proc/self/exe").string();
+    const std::filesystem::path dir = std::filesystem::path(options.out_dir) / "runs";
+    std::filesystem::create_directories(dir);
+    std::vector<RunData> runs;
+    for (int i = 0; i < options.runs; ++i) {
+        const std::string file = (dir / ("run-" + std::to_string(i) + ".txt")).string();
+        std::filesystem::remove(file);
+        std::vector<std::string> args{exe};
+        for (int a = 1; a < argc; ++a) {
+            std::string arg = argv[a];
+            if (arg == "--seed" || arg == "--runs") {
+                ++a;
+                continue;
+            }
+            args.push_back(arg);
+        }
+        for (std::string extra : {"--runs", "1", "--seed", "", "--worker-out", "", "--worker-index", ""})
+            args.push_back(extra);
+        args[args.size() - 5] = std::to_string(seed + std::uint64_t(i));
+        args[args.size() - 3] = file;
+        args[args.size() - 1] = std::to_string(i);
+        std::vector<char*> child_argv;
+        for (std::string& arg : args) child_argv.push_back(arg.data());
+        child_argv.push_back(nullptr);
+        std::printf("run %d/%d: seed %llu\n", i + 1, options.runs, (unsigned long long)(seed + std::uint64_t(i)));
+        std::fflush(stdout);
+        pid_t pid = fork();
+        if (pid < 0) throw std::runtime_error("fork failed");
+        if (pid == 0) {
+            execv(exe.c_str(), child_argv.data());
+            _exit(127);
+        }
+        int status = 0;
+        waitpid(pid, &status, 0);
+        if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+            throw std::runtime_error("run " + std::to_string(i + 1) + " failed (its messages are above)");
+        runs.push_back(load(file, options.config));
+    }
+    return runs;
+}
+
+// ---- Step 3: analyse ----------------------------------------------------
+
+struct StageRow {
+    std::string variant;
+    int stage = 0;
+    std::size_t samples = 0;
+    std::size_t blocks = 0;
+    Summary summary;
+    Ratio to_ref;
+    std::optional<Ratio> to_raw;
+    double floor_us = 0;
+    std::optional<double> above_floor_ns;
+    std::optional<double> target;
+    std::string verdict;
+};
+
+struct VariantImages {
+    std::string name;
+    int blocks = 0, mismatches = 0;
+    std::size_t worst_pixels = 0;
+    int worst_channel = 0;
+};
+
+struct ConfigAnalysis {
+    Config config;
+    int frames = 0;
+    int runs = 0;
+    std::vector<std::string> variants;
+    std::vector<std::string> presentations;
+    std::vector<StageRow> rows;
+    std::vector<VariantImages> images;
+    std::vector<std::vector<double>> samples[stage_count];  // [stage][variant]: all runs pooled, for the plots
+    std::optional<GeometricError> geometric;
+    double error_pixels = 0;
+    std::optional<std::size_t> image_error_pixels;
+    int image_error_channel = 0;
+};
+
+double median_of(const Block& block) { return quantile(block, 0.5); }
+
+// ratios[run][block]: a variant's block median over the neighbouring (same
+// round) block median of `against`.
+std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, std::size_t config, std::size_t v,
+                                              std::size_t against, int stage) {
+    std::vector<std::vector<double>> ratios;
+    for (const RunData& run : runs) {
+        const ConfigRun& r = run.configs.at(config);
+        const auto& mine = r.variants.at(v).blocks[stage];
+        const auto& theirs = r.variants.at(against).blocks[stage];
+        std::vector<double> per_block;
+        for (std::size_t b = 0; b < std::min(mine.size(), theirs.size()); ++b) {
+            double denominator = median_of(theirs[b]);
+            if (denominator > 0) per_block.push_back(median_of(mine[b]) / denominator);
+        }
+        ratios.push_back(std::move(per_block));
+    }
+    return ratios;
+}
+
+std::vector<ConfigAnalysis> analyse(const std::vector<RunData>& runs, const Options& options) {
+    std::vector<ConfigAnalysis> out;
+    std::map<int, Mesh> meshes;
+    const RunData& first = runs.at(0);
+    for (std::size_t c = 0; c < first.configs.size(); ++c) {
+        const ConfigRun& base = first.configs[c];
+        ConfigAnalysis a;
+        a.config = base.config;
+        a.frames = base.frames;
+        a.runs = int(runs.size());
+        a.image_error_pixels = base.image_error_pixels;
+        a.image_error_channel = base.image_error_channel;
+        std::optional<std::size_t> raw;
+        for (std::size_t v = 0; v < base.variants.size(); ++v) {
+            a.variants.push_back(base.variants[v].name);
+            a.presentations.push_back(base.variants[v].presentation);
+            if (base.variants[v].name == "raw") raw = v;
+        }
+        for (int s = 0; s < stage_count; ++s) a.samples[s].resize(base.variants.size());
+        for (std::size_t v = 0; v < base.variants.size(); ++v) {
+            VariantImages images{base.variants[v].name};
+            for (const RunData& run : runs) {
+                const VariantRun& vr = run.configs.at(c).variants.at(v);
+                if (vr.name != images.name) throw std::runtime_error("runs disagree on the variants");
+                images.blocks += vr.image_blocks;
+                images.mismatches += vr.image_mismatch_blocks;
+                images.worst_pixels = std::max(images.worst_pixels, vr.worst_pixels);
+                images.worst_channel = std::max(images.worst_channel, vr.worst_channel);
+                for (int s = 0; s < stage_count; ++s)
+                    for (const Block& block : vr.blocks[s])
+                        a.samples[s][v].insert(a.samples[s][v].end(), block.begin(), block.end());
+            }
+            a.images.push_back(images);
+        }
+        const double floor_us = quantile(a.samples[floor_stage][0], 0.5);
+        for (int s = 0; s < stage_count; ++s)
+            for (std::size_t v = 0; v < base.variants.size(); ++v) {
+                StageRow row;
+                row.variant = a.variants[v];
+                row.stage = s;
+                row.samples = a.samples[s][v].size();
+                row.summary = summarize(a.samples[s][v]);
+                auto ref_ratios = block_ratios(runs, c, v, 0, s);
+                for (const auto& run : ref_ratios) row.blocks += run.size();
+                row.to_ref = block_bootstrap_ratio(ref_ratios);
+                if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, c, v, *raw, s));
+                row.floor_us = floor_us;
+                if (s >= 1 && s <= frame_stages) row.above_floor_ns = (row.summary.median - floor_us) * 1000.0;
+                row.target = target_ratio(row.variant, s);
+                a.rows.push_back(row);
+            }
+        // Verdicts: a target counts as met only when the variant's upper
+        // bound is within it and the control's interval lies in 1 +- 0.01.
+        for (StageRow& row : a.rows) {
+            if (!row.target) continue;
+            const StageRow* control = nullptr;
+            for (const StageRow& other : a.rows)
+                if (other.variant == control_name && other.stage == row.stage) control = &other;
+            const bool resolved = control && control->to_ref.low >= 0.99 && control->to_ref.high <= 1.01;
+            row.verdict = resolved && row.to_ref.high <= *row.target ? "met" : "not resolved";
+        }
+        if (a.config.teapots == options.config.teapots &&
+            a.config.frames_in_flight == options.config.frames_in_flight &&
+            a.config.uniform_writes == options.config.uniform_writes) {
+            auto it = meshes.emplace(a.config.tessellation, tessellate(newell_teapot(), a.config.tessellation)).first;
+            a.geometric = geometric_error(newell_teapot(), it->second);
+            a.error_pixels = a.geometric->max * pixels_per_unit(a.config);
+        }
+        out.push_back(std::move(a));
+    }
+    return out;
+}
+
+// ---- Step 4: report -----------------------------------------------------
+
+std::string format_ratio(const Ratio& r) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%6.3f [%6.3f, %6.3f]", r.ratio, r.low, r.high);
+    return text;
+}
+
+void print_table(const ConfigAnalysis& a) {
+    const Config& c = a.config;
+    std::printf(
+        "\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %ux%u, "
+        "%d frames per variant per run, %d runs\n",
+        c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
+        std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, a.frames, a.runs);
+    std::printf("presentation: %s\n", a.presentations[0].c_str());
+    for (std::size_t v = 0; v < a.variants.size(); ++v)
+        if (a.presentations[v] != a.presentations[0])
+            std::printf("presentation of %s DIFFERS: %s\n", a.variants[v].c_str(), a.presentations[v].c_str());
+    std::printf("floor (empty timed region, %s): %.0f ns; ratios are block-wise to %s, 95%% CI over blocks and runs\n",
+                reference_name, a.rows.empty() ? 0.0 : a.rows.front().floor_us * 1000.0, reference_name);
+    std::printf("%-8s %-18s %11s %11s %11s %10s %-26s %-8s %s\n", "stage", "variant", "median_us", "p5_us", "p95_us",
+                "above_ns", "ratio [95% CI]", "target", "verdict");
+    for (const StageRow& row : a.rows) {
+        if (row.stage == floor_stage) continue;
+        char above[32] = "";
+        if (row.above_floor_ns) std::snprintf(above, sizeof above, "%.0f", *row.above_floor_ns);
+        char target[16] = "";
+        if (row.target) std::snprintf(target, sizeof target, "<=%.2f", *row.target);
+        std::printf("%-8s %-18s %11.3f %11.3f %11.3f %10s %-26s %-8s %s\n", stage_names[row.stage], row.variant.c_str(),
+                    row.summary.median, row.summary.p5, row.summary.p95, above, format_ratio(row.to_ref).c_str(),
+                    target, row.verdict.c_str());
+    }
+    for (const VariantImages& image : a.images)
+        std::printf("image    %-18s %s (%d of %d last frames differ from %s; worst %zu pixels, max channel %d)\n",
+                    image.name.c_str(), image.mismatches == 0 ? "identical" : "DIFFERS", image.mismatches, image.blocks,
+                    reference_name, image.worst_pixels, image.worst_channel);
+    if (a.geometric)
+        std::printf("geometric error: max %.3g, rms %.3g model units; max %.3g pixels at the nearest teapot\n",
+                    a.geometric->max, a.geometric->rms, a.error_pixels);
+}
+
+void print_sweep(const std::vector<ConfigAnalysis>& results, const Options& options) {
+    std::printf("\nspeed against error (variant %s, %ux%u):\n", reference_name, options.config.width,
+                options.config.height);
+    std::printf("%5s %10s %12s %12s %12s %10s %14s %12s\n", "level", "triangles", "frame_us", "geom_max", "geom_rms",
+                "max_px", "pixels_differ", "max_channel");
+    std::optional<int> budget_level;
+    std::vector<const ConfigAnalysis*> levels;
+    for (const ConfigAnalysis& r : results)
+        if (r.geometric) levels.push_back(&r);
+    std::sort(levels.begin(), levels.end(), [](const ConfigAnalysis* a, const ConfigAnalysis* b) {
+        return a->config.tessellation < b->config.tessellation;
+    });
+    for (const ConfigAnalysis* level : levels) {
+        const ConfigAnalysis& r = *level;
+        Summary frame = summarize(r.samples[frame_stage][0]);
+        std::printf("%5d %10d %12.1f %12.3g %12.3g %10.3g %14zu %12d\n", r.config.tessellation,
+                    64 * r.config.tessellation * r.config.tessellation, frame.median, r.geometric->max,
+                    r.geometric->rms, r.error_pixels, r.image_error_pixels.value_or(0), r.image_error_channel);
+        if (r.error_pixels <= 1.0 && (!budget_level || r.config.tessellation < *budget_level))
+            budget_level = r.config.tessellation;
+    }
+    if (budget_level)
+        std::printf(
+            "a 1-pixel error budget at %ux%u needs tessellation %d (max geometric error <= 1 pixel at the "
+            "nearest teapot)\n",
+            options.config.width, options.config.height, *budget_level);
+    else
+        std::printf("no level run meets a 1-pixel error budget at %ux%u\n", options.config.width,
+                    options.config.height);
+}
+
+// One row per variant and stage, then an image row per variant (median_us
+// holds the number of last frames that differed). frames is the number of
+// samples behind the row, blocks the number of block ratios.
+void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& results) {
+    std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
     std::ofstream out(path);
     if (!out) throw std::runtime_error("cannot write " + path);
     out << "variant,stage,teapots,frames_in_flight,uniform_writes,tessellation,frames,median_us,p5_us,p95_us,"
-           "ratio_to_raw,ratio_ci_low,ratio_ci_high,geometric_max_error,geometric_rms_error,geometric_max_error_px,"
+           "reference,ratio_to_ref,ref_ci_low,ref_ci_high,ratio_to_raw,ratio_ci_low,ratio_ci_high,floor_ns,"
+           "above_floor_ns,target,verdict,runs,blocks,geometric_max_error,geometric_rms_error,geometric_max_error_px,"
            "image_error_pixels,image_error_max_channel\n";
-    char line[512];
-    for (const ConfigResult& r : results) {
+    char line[768];
+    for (const ConfigAnalysis& r : results) {
         const Config& c = r.config;
-        std::string extra = ",,,,,";
+        std::string extra = ",,,,";
         if (r.geometric) {
-            std::snprintf(line, sizeof line, ",%.6g,%.6g,%.6g,", r.geometric->max, r.geometric->rms, r.error_pixels);
+            std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,", r.geometric->max, r.geometric->rms, r.error_pixels);
             extra = line;
             extra += r.image_error_pixels
                          ? std::to_string(*r.image_error_pixels) + "," + std::to_string(r.image_error_channel)
                          : ",";
         }
-        for (const VariantResult& v : r.variants) {
-            for (int s = 0; s < stage_count; ++s) {
-                Summary sum = summarize(v.stage_us[s]);
-                Ratio ratio = bootstrap_ratio(v.stage_us[s], r.variants[0].stage_us[s]);
-                std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%d,%zu,%.3f,%.3f,%.3f,%.4f,%.4f,%.4f", v.name.c_str(),
-                              stage_names[s], c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
-                              v.stage_us[s].size(), sum.median, sum.p5, sum.p95, ratio.ratio, ratio.low, ratio.high);
-                out << line << extra << "\n";
+        for (const StageRow& row : r.rows) {
+            std::string raw = ",,";
+            if (row.to_raw) {
+                std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f", row.to_raw->ratio, row.to_raw->low,
+                              row.to_raw->high);
+                raw = line;
             }
-            // The image check: median_us holds the number of differing pixels.
-            std::snprintf(line, sizeof line, "%s,image,%d,%d,%d,%d,1,%zu,,,,,", v.name.c_str(), c.teapots,
-                          c.frames_in_flight, c.uniform_writes, c.tessellation, v.differing_pixels);
+            std::string above = row.above_floor_ns ? std::to_string(int(std::lround(*row.above_floor_ns))) : "";
+            std::string target = "";
+            if (row.target) {
+                std::snprintf(line, sizeof line, "%.2f", *row.target);
+                target = line;
+            }
+            std::snprintf(
+                line, sizeof line, "%s,%s,%d,%d,%d,%d,%zu,%.3f,%.3f,%.3f,%s,%.4f,%.4f,%.4f,%s,%.0f,%s,%s,%s,%d,%zu,",
+                row.variant.c_str(), stage_names[row.stage], c.teapots, c.frames_in_flight, c.uniform_writes,
+                c.tessellation, row.samples, row.summary.median, row.summary.p5, row.summary.p95, reference_name,
+                row.to_ref.ratio, row.to_ref.low, row.to_ref.high, raw.c_str(), row.floor_us * 1000.0, above.c_str(),
+                target.c_str(), row.verdict.c_str(), r.runs, row.blocks);
+            out << line << extra << "\n";
+        }
+        for (const VariantImages& image : r.images) {
+            std::snprintf(line, sizeof line, "%s,image,%d,%d,%d,%d,%d,%d,,,%s,,,,,,,,,,,%d,%d,", image.name.c_str(),
+                          c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation, image.blocks,
+                          image.mismatches, reference_name, r.runs, image.blocks);
             out << line << extra << "\n";
         }
     }
 }
 
-void write_plots(const std::string& dir, const ConfigResult& r) {
-    std::string tag = config_tag(r.config);
+void write_plots(const std::string& dir, const ConfigAnalysis& a) {
+    std::string tag = config_tag(a.config);
     for (int s = 1; s < stage_count; ++s) {
         std::vector<HistogramSeries> series;
-        for (const VariantResult& v : r.variants) series.push_back({v.name, v.stage_us[s]});
+        for (std::size_t v = 0; v < a.variants.size(); ++v) series.push_back({a.variants[v], a.samples[s][v]});
         write_histogram_png(dir + "/hist_" + tag + "_" + stage_names[s] + ".png",
                             std::string(stage_names[s]) + " stage, " + tag + " (microseconds per frame)", series);
     }
-    std::vector<std::string> names;
     std::vector<RatioBar> bars;
-    for (const VariantResult& v : r.variants) names.push_back(v.name);
-    for (int s = 0; s < stage_count; ++s)
-        for (const VariantResult& v : r.variants) {
-            Ratio ratio = bootstrap_ratio(v.stage_us[s], r.variants[0].stage_us[s]);
-            bars.push_back({stage_names[s], v.name, ratio.ratio, ratio.low, ratio.high});
-        }
+    for (const StageRow& row : a.rows)
+        if (row.stage != floor_stage)
+            bars.push_back({stage_names[row.stage], row.variant, row.to_ref.ratio, row.to_ref.low, row.to_ref.high});
     write_ratio_png(dir + "/ratios_" + tag + ".png",
-                    "median stage time / " + r.variants[0].name + ", 95% bootstrap CI, " + tag, names, bars);
-    for (const VariantResult& v : r.variants)
-        write_png(dir + "/frame_" + tag + "_" + v.name + ".png", r.config.width, r.config.height, v.image);
+                    std::string("block-wise stage time / ") + reference_name + ", 95% CI over blocks and runs, " + tag,
+                    a.variants, bars);
 }
 
-int run(int argc, char** argv) {
-    Options options = parse(argc, argv);
-    std::filesystem::create_directories(options.png_dir);
-    // GLFW for every window of the run (harness/window.hpp says why here).
-    std::optional<GlfwSession> glfw;
-    if (options.config.window) glfw.emplace();
+void report(const std::vector<ConfigAnalysis>& results, const Options& options, const std::string& device,
+            std::uint64_t seed) {
+    std::printf("device: %s\nseed: %llu (--seed %llu repeats the shuffles)\n", device.c_str(), (unsigned long long)seed,
+                (unsigned long long)seed);
+    for (const ConfigAnalysis& r : results) print_table(r);
+    if (options.sweep) print_sweep(results, options);
+    write_csv(options.csv, results);
+    std::filesystem::create_directories(options.out_dir);
+    for (const ConfigAnalysis& r : results) write_plots(options.out_dir, r);
+    std::printf("\nplots and frames in %s, CSV in %s\n", options.out_dir.c_str(), options.csv.c_str());
+}
 
-    // The configurations: the one given, or the sweep, varying one setting
-    // at a time from the given one. Larger scenes get proportionally fewer
-    // frames (at least 40) so a sweep stays within minutes.
-    std::vector<std::pair<Config, int>> plan;
-    plan.push_back({options.config, options.frames});
-    std::vector<int> tessellation_levels{options.config.tessellation};
-    if (options.sweep) {
-        auto add = [&](Config c) {
-            for (const auto& [existing, f] : plan)
-                if (config_tag(existing) == config_tag(c)) return;
-            int scaled = std::max(40, int(std::int64_t(options.frames) * 25 / std::max(25, c.teapots)));
-            plan.push_back({c, std::min(options.frames, scaled)});
-        };
-        for (int teapots : {25, 250, 2500}) {
-            Config c = options.config;
-            c.teapots = teapots;
-            add(c);
-        }
-        for (int fif : {1, 2}) {
-            Config c = options.config;
-            c.frames_in_flight = fif;
-            add(c);
-        }
-        for (int writes : {1, 1000}) {
-            Config c = options.config;
-            c.uniform_writes = writes;
-            add(c);
-        }
-        tessellation_levels = {2, 4, 8, 16, 32};
-        for (int level : tessellation_levels) {
-            Config c = options.config;
-            c.tessellation = level;
-            add(c);
-        }
+// ---- Step 5: exit status ------------------------------------------------
+
+int exit_status(const std::vector<ConfigAnalysis>& results) {
+    bool images_ok = true, presentation_ok = true;
+    for (const ConfigAnalysis& r : results) {
+        for (const VariantImages& image : r.images) images_ok &= image.mismatches == 0;
+        for (const std::string& p : r.presentations) presentation_ok &= p == r.presentations[0];
     }
-
-    std::map<int, Mesh> meshes;
-    std::vector<ConfigResult> results;
-    bool images_ok = true;
-    bool presentation_ok = true;
-    for (std::size_t i = 0; i < plan.size(); ++i) {
-        results.push_back(run_configuration(options, plan[i].first, plan[i].second, meshes, int(i), int(plan.size())));
-        for (const VariantResult& v : results.back().variants) {
-            images_ok &= v.differing_pixels == 0;
-            presentation_ok &= v.presentation == results.back().variants[0].presentation;
-        }
-    }
-
-    // Speed against error: geometric error of every level run, and the image
-    // error against the finest level's frame where that level was run.
-    const ConfigResult* finest = nullptr;
-    for (const ConfigResult& r : results)
-        if (r.config.tessellation == finest_tessellation && config_tag(r.config) == [&] {
-                Config c = options.config;
-                c.tessellation = finest_tessellation;
-                return config_tag(c);
-            }())
-            finest = &r;
-    for (ConfigResult& r : results) {
-        if (r.config.teapots != options.config.teapots ||
-            r.config.frames_in_flight != options.config.frames_in_flight ||
-            r.config.uniform_writes != options.config.uniform_writes)
-            continue;
-        r.geometric = geometric_error(newell_teapot(), meshes.at(r.config.tessellation));
-        r.error_pixels = r.geometric->max * pixels_per_unit(r.config);
-        if (finest) {
-            auto [differing, channel] = compare_images(r.variants[0].image, finest->variants[0].image);
-            r.image_error_pixels = differing;
-            r.image_error_channel = channel;
-        }
-    }
-
-    for (const ConfigResult& r : results) print_table(r);
-    if (options.sweep) {
-        std::printf("\nspeed against error (variant %s, %dx%d):\n", results[0].variants[0].name.c_str(),
-                    options.config.width, options.config.height);
-        std::printf("%5s %10s %12s %12s %12s %10s %14s %12s\n", "level", "triangles", "frame_us", "geom_max",
-                    "geom_rms", "max_px", "pixels_differ", "max_channel");
-        std::optional<int> budget_level;
-        std::vector<const ConfigResult*> levels;
-        for (const ConfigResult& r : results)
-            if (r.geometric) levels.push_back(&r);
-        std::sort(levels.begin(), levels.end(), [](const ConfigResult* a, const ConfigResult* b) {
-            return a->config.tessellation < b->config.tessellation;
-        });
-        for (const ConfigResult* level : levels) {
-            const ConfigResult& r = *level;
-            Summary frame = summarize(r.variants[0].stage_us[frame_stage]);
-            std::printf("%5d %10d %12.1f %12.3g %12.3g %10.3g %14zu %12d\n", r.config.tessellation,
-                        64 * r.config.tessellation * r.config.tessellation, frame.median, r.geometric->max,
-                        r.geometric->rms, r.error_pixels, r.image_error_pixels.value_or(0), r.image_error_channel);
-            if (r.error_pixels <= 1.0 && (!budget_level || r.config.tessellation < *budget_level))
-                budget_level = r.config.tessellation;
-        }
-        if (budget_level)
-            std::printf(
-                "a 1-pixel error budget at %ux%u needs tessellation %d (max geometric error <= 1 pixel at the "
-                "nearest teapot)\n",
-                options.config.width, options.config.height, *budget_level);
-        else
-            std::printf("no level run meets a 1-pixel error budget at %ux%u\n", options.config.width,
-                        options.config.height);
-    }
-
-    if (!options.csv.empty()) write_csv(options.csv, results);
-    for (const ConfigResult& r : results) write_plots(options.png_dir, r);
-    std::printf("\nplots and frames in %s%s%s\n", options.png_dir.c_str(), options.csv.empty() ? "" : ", CSV in ",
-                options.csv.c_str());
-
     int status = 0;
     if (!images_ok) {
-        std::fprintf(stderr, "teapot: FAILED: a variant's image differs from %s's\n",
-                     results[0].variants[0].name.c_str());
+        std::fprintf(stderr, "teapot: FAILED: a variant's image differs from %s's\n", reference_name);
         status = 1;
     }
     if (!presentation_ok) {
@@ -505,6 +907,72 @@ int run(int argc, char** argv) {
         status = 1;
     }
     return status;
+}
+
+// ---- --instructions: the noise-free count -------------------------------
+
+// For callgrind (--collect-atstart=no; bench/instructions.sh): per variant,
+// after warm-up, `frames` frames per stage with collection on around that
+// stage's call only, then a dump named "teapot variant=V stage=S calls=N".
+// Each dump then holds exactly one stage of one variant.
+int count_instructions(const Options& options) {
+    if (!TEAPOT_HAS_CALLGRIND)
+        throw std::runtime_error("--instructions: built without valgrind/callgrind.h (install valgrind, rebuild)");
+    if (!RUNNING_ON_VALGRIND)
+        std::fprintf(stderr, "teapot: --instructions outside valgrind counts nothing (bench/instructions.sh)\n");
+    const Config& config = options.config;
+    Mesh mesh = tessellate(newell_teapot(), config.tessellation);
+    SceneData scene{&mesh, camera(config.teapots, config.width, config.height)};
+    for (const std::string& name : options.variants) {
+        std::unique_ptr<Variant> variant = make_variant(name);
+        variant->init(config, scene);
+        if (name == options.variants.front()) std::printf("device: %s\n", variant->device_name().c_str());
+        double t = 0;
+        variant->update(t);
+        for (int f = 0; f < warmup_frames; ++f) timed_frame(*variant, t += frame_step);
+        for (int stage = 1; stage <= frame_stages; ++stage) {
+            for (int f = 0; f < options.frames; ++f) {
+                t += frame_step;
+                // The stages of timed_frame, collection toggled around one.
+                auto run = [&](int s, auto&& call) {
+                    if (s == stage) CALLGRIND_TOGGLE_COLLECT;
+                    call();
+                    if (s == stage) CALLGRIND_TOGGLE_COLLECT;
+                };
+                run(1, [&] { variant->acquire(); });
+                run(2, [&] { variant->uniform(); });
+                run(3, [&] { variant->command(); });
+                run(4, [&] { variant->submit(); });
+                run(5, [&] { variant->present(); });
+                run(6, [&] { variant->wait(); });
+                run(7, [&] { variant->update(t); });
+            }
+            const std::string label =
+                "teapot variant=" + name + " stage=" + stage_names[stage] + " calls=" + std::to_string(options.frames);
+            CALLGRIND_DUMP_STATS_AT(label.c_str());
+            (void)label;
+        }
+        variant->drain();
+    }
+    return validation_messages > 0 ? 1 : 0;
+}
+
+int run(int argc, char** argv) {
+    Options options = parse(argc, argv);
+    // GLFW for every window of the run (harness/window.hpp says why here).
+    std::optional<GlfwSession> glfw;
+    if (options.config.window) glfw.emplace();
+    if (options.instructions) return count_instructions(options);
+    const std::uint64_t seed = options.seed.value_or(std::random_device{}() & 0xffffffffu);
+
+    if (!options.worker_out.empty()) {  // a child of run_processes
+        save(measure(options, plan(options), seed), options.worker_out);
+        return validation_messages > 0 ? 1 : 0;
+    }
+    std::vector<RunData> runs = run_processes(options, argc, argv, seed);
+    std::vector<ConfigAnalysis> results = analyse(runs, options);
+    report(results, options, runs.at(0).device, seed);
+    return exit_status(results);
 }
 
 }  // namespace

@@ -59,4 +59,34 @@ Ratio bootstrap_ratio(std::span<const double> variant, std::span<const double> r
     return r;
 }
 
+Ratio block_bootstrap_ratio(const std::vector<std::vector<double>>& ratios, int resamples, std::uint64_t seed) {
+    std::vector<double> pooled;
+    std::vector<const std::vector<double>*> runs;
+    for (const auto& run : ratios)
+        if (!run.empty()) {
+            runs.push_back(&run);
+            pooled.insert(pooled.end(), run.begin(), run.end());
+        }
+    if (pooled.empty()) return {};
+    Ratio r;
+    r.ratio = quantile(pooled, 0.5);
+    std::mt19937_64 rng(seed);
+    std::uniform_int_distribution<std::size_t> pick_run(0, runs.size() - 1);
+    std::vector<double> medians, sample;
+    medians.reserve(resamples);
+    for (int i = 0; i < resamples; ++i) {
+        sample.clear();
+        for (std::size_t k = 0; k < runs.size(); ++k) {
+            const std::vector<double>& run = *runs[runs.size() > 1 ? pick_run(rng) : 0];
+            std::uniform_int_distribution<std::size_t> pick_block(0, run.size() - 1);
+            for (std::size_t b = 0; b < run.size(); ++b) sample.push_back(run[pick_block(rng)]);
+        }
+        medians.push_back(quantile(sample, 0.5));
+    }
+    std::sort(medians.begin(), medians.end());
+    r.low = sorted_quantile(medians, 0.025);
+    r.high = sorted_quantile(medians, 0.975);
+    return r;
+}
+
 }  // namespace teapot

@@ -27,7 +27,7 @@
 //     measure the API rather than the display's rate; FIFO is the one every
 //     surface has), minImageCount frames_in_flight + 1 clamped to the
 //     surface's limits, the surface's current extent (Config width x height
-//     where the surface leaves it to the swapchain), COLOR_ATTACHMENT usage,
+//     where the surface leaves it to the swapchain), COLOR_ATTACHMENT and TRANSFER_SRC (image check) usage,
 //     opaque composite alpha where supported, clipped. One binary
 //     "render done" semaphore per swapchain image. vkrc's Swapchain applies
 //     the same rule from its SwapchainCreateInfo.
@@ -69,7 +69,17 @@
 //     slot has been submitted, and resets it (with one frame in flight this
 //     waits for the frame just submitted).
 //   * update: the CPU animation of every teapot for time t (teapot::animate)
-//     into the variant's draw array, read by the next command stage.
+//     into the variant's draw array, read by the next command stage, and the
+//     camera for time t (it sways), written by the next uniform stage
+//     (update_scene below).
+//   * Last frame (read_back_last_frame, the per-block image check): after a
+//     block and drain(), the image the last timed frame rendered is read back
+//     (headless: the ring image last presented, still TRANSFER_SRC_OPTIMAL;
+//     windowed: one more frame at the same t through the window's stages,
+//     its swapchain image, created with TRANSFER_SRC usage for this, copied
+//     to the readback buffer between rendering and presentation: a second,
+//     untimed submission PRESENT_SRC -> TRANSFER_SRC -> PRESENT_SRC that
+//     signals the render-done semaphore the present waits on).
 //   * Reference frame (render_reference_frame, the image check): in both
 //     modes it is rendered offscreen through the headless path of the stages
 //     above, into a ring image of Config width x height (windowed: a ring of
@@ -142,6 +152,9 @@ public:
     // it and reads its colour image back: width * height RGBA8 pixels, top
     // row first.
     virtual std::vector<std::uint8_t> render_reference_frame(double t) = 0;
+    // After drain(): the last timed frame's colour image, rendered at time t
+    // (the convention's "last frame"), as RGBA8 pixels, top row first.
+    virtual std::vector<std::uint8_t> read_back_last_frame(double t) = 0;
     virtual std::string device_name() const = 0;
     // How frames are presented, e.g. "swapchain B8G8R8A8_UNORM, FIFO, 3
     // images, 800x600": the harness requires it to be the same for all.
@@ -242,6 +255,12 @@ inline void write_camera_uniforms(void* mapped, const CameraUniforms& camera, in
     }
 }
 
+// The update stage's work, the same for every variant.
+inline void update_scene(const Config& config, double t, std::vector<PushConstants>& draws, CameraUniforms& camera) {
+    animate(config.teapots, t, draws);
+    camera = teapot::camera(config.teapots, config.width, config.height, t);
+}
+
 // Validation messages (warnings and errors) seen by any variant; the run
 // fails if any arrive. Variants install validation_callback on their
 // instance (also through VkInstanceCreateInfo::pNext) when
@@ -271,5 +290,7 @@ std::unique_ptr<Variant> make_vkhpp_variant();
 // variants/vkrc.cpp, compiled against vkrc::st and against vkrc::mt.
 std::unique_ptr<Variant> make_vkrc_st_variant();
 std::unique_ptr<Variant> make_vkrc_mt_variant();
+// The vkrc-st copy built against a vkrc compiled with VKRC_RUNTIME_CHECKS=1.
+std::unique_ptr<Variant> make_vkrc_st_checked_variant();
 
 }  // namespace teapot

@@ -114,4 +114,15 @@ CameraUniforms camera(int count, std::uint32_t width, std::uint32_t height) {
     return {view_matrix(count), projection_matrix(pi / 4.0, aspect, 0.5, far_plane)};
 }
 
+CameraUniforms camera(int count, std::uint32_t width, std::uint32_t height, double t) {
+    CameraUniforms c = camera(count, width, height);
+    const double angle = 0.08 * std::sin(2.0 * pi * wrap_time(t) / animation_period);
+    const double cs = std::cos(angle), sn = std::sin(angle);
+    glm::dmat4 sway(1.0);  // rotation about the vertical axis through the grid's centre
+    sway[0] = glm::dvec4(cs, 0, -sn, 0);
+    sway[2] = glm::dvec4(sn, 0, cs, 0);
+    c.view = glm::mat4(glm::dmat4(c.view) * sway);
+    return c;
+}
+
 }  // namespace teapot

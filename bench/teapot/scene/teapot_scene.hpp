@@ -124,5 +124,9 @@ glm::mat4 projection_matrix(double fov_short, double aspect, double near_plane, 
 
 // The benchmark's camera for count teapots in a width x height image.
 CameraUniforms camera(int count, std::uint32_t width, std::uint32_t height);
+// The same camera swaying about the vertical axis with time (a few degrees,
+// period animation_period): what the benchmark writes every frame, so a
+// uniform stage that stopped writing shows in the image check.
+CameraUniforms camera(int count, std::uint32_t width, std::uint32_t height, double t);
 
 }  // namespace teapot

@@ -41,7 +41,7 @@ void check(VkResult result, const char* call) {
     X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) X(vkQueueSubmit2)                      \
     X(vkCmdPipelineBarrier2) X(vkCmdBeginRendering) X(vkCmdEndRendering) X(vkCmdBindPipeline)                     \
     X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdBindDescriptorSets) X(vkCmdBindVertexBuffers)                   \
-    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer)                \
+    X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBuffer) \
     X(vkCreateSemaphore) X(vkDestroySemaphore) X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR)                   \
     X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) X(vkQueuePresentKHR)
 // clang-format on
@@ -58,6 +58,60 @@ struct Allocation {
     void* mapped = nullptr;
 };
 
+// The helpers a careful C programmer writes once.
+
+// An image barrier on the first mip level and layer of one aspect.
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout old_layout,
+                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
+                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
+                                    VkAccessFlags2 dst_access) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    b.oldLayout = old_layout;
+    b.newLayout = new_layout;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {aspect, 0, 1, 0, 1};
+    return b;
+}
+
+// Records the image barriers into cmd with vkCmdPipelineBarrier2.
+void pipeline_barrier(PFN_vkCmdPipelineBarrier2 barrier, VkCommandBuffer cmd,
+                      std::span<const VkImageMemoryBarrier2> images,
+                      std::span<const VkBufferMemoryBarrier2> buffers = {}) {
+    VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dependency.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+    dependency.pImageMemoryBarriers = images.data();
+    dependency.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+    dependency.pBufferMemoryBarriers = buffers.data();
+    barrier(cmd, &dependency);
+}
+
+// Begins a one-time-submit recording of cmd after resetting its pool.
+void begin_one_time(const DeviceFunctions& fn, VkDevice device, VkCommandPool pool, VkCommandBuffer cmd) {
+    check(fn.vkResetCommandPool(device, pool, 0), "vkResetCommandPool");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(fn.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+}
+
+// Ends cmd, submits it signalling fence, waits for the fence and resets it.
+void submit_and_wait(const DeviceFunctions& fn, VkDevice device, VkQueue queue, VkCommandBuffer cmd, VkFence fence) {
+    check(fn.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+    VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cmd_info.commandBuffer = cmd;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.commandBufferInfoCount = 1;
+    submit.pCommandBufferInfos = &cmd_info;
+    check(fn.vkQueueSubmit2(queue, 1, &submit, fence), "vkQueueSubmit2");
+    check(fn.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    check(fn.vkResetFences(device, 1, &fence), "vkResetFences");
+}
+
 template <bool Direct>
 class RawVariant final : public Variant {
 public:
@@ -65,9 +119,8 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
-        index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
+        mesh_.index_count = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
         create_instance();
         create_device();
@@ -89,19 +142,19 @@ public:
             return;
         }
         for (;;) {
-            if (swapchain_stale_) recreate_swapchain();
+            if (window_sc_.stale) recreate_swapchain();
             VkResult result = call(&DeviceFunctions::vkAcquireNextImageKHR, ::vkAcquireNextImageKHR)(
-                device_, swapchain_, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
+                device_, window_sc_.swapchain, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
             if (result == VK_ERROR_OUT_OF_DATE_KHR) {
-                swapchain_stale_ = true;
+                window_sc_.stale = true;
                 continue;
             }
             if (result == VK_SUBOPTIMAL_KHR)
-                swapchain_stale_ = true;  // the image is still usable: re-created after its present
+                window_sc_.stale = true;  // the image is still usable: re-created after its present
             else check(result, "vkAcquireNextImageKHR");
             break;
         }
-        target_ = {swapchain_images_[image_], swapchain_views_[image_], swapchain_extent_,
+        target_ = {window_sc_.images[image_], window_sc_.views[image_], window_sc_.extent,
                    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
     }
 
@@ -120,35 +173,18 @@ public:
         check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin),
               "vkBeginCommandBuffer");
 
-        VkImageMemoryBarrier2 to_render[2]{};
-        to_render[0].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-        to_render[0].srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_render[0].dstStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_render[0].dstAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_render[0].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        to_render[0].newLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        to_render[0].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[0].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[0].image = target_.image;
-        to_render[0].subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        to_render[1].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-        to_render[1].srcStageMask =
+        const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-        to_render[1].srcAccessMask = VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-        to_render[1].dstStageMask =
-            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-        to_render[1].dstAccessMask =
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
-        to_render[1].oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-        to_render[1].newLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-        to_render[1].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[1].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_render[1].image = depth_.image;
-        to_render[1].subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dependency.imageMemoryBarrierCount = 2;
-        dependency.pImageMemoryBarriers = to_render;
-        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &dependency);
+        const VkImageMemoryBarrier2 to_render[2] = {
+            image_barrier(target_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0,
+                          VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
+            image_barrier(
+                depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                depth_stages,
+                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT)};
+        pipeline_barrier(call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2), cmd, to_render);
 
         VkRenderingAttachmentInfo colour{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
         colour.imageView = target_.view;
@@ -177,32 +213,24 @@ public:
         call(&DeviceFunctions::vkCmdSetScissor, ::vkCmdSetScissor)(cmd, 0, 1, &scissor);
         call(&DeviceFunctions::vkCmdBindDescriptorSets, ::vkCmdBindDescriptorSets)(
             cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_layout_, 0, 1, &f.descriptor_set, 0, nullptr);
-        VkBuffer vertex_buffers[2] = {positions_, normals_};
+        VkBuffer vertex_buffers[2] = {mesh_.positions, mesh_.normals};
         VkDeviceSize offsets[2] = {0, 0};
         call(&DeviceFunctions::vkCmdBindVertexBuffers, ::vkCmdBindVertexBuffers)(cmd, 0, 2, vertex_buffers, offsets);
-        call(&DeviceFunctions::vkCmdBindIndexBuffer, ::vkCmdBindIndexBuffer)(cmd, indices_, 0, VK_INDEX_TYPE_UINT16);
+        call(&DeviceFunctions::vkCmdBindIndexBuffer, ::vkCmdBindIndexBuffer)(cmd, mesh_.indices, 0,
+                                                                             VK_INDEX_TYPE_UINT16);
         auto push = call(&DeviceFunctions::vkCmdPushConstants, ::vkCmdPushConstants);
         auto draw = call(&DeviceFunctions::vkCmdDrawIndexed, ::vkCmdDrawIndexed);
         for (const PushConstants& d : draws_) {
             push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof d, &d);
-            draw(cmd, index_count_, 1, 0, 0, 0);
+            draw(cmd, mesh_.index_count, 1, 0, 0, 0);
         }
         call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
 
-        VkImageMemoryBarrier2 to_present{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        to_present.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_present.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_present.dstStageMask = VK_PIPELINE_STAGE_2_NONE;
-        to_present.oldLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-        to_present.newLayout = target_.present_layout;
-        to_present.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_present.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_present.image = target_.image;
-        to_present.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkDependencyInfo present_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        present_dependency.imageMemoryBarrierCount = 1;
-        present_dependency.pImageMemoryBarriers = &to_present;
-        call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2)(cmd, &present_dependency);
+        const VkImageMemoryBarrier2 to_present =
+            image_barrier(target_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          target_.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                          VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+        pipeline_barrier(call(&DeviceFunctions::vkCmdPipelineBarrier2, ::vkCmdPipelineBarrier2), cmd, {&to_present, 1});
         check(call(&DeviceFunctions::vkEndCommandBuffer, ::vkEndCommandBuffer)(cmd), "vkEndCommandBuffer");
     }
 
@@ -218,7 +246,7 @@ public:
         if (present_to_window_) {
             wait.semaphore = f.acquire_semaphore;
             wait.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-            signal.semaphore = render_done_[image_];
+            signal.semaphore = window_sc_.render_done[image_];
             signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
             submit.waitSemaphoreInfoCount = 1;
             submit.pWaitSemaphoreInfos = &wait;
@@ -233,13 +261,13 @@ public:
         if (present_to_window_) {
             VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
             info.waitSemaphoreCount = 1;
-            info.pWaitSemaphores = &render_done_[image_];
+            info.pWaitSemaphores = &window_sc_.render_done[image_];
             info.swapchainCount = 1;
-            info.pSwapchains = &swapchain_;
+            info.pSwapchains = &window_sc_.swapchain;
             info.pImageIndices = &image_;
             VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(queue_, &info);
             if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
-                swapchain_stale_ = true;  // re-created at the next acquire
+                window_sc_.stale = true;  // re-created at the next acquire
             else check(result, "vkQueuePresentKHR");
         }
         presented_image_ = image_;
@@ -255,7 +283,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
 
@@ -269,38 +297,58 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         present_to_window_ = config_.window;
+        return read_back_ring_image();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return read_back_presented_frame(t);
+        return read_back_ring_image();
+    }
+
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to the readback buffer (the swapchain has
+    // TRANSFER_SRC usage) between its rendering and its presentation: the
+    // submission renders (waiting on the acquire semaphore), then a one-off
+    // copy goes PRESENT_SRC -> TRANSFER_SRC -> PRESENT_SRC and signals the
+    // render-done semaphore that present waits on.
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
         drain();
-        // Copy the presented image to the readback buffer with a one-off
-        // command buffer from the slot's pool (idle after the drain).
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (window_sc_.extent.width != config_.width || window_sc_.extent.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
         Frame& f = frames_[slot_];
+        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmd_info.commandBuffer = f.cmd;
+        VkSemaphoreSubmitInfo wait_info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        wait_info.semaphore = f.acquire_semaphore;
+        wait_info.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        VkSubmitInfo2 render{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        render.waitSemaphoreInfoCount = 1;
+        render.pWaitSemaphoreInfos = &wait_info;
+        render.commandBufferInfoCount = 1;
+        render.pCommandBufferInfos = &cmd_info;
+        check(fn_.vkQueueSubmit2(queue_, 1, &render, f.fence), "vkQueueSubmit2");
         check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
         check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
-        f.submitted = false;
-        check(fn_.vkResetCommandPool(device_, f.pool, 0), "vkResetCommandPool");
-        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-        begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        check(fn_.vkBeginCommandBuffer(f.cmd, &begin), "vkBeginCommandBuffer");
-        VkImageMemoryBarrier2 to_copy{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        to_copy.srcStageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        to_copy.srcAccessMask = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-        to_copy.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_copy.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
-        to_copy.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_copy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-        to_copy.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_copy.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_copy.image = ring_[presented_image_].image;
-        to_copy.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        dependency.imageMemoryBarrierCount = 1;
-        dependency.pImageMemoryBarriers = &to_copy;
-        fn_.vkCmdPipelineBarrier2(f.cmd, &dependency);
+
+        begin_one_time(fn_, device_, f.pool, f.cmd);
+        const VkImage image = window_sc_.images[image_];
+        const VkImageMemoryBarrier2 to_copy = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
         VkBufferImageCopy region{};
         region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {config_.width, config_.height, 1};
-        fn_.vkCmdCopyImageToBuffer(f.cmd, ring_[presented_image_].image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                   readback_buffer_, 1, &region);
+        region.imageExtent = {window_sc_.extent.width, window_sc_.extent.height, 1};
+        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
+        const VkImageMemoryBarrier2 back = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+            VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
         VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
         to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
         to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
@@ -310,23 +358,28 @@ public:
         to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         to_host.buffer = readback_buffer_;
         to_host.size = VK_WHOLE_SIZE;
-        VkDependencyInfo host_dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-        host_dependency.bufferMemoryBarrierCount = 1;
-        host_dependency.pBufferMemoryBarriers = &to_host;
-        fn_.vkCmdPipelineBarrier2(f.cmd, &host_dependency);
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&back, 1}, {&to_host, 1});
         check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
-        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
         cmd_info.commandBuffer = f.cmd;
-        VkSubmitInfo2 submit_info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit_info.commandBufferInfoCount = 1;
-        submit_info.pCommandBufferInfos = &cmd_info;
-        check(fn_.vkQueueSubmit2(queue_, 1, &submit_info, f.fence), "vkQueueSubmit2");
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        signal.semaphore = window_sc_.render_done[image_];
+        signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        VkSubmitInfo2 copy{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        copy.commandBufferInfoCount = 1;
+        copy.pCommandBufferInfos = &cmd_info;
+        copy.signalSemaphoreInfoCount = 1;
+        copy.pSignalSemaphoreInfos = &signal;
+        check(fn_.vkQueueSubmit2(queue_, 1, &copy, f.fence), "vkQueueSubmit2");
         check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
         check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
         const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        std::vector<std::uint8_t> image(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
-        to_rgba(image, colour_format_);
-        return image;
+        std::vector<std::uint8_t> bytes(pixels,
+                                        pixels + std::size_t(window_sc_.extent.width) * window_sc_.extent.height * 4);
+        to_rgba(bytes, colour_format_);
+        present();
+        wait();
+        drain();
+        return bytes;
     }
 
     std::string device_name() const override { return device_name_; }
@@ -334,9 +387,9 @@ public:
     const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
 
     std::string presentation() const override {
-        return config_.window
-                   ? swapchain_presentation(colour_format_, present_mode_, swapchain_images_.size(), swapchain_extent_)
-                   : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
+        return config_.window ? swapchain_presentation(colour_format_, window_sc_.present_mode,
+                                                       window_sc_.images.size(), window_sc_.extent)
+                              : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
     }
 
 private:
@@ -353,6 +406,25 @@ private:
         VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
         bool submitted = false;
     };
+    // The mesh: three device-local buffers filled by a staging upload.
+    struct MeshBuffers {
+        VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE, indices = VK_NULL_HANDLE;
+        Allocation positions_memory, normals_memory, indices_memory;
+        std::uint32_t index_count = 0;
+    };
+    // Windowed: the surface, the swapchain by the convention's rule and its
+    // per-image objects.
+    struct WindowSwapchain {
+        VkSurfaceKHR surface = VK_NULL_HANDLE;
+        VkSurfaceFormatKHR surface_format{};
+        VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+        VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+        VkExtent2D extent{};
+        std::vector<VkImage> images;
+        std::vector<VkImageView> views;
+        std::vector<VkSemaphore> render_done;  // one per swapchain image
+        bool stale = false;                    // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
+    };
     // What this frame renders into: a ring image or a swapchain image.
     struct Target {
         VkImage image = VK_NULL_HANDLE;
@@ -367,6 +439,44 @@ private:
     Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
         if constexpr (Direct) return fn_.*member;
         else return exported;
+    }
+
+    // Drains, then copies the ring image last presented to the readback
+    // buffer with a one-off command buffer from the last frame's slot.
+    std::vector<std::uint8_t> read_back_ring_image() {
+        drain();
+        Frame& f = frames_[slot_];
+        if (f.submitted) {
+            check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+            check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+            f.submitted = false;
+        }
+        begin_one_time(fn_, device_, f.pool, f.cmd);
+        const VkImage image = ring_[presented_image_].image;
+        const VkImageMemoryBarrier2 to_copy = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {config_.width, config_.height, 1};
+        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
+        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = readback_buffer_;
+        to_host.size = VK_WHOLE_SIZE;
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {}, {&to_host, 1});
+        submit_and_wait(fn_, device_, queue_, f.cmd, f.fence);
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        std::vector<std::uint8_t> image_bytes(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
+        to_rgba(image_bytes, colour_format_);
+        return image_bytes;
     }
 
     void create_instance() {
@@ -394,7 +504,8 @@ private:
         }
         check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
         if (config_.window)
-            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &surface_), "glfwCreateWindowSurface");
+            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &window_sc_.surface),
+                  "glfwCreateWindowSurface");
         if (config_.validation) {
             auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
@@ -420,7 +531,7 @@ private:
             for (std::uint32_t i = 0; i < family_count; ++i) {
                 VkBool32 presents = VK_TRUE;
                 if (config_.window)
-                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, surface_, &presents),
+                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, window_sc_.surface, &presents),
                           "vkGetPhysicalDeviceSurfaceSupportKHR");
                 if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && presents) {
                     physical_device_ = candidate;
@@ -443,24 +554,44 @@ private:
         queue_info.queueFamilyIndex = queue_family_;
         queue_info.queueCount = 1;
         queue_info.pQueuePriorities = &priority;
+        // The features and extensions vkrc::Device enables (setup parity):
+        // synchronization2, dynamicRendering, maintenance4, timelineSemaphore,
+        // VK_EXT_memory_budget where supported.
         VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
         features13.synchronization2 = VK_TRUE;
         features13.dynamicRendering = VK_TRUE;
+        features13.maintenance4 = VK_TRUE;
+        VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+        features12.pNext = &features13;
+        features12.timelineSemaphore = VK_TRUE;
         VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-        info.pNext = &features13;
+        info.pNext = &features12;
         info.queueCreateInfoCount = 1;
         info.pQueueCreateInfos = &queue_info;
-        const char* swapchain_extension = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
-        if (config_.window) {
-            info.enabledExtensionCount = 1;
-            info.ppEnabledExtensionNames = &swapchain_extension;
-        }
+        std::vector<const char*> extensions;
+        if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+        if (supports_device_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME))
+            extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+        info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+        info.ppEnabledExtensionNames = extensions.data();
         check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
         // The pointers for raw-direct's hot path and for the untimed helpers.
 #define TEAPOT_LOAD(name) fn_.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device_, #name));
         TEAPOT_DEVICE_FUNCTIONS(TEAPOT_LOAD)
 #undef TEAPOT_LOAD
         fn_.vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    }
+
+    bool supports_device_extension(const char* name) const {
+        std::uint32_t count = 0;
+        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, nullptr),
+              "vkEnumerateDeviceExtensionProperties");
+        std::vector<VkExtensionProperties> extensions(count);
+        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, extensions.data()),
+              "vkEnumerateDeviceExtensionProperties");
+        for (const VkExtensionProperties& e : extensions)
+            if (std::strcmp(e.extensionName, name) == 0) return true;
+        return false;
     }
 
     std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted) const {
@@ -491,17 +622,70 @@ private:
         return buffer;
     }
 
+    // A device-local buffer filled through a host-visible staging buffer
+    // (what vkrc::upload_buffer does), with a one-off command pool and fence.
     template <typename T>
     VkBuffer create_filled_buffer(const std::vector<T>& data, VkBufferUsageFlags usage, Allocation& allocation) {
-        VkBuffer buffer = create_buffer(data.size() * sizeof(T), usage, allocation);
-        std::memcpy(allocation.mapped, data.data(), data.size() * sizeof(T));
+        const VkDeviceSize size = data.size() * sizeof(T);
+        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+        info.size = size;
+        info.usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        VkBuffer buffer;
+        check(fn_.vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
+        VkMemoryRequirements requirements;
+        fn_.vkGetBufferMemoryRequirements(device_, buffer, &requirements);
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, 0);
+        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        allocate.allocationSize = requirements.size;
+        allocate.memoryTypeIndex = type;
+        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &allocation.memory), "vkAllocateMemory");
+        check(fn_.vkBindBufferMemory(device_, buffer, allocation.memory, 0), "vkBindBufferMemory");
+
+        Allocation staging_memory;
+        VkBuffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, staging_memory);
+        std::memcpy(staging_memory.mapped, data.data(), size);
+        VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+        pool_info.queueFamilyIndex = queue_family_;
+        VkCommandPool pool;
+        check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &pool), "vkCreateCommandPool");
+        VkCommandBufferAllocateInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+        cmd_info.commandPool = pool;
+        cmd_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        cmd_info.commandBufferCount = 1;
+        VkCommandBuffer cmd;
+        check(fn_.vkAllocateCommandBuffers(device_, &cmd_info, &cmd), "vkAllocateCommandBuffers");
+        VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        VkFence fence;
+        check(fn_.vkCreateFence(device_, &fence_info, nullptr, &fence), "vkCreateFence");
+        begin_one_time(fn_, device_, pool, cmd);
+        VkBufferCopy region{0, 0, size};
+        fn_.vkCmdCopyBuffer(cmd, staging, buffer, 1, &region);
+        // Visible to every later command (vertex input and index reads).
+        VkBufferMemoryBarrier2 to_read{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_read.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_read.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_read.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        to_read.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
+        to_read.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_read.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_read.buffer = buffer;
+        to_read.size = VK_WHOLE_SIZE;
+        pipeline_barrier(fn_.vkCmdPipelineBarrier2, cmd, {}, {&to_read, 1});
+        submit_and_wait(fn_, device_, queue_, cmd, fence);
+        fn_.vkDestroyFence(device_, fence, nullptr);
+        fn_.vkDestroyCommandPool(device_, pool, nullptr);
+        fn_.vkDestroyBuffer(device_, staging, nullptr);
+        fn_.vkFreeMemory(device_, staging_memory.memory, nullptr);
         return buffer;
     }
 
     void create_geometry(const Mesh& mesh) {
-        positions_ = create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, positions_memory_);
-        normals_ = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, normals_memory_);
-        indices_ = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, indices_memory_);
+        mesh_.positions =
+            create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.positions_memory);
+        mesh_.normals = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.normals_memory);
+        mesh_.indices = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, mesh_.indices_memory);
         uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
         uniform_buffer_ =
             create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, uniform_);
@@ -563,8 +747,8 @@ private:
     }
 
     void create_depth() {
-        depth_extent_ = {std::max(config_.width, swapchain_extent_.width),
-                         std::max(config_.height, swapchain_extent_.height)};
+        depth_extent_ = {std::max(config_.width, window_sc_.extent.width),
+                         std::max(config_.height, window_sc_.extent.height)};
         depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
                               depth_extent_);
     }
@@ -573,19 +757,19 @@ private:
     // mode are chosen once: the pipeline is made for the format.
     void create_swapchain() {
         std::uint32_t count = 0;
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, nullptr),
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, nullptr),
               "vkGetPhysicalDeviceSurfaceFormatsKHR");
         std::vector<VkSurfaceFormatKHR> formats(count);
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, surface_, &count, formats.data()),
+        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, formats.data()),
               "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        surface_format_ = choose_window_format(formats);
-        colour_format_ = surface_format_.format;
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, nullptr),
+        window_sc_.surface_format = choose_window_format(formats);
+        colour_format_ = window_sc_.surface_format.format;
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, nullptr),
               "vkGetPhysicalDeviceSurfacePresentModesKHR");
         std::vector<VkPresentModeKHR> modes(count);
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, surface_, &count, modes.data()),
+        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, modes.data()),
               "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        present_mode_ = choose_present_mode(modes);
+        window_sc_.present_mode = choose_present_mode(modes);
         while (!build_swapchain()) wait_window_events();
     }
 
@@ -593,62 +777,63 @@ private:
     // one (the device is idle); false while the surface has no area.
     bool build_swapchain() {
         VkSurfaceCapabilitiesKHR caps;
-        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, surface_, &caps),
+        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, window_sc_.surface, &caps),
               "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
         const VkExtent2D extent = swapchain_extent(config_, caps);
         if (extent.width == 0 || extent.height == 0) return false;
         VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
-        info.surface = surface_;
+        info.surface = window_sc_.surface;
         info.minImageCount = swapchain_image_request(config_, caps);
-        info.imageFormat = surface_format_.format;
-        info.imageColorSpace = surface_format_.colorSpace;
+        info.imageFormat = window_sc_.surface_format.format;
+        info.imageColorSpace = window_sc_.surface_format.colorSpace;
         info.imageExtent = extent;
         info.imageArrayLayers = 1;
-        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check
         info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
         info.preTransform = caps.currentTransform;
         info.compositeAlpha = composite_alpha(caps);
-        info.presentMode = present_mode_;
+        info.presentMode = window_sc_.present_mode;
         info.clipped = VK_TRUE;
-        info.oldSwapchain = swapchain_;
+        info.oldSwapchain = window_sc_.swapchain;
         VkSwapchainKHR swapchain = VK_NULL_HANDLE;
         const VkResult result = fn_.vkCreateSwapchainKHR(device_, &info, nullptr, &swapchain);
         destroy_swapchain();  // retired even if the creation failed
         check(result, "vkCreateSwapchainKHR");
-        swapchain_ = swapchain;
+        window_sc_.swapchain = swapchain;
         std::uint32_t count = 0;
-        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, nullptr), "vkGetSwapchainImagesKHR");
-        swapchain_images_.resize(count);
-        check(fn_.vkGetSwapchainImagesKHR(device_, swapchain_, &count, swapchain_images_.data()),
+        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, nullptr), "vkGetSwapchainImagesKHR");
+        window_sc_.images.resize(count);
+        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, window_sc_.images.data()),
               "vkGetSwapchainImagesKHR");
         VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-        for (VkImage image : swapchain_images_) {
-            swapchain_views_.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
-            render_done_.push_back(VK_NULL_HANDLE);
-            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &render_done_.back()), "vkCreateSemaphore");
+        for (VkImage image : window_sc_.images) {
+            window_sc_.views.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
+            window_sc_.render_done.push_back(VK_NULL_HANDLE);
+            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &window_sc_.render_done.back()),
+                  "vkCreateSemaphore");
         }
-        swapchain_extent_ = extent;
+        window_sc_.extent = extent;
         return true;
     }
 
     void recreate_swapchain() {
         check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle");
         while (!build_swapchain()) wait_window_events();
-        if (swapchain_extent_.width > depth_extent_.width || swapchain_extent_.height > depth_extent_.height) {
+        if (window_sc_.extent.width > depth_extent_.width || window_sc_.extent.height > depth_extent_.height) {
             destroy_image(depth_);
             create_depth();
         }
-        swapchain_stale_ = false;
+        window_sc_.stale = false;
     }
 
     void destroy_swapchain() {
-        for (VkImageView view : swapchain_views_) fn_.vkDestroyImageView(device_, view, nullptr);
-        for (VkSemaphore semaphore : render_done_) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
-        swapchain_views_.clear();
-        render_done_.clear();
-        swapchain_images_.clear();
-        if (swapchain_) fn_.vkDestroySwapchainKHR(device_, swapchain_, nullptr);
-        swapchain_ = VK_NULL_HANDLE;
+        for (VkImageView view : window_sc_.views) fn_.vkDestroyImageView(device_, view, nullptr);
+        for (VkSemaphore semaphore : window_sc_.render_done) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
+        window_sc_.views.clear();
+        window_sc_.render_done.clear();
+        window_sc_.images.clear();
+        if (window_sc_.swapchain) fn_.vkDestroySwapchainKHR(device_, window_sc_.swapchain, nullptr);
+        window_sc_.swapchain = VK_NULL_HANDLE;
     }
 
     VkShaderModule create_shader(std::span<const std::uint32_t> code) {
@@ -755,6 +940,7 @@ private:
         auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
         VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
         VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+        pool.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;  // as every variant's pool
         pool.maxSets = slots;
         pool.poolSizeCount = 1;
         pool.pPoolSizes = &pool_size;
@@ -811,14 +997,15 @@ private:
                 fn_.vkDestroyBuffer(device_, buffer, nullptr);
                 fn_.vkFreeMemory(device_, allocation.memory, nullptr);  // unmaps implicitly
             };
-            destroy_buffer(positions_, positions_memory_);
-            destroy_buffer(normals_, normals_memory_);
-            destroy_buffer(indices_, indices_memory_);
+            destroy_buffer(mesh_.positions, mesh_.positions_memory);
+            destroy_buffer(mesh_.normals, mesh_.normals_memory);
+            destroy_buffer(mesh_.indices, mesh_.indices_memory);
             destroy_buffer(uniform_buffer_, uniform_);
             destroy_buffer(readback_buffer_, readback_);
             fn_.vkDestroyDevice(device_, nullptr);
         }
-        if (surface_) vkDestroySurfaceKHR(instance_, surface_, nullptr);  // before the window (a member) goes
+        if (window_sc_.surface)
+            vkDestroySurfaceKHR(instance_, window_sc_.surface, nullptr);  // before the window (a member) goes
         if (messenger_) {
             auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
                 vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -830,7 +1017,6 @@ private:
     Config config_;
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
-    std::uint32_t index_count_ = 0;
 
     BenchWindow window_;  // windowed only; outlives the surface (destroy() runs first)
     VkInstance instance_ = VK_NULL_HANDLE;
@@ -844,8 +1030,7 @@ private:
     DeviceFunctions fn_;
     VkQueue queue_ = VK_NULL_HANDLE;
 
-    VkBuffer positions_ = VK_NULL_HANDLE, normals_ = VK_NULL_HANDLE, indices_ = VK_NULL_HANDLE;
-    Allocation positions_memory_, normals_memory_, indices_memory_;
+    MeshBuffers mesh_;
     VkBuffer uniform_buffer_ = VK_NULL_HANDLE;
     Allocation uniform_;
     VkDeviceSize uniform_stride_ = 0;
@@ -856,16 +1041,8 @@ private:
     VkExtent2D depth_extent_{};
     VkFormat colour_format_ = colour_format;  // windowed: the swapchain's
 
-    VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-    VkSurfaceFormatKHR surface_format_{};
-    VkPresentModeKHR present_mode_ = VK_PRESENT_MODE_FIFO_KHR;
-    VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
-    VkExtent2D swapchain_extent_{};
-    std::vector<VkImage> swapchain_images_;
-    std::vector<VkImageView> swapchain_views_;
-    std::vector<VkSemaphore> render_done_;  // one per swapchain image
-    bool swapchain_stale_ = false;          // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
-    bool present_to_window_ = false;        // windowed, except for the reference frame
+    WindowSwapchain window_sc_;       // windowed only
+    bool present_to_window_ = false;  // windowed, except for the reference frame
     VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
     VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
     VkPipeline pipeline_ = VK_NULL_HANDLE;

@@ -28,7 +28,6 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
@@ -154,7 +153,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { device_->waitIdle(); }
 
@@ -168,12 +167,79 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         present_to_window_ = config_.window;
+        return read_back_ring_image();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return read_back_presented_frame(t);
+        return read_back_ring_image();
+    }
+
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to the readback buffer between its rendering and
+    // its presentation (as raw.cpp's read_back_presented_frame).
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
         drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (swapchain_extent_.width != config_.width || swapchain_extent_.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
         Frame& f = frames_[slot_];
+        vk::CommandBufferSubmitInfo cmd_info(*f.cmd);
+        vk::SemaphoreSubmitInfo wait(*f.acquire_semaphore, 0, vk::PipelineStageFlagBits2::eColorAttachmentOutput);
+        queue_->submit2(vk::SubmitInfo2({}, wait, cmd_info, {}), *f.fence);
         (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
         device_->resetFences(*f.fence);
-        f.submitted = false;
+        f.pool.reset();
+        const vk::raii::CommandBuffer& cmd = f.cmd;
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        const vk::Image image = swapchain_images_[image_];
+        vk::ImageMemoryBarrier2 to_copy(vk::PipelineStageFlagBits2::eNone, {}, vk::PipelineStageFlagBits2::eCopy,
+                                        vk::AccessFlagBits2::eTransferRead, vk::ImageLayout::ePresentSrcKHR,
+                                        vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                        VK_QUEUE_FAMILY_IGNORED, image, {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, {}, to_copy));
+        vk::BufferImageCopy region(0, 0, 0, {vk::ImageAspectFlagBits::eColor, 0, 0, 1}, {0, 0, 0},
+                                   {swapchain_extent_.width, swapchain_extent_.height, 1});
+        cmd.copyImageToBuffer(image, vk::ImageLayout::eTransferSrcOptimal, *readback_.buffer, region);
+        vk::ImageMemoryBarrier2 back(vk::PipelineStageFlagBits2::eCopy, {}, vk::PipelineStageFlagBits2::eNone, {},
+                                     vk::ImageLayout::eTransferSrcOptimal, vk::ImageLayout::ePresentSrcKHR,
+                                     VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, image,
+                                     {vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1});
+        vk::BufferMemoryBarrier2 to_host(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                         vk::PipelineStageFlagBits2::eHost, vk::AccessFlagBits2::eHostRead,
+                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *readback_.buffer, 0,
+                                         VK_WHOLE_SIZE);
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, to_host, back));
+        cmd.end();
+        vk::SemaphoreSubmitInfo signal(*render_done_[image_], 0, vk::PipelineStageFlagBits2::eAllCommands);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, signal), *f.fence);
+        (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+        device_->resetFences(*f.fence);
+        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
+        std::vector<std::uint8_t> bytes(pixels,
+                                        pixels + std::size_t(swapchain_extent_.width) * swapchain_extent_.height * 4);
+        to_rgba(bytes, VkFormat(colour_format_));
+        present();
+        this->wait();
+        drain();
+        return bytes;
+    }
+
+    // Drains, then copies the ring image last presented to the readback
+    // buffer with a one-off command buffer from the last frame's slot.
+    std::vector<std::uint8_t> read_back_ring_image() {
+        drain();
+        Frame& f = frames_[slot_];
+        if (f.submitted) {
+            (void)device_->waitForFences(*f.fence, VK_TRUE, UINT64_MAX);
+            device_->resetFences(*f.fence);
+            f.submitted = false;
+        }
         f.pool.reset();
         const vk::raii::CommandBuffer& cmd = f.cmd;
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
@@ -294,9 +360,17 @@ private:
         vk::DeviceQueueCreateInfo queue_info({}, queue_family_, 1, &priority);
         std::vector<const char*> extensions;
         if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
-        vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan13Features> chain(
-            vk::DeviceCreateInfo({}, queue_info, {}, extensions),
-            vk::PhysicalDeviceVulkan13Features().setSynchronization2(true).setDynamicRendering(true));
+        // The features and extensions vkrc::Device enables (setup parity).
+        for (const vk::ExtensionProperties& e : physical_device_->enumerateDeviceExtensionProperties())
+            if (std::string_view(e.extensionName.data()) == VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)
+                extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+        vk::StructureChain<vk::DeviceCreateInfo, vk::PhysicalDeviceVulkan12Features, vk::PhysicalDeviceVulkan13Features>
+            chain(vk::DeviceCreateInfo({}, queue_info, {}, extensions),
+                  vk::PhysicalDeviceVulkan12Features().setTimelineSemaphore(true),
+                  vk::PhysicalDeviceVulkan13Features()
+                      .setSynchronization2(true)
+                      .setDynamicRendering(true)
+                      .setMaintenance4(true));
         device_.emplace(*physical_device_, chain.get<vk::DeviceCreateInfo>());
         queue_.emplace(*device_, queue_family_, 0);
     }
@@ -323,10 +397,37 @@ private:
         return b;
     }
 
+    // A device-local buffer filled through a host-visible staging buffer
+    // (what vkrc::upload_buffer does), with a one-off command pool and fence.
     template <typename T>
     Buffer create_filled_buffer(const std::vector<T>& data, vk::BufferUsageFlags usage) {
-        Buffer b = create_buffer(data.size() * sizeof(T), usage);
-        std::memcpy(b.mapped, data.data(), data.size() * sizeof(T));
+        const vk::DeviceSize size = data.size() * sizeof(T);
+        Buffer b;
+        b.buffer =
+            vk::raii::Buffer(*device_, vk::BufferCreateInfo({}, size, usage | vk::BufferUsageFlagBits::eTransferDst));
+        vk::MemoryRequirements requirements = b.buffer.getMemoryRequirements();
+        std::uint32_t type = memory_type(requirements.memoryTypeBits, vk::MemoryPropertyFlagBits::eDeviceLocal);
+        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, {});
+        b.memory = vk::raii::DeviceMemory(*device_, vk::MemoryAllocateInfo(requirements.size, type));
+        b.buffer.bindMemory(*b.memory, 0);
+
+        Buffer staging = create_buffer(size, vk::BufferUsageFlagBits::eTransferSrc);
+        std::memcpy(staging.mapped, data.data(), size);
+        vk::raii::CommandPool pool(*device_,
+                                   vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eTransient, queue_family_));
+        vk::raii::CommandBuffer cmd = std::move(vk::raii::CommandBuffers(
+            *device_, vk::CommandBufferAllocateInfo(*pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
+        vk::raii::Fence fence(*device_, vk::FenceCreateInfo());
+        cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        cmd.copyBuffer(*staging.buffer, *b.buffer, vk::BufferCopy(0, 0, size));
+        vk::BufferMemoryBarrier2 to_read(vk::PipelineStageFlagBits2::eCopy, vk::AccessFlagBits2::eTransferWrite,
+                                         vk::PipelineStageFlagBits2::eAllCommands, vk::AccessFlagBits2::eMemoryRead,
+                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *b.buffer, 0, VK_WHOLE_SIZE);
+        cmd.pipelineBarrier2(vk::DependencyInfo({}, {}, to_read, {}));
+        cmd.end();
+        vk::CommandBufferSubmitInfo cmd_info(*cmd);
+        queue_->submit2(vk::SubmitInfo2({}, {}, cmd_info, {}), *fence);
+        (void)device_->waitForFences(*fence, VK_TRUE, UINT64_MAX);
         return b;
     }
 
@@ -396,8 +497,8 @@ private:
         if (extent.width == 0 || extent.height == 0) return false;
         vk::SwapchainCreateInfoKHR info(
             {}, **surface_, swapchain_image_request(config_, caps), surface_format_.format, surface_format_.colorSpace,
-            vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment, vk::SharingMode::eExclusive, {},
-            vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
+            vk::Extent2D(extent), 1, vk::ImageUsageFlagBits::eColorAttachment | vk::ImageUsageFlagBits::eTransferSrc,
+            vk::SharingMode::eExclusive, {}, vk::SurfaceTransformFlagBitsKHR(caps.currentTransform),
             vk::CompositeAlphaFlagBitsKHR(composite_alpha(caps)), present_mode_, true, *swapchain_);
         swapchain_views_.clear();
         render_done_.clear();

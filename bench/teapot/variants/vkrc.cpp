@@ -55,7 +55,6 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
-        camera_ = scene.camera;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         create_device();
@@ -157,7 +156,7 @@ public:
         next.submitted = false;
     }
 
-    void update(double t) override { animate(config_.teapots, t, draws_); }
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
 
     void drain() override { device_.wait_idle(); }
 
@@ -172,12 +171,79 @@ public:
         command();
         submit();
         present();
+        wait();  // the other slot's last frame: every slot is free afterwards
         presenter_ = timed;
+        return read_back_offscreen();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return read_back_presented_frame(t);
+        return read_back_offscreen();
+    }
+
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to a readback buffer between its rendering and
+    // its presentation (as raw.cpp's read_back_presented_frame): the frame's
+    // submission takes the frame's waits, the copy's its signals.
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
         drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (frame_.extent.width != config_.width || frame_.extent.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
         Frame& f = frames_[slot_];
+        vkrc::submit(queue_, {.waits = frame_.waits(), .command_buffers = {&f.cmd, 1}}, f.fence);
         f.fence.wait();
         f.fence.unsignal();
-        f.submitted = false;
+        f.pool.reset_commands();
+        const vkrc::CommandBuffer& cmd = f.cmd;
+        cmd.begin();
+        const VkImage image = frame_.image.vk();
+        const VkImageMemoryBarrier2 to_copy = vkrc::image_barrier(
+            image, frame_.present_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        cmd.pipeline_barrier({}, {}, {&to_copy, 1});
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {frame_.extent.width, frame_.extent.height, 1};
+        cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_.vk(), {&region, 1});
+        const VkImageMemoryBarrier2 back =
+            vkrc::image_barrier(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, frame_.present_layout,
+                                VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
+        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        to_host.buffer = readback_.vk();
+        to_host.size = VK_WHOLE_SIZE;
+        cmd.pipeline_barrier({}, {&to_host, 1}, {&back, 1});
+        cmd.end();
+        vkrc::submit(queue_, {.command_buffers = {&f.cmd, 1}, .signals = frame_.signals()}, f.fence);
+        f.fence.wait();
+        f.fence.unsignal();
+        std::vector<std::uint8_t> bytes(std::size_t(frame_.extent.width) * frame_.extent.height * 4);
+        readback_.allocation().read(0, bytes.data(), bytes.size());
+        to_rgba(bytes, colour_format_);
+        present();
+        wait();
+        drain();
+        return bytes;
+    }
+
+    // Drains, then reads back the headless presenter's last presented image.
+    std::vector<std::uint8_t> read_back_offscreen() {
+        drain();
+        Frame& f = frames_[slot_];
+        if (f.submitted) {
+            f.fence.wait();
+            f.fence.unsignal();
+            f.submitted = false;
+        }
         const vkrc::List<std::byte> pixels = offscreen_.read_back(offscreen_.last_presented());
         const auto* bytes = reinterpret_cast<const std::uint8_t*>(pixels.data());
         std::vector<std::uint8_t> image(bytes, bytes + pixels.size());
@@ -249,7 +315,11 @@ private:
             info.preferred_formats = vkrc::List<VkSurfaceFormatKHR>(window_formats, std::size(window_formats));
             info.present_mode = VK_PRESENT_MODE_IMMEDIATE_KHR;
             info.min_image_count = static_cast<std::uint32_t>(config_.frames_in_flight + 1);
-            info.extent = {config_.width, config_.height};  // where the surface leaves it to the swapchain
+            info.extent = {config_.width, config_.height};        // where the surface leaves it to the swapchain
+            info.image_usage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check reads a presented image back
+            readback_ = vkrc::Buffer::create(device_, {.size = VkDeviceSize(config_.width) * config_.height * 4,
+                                                       .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                       .memory = {.usage = vkrc::MemoryUsage::readback}});
             swapchain_ = vkrc::Swapchain::create(queue_, surface_, info);
             // vkrc falls back to the surface's first format; the convention has no fallback.
             if (!is_window_format({swapchain_.format(), swapchain_.color_space()})) throw_no_window_format();
@@ -319,8 +389,10 @@ private:
 
     void create_frames() {
         const auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
-        descriptor_pool_ = vkrc::DescriptorPool::create(
-            device_, {.flags = 0, .max_sets = slots, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots}}});
+        descriptor_pool_ =
+            vkrc::DescriptorPool::create(device_, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT,
+                                                   .max_sets = slots,
+                                                   .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots}}});
         frames_.resize(slots);
         for (std::uint32_t i = 0; i < slots; ++i) {
             Frame& f = frames_[i];
@@ -348,6 +420,7 @@ private:
     vkrc::Buffer uniforms_;
     vkrc::WriteOnlyView uniform_writer_;
     VkDeviceSize uniform_stride_ = 0;
+    vkrc::Buffer readback_;              // windowed: the presented-image check
     vkrc::Swapchain swapchain_;          // windowed
     vkrc::HeadlessPresenter offscreen_;  // headless: every frame; windowed: the reference frame
     vkrc::Presenter* presenter_ = nullptr;

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# The teapot runs behind docs/benchmarks.md, on whatever device this machine
+# has: 25 and 2 500 teapots, headless, --runs 3 fresh processes each. Writes
+# one CSV per configuration into OUT, each headed by '# key: value' lines
+# (device, driver, date, command, git revision) that scripts/gen_bench_docs.py
+# reads; copy them into docs/results/ and run the generator.
+#
+#   bench/device_run.sh BUILD_DIR OUT [NAME]
+#
+# BUILD_DIR: a Release build with the bench (BUILD_DIR/bench/teapot), e.g.
+#   cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_TESTS=OFF
+#   cmake --build build-release -j --target teapot
+# NAME: the results' file prefix (default: the date and a device slug).
+# FRAMES_25 / FRAMES_2500 (environment) override the frames per run (2500 / 400).
+set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: bench/device_run.sh BUILD_DIR OUT [NAME]" >&2
+  exit 2
+fi
+build=$1
+out=$2
+name=${3:-}
+teapot="$build/bench/teapot"
+[ -x "$teapot" ] || { echo "device_run.sh: no $teapot (build the teapot target first)" >&2; exit 1; }
+mkdir -p "$out"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+revision=$(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)
+if git -C "$source_dir" status --porcelain 2>/dev/null | grep -q .; then revision="$revision (with local changes)"; fi
+driver=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverInfo/ {print $2; exit}' || true)
+driver_name=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverName/ {print $2; exit}' || true)
+[ -n "$driver_name" ] || driver_name="mesa-vulkan-drivers $(dpkg-query -W -f="\${Version}" mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+
+run() {  # run FILE-SUFFIX teapot-args...
+  local suffix=$1
+  shift
+  local csv="$out/tmp-$suffix.csv" log="$out/tmp-$suffix.log"
+  local command="bench/teapot --runs 3 $*"
+  echo "== $command" >&2
+  "$teapot" --runs 3 "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
+  local device
+  device=$(awk -F': ' '/^device: / {print $2; exit}' "$log")
+  local prefix=$name
+  [ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+  {
+    echo "# device: $device"
+    echo "# driver: ${driver_name:-unknown} ${driver:-}"
+    echo "# date: $date_utc"
+    echo "# command: $command"
+    echo "# git: $revision"
+    echo "# host: $(nproc) CPUs, $(uname -sr)"
+    cat "$csv"
+  } >"$out/$prefix-$suffix.csv"
+  rm -f "$csv"
+  echo "wrote $out/$prefix-$suffix.csv" >&2
+}
+
+run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
+run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"

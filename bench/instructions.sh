@@ -1,0 +1,120 @@
+#!/usr/bin/env bash
+# Instructions per call of every per-frame stage of every teapot variant,
+# counted by valgrind's callgrind: deterministic where timers are noise.
+#
+#   bench/instructions.sh TEAPOT CSV [teapot options...]
+#
+# TEAPOT is a built bench/teapot (Release for figures worth quoting), CSV the
+# file to write (variant,stage,calls,instructions,instructions_per_call,
+# ratio_to_ref; the reference is raw-direct); the options go to
+# `teapot --instructions` (e.g. --variants vkrc-st,vkrc-mt --frames 50
+# --teapots 25; --frames is the number of calls counted per stage). Each
+# stage of each variant is collected on its own (callgrind client requests
+# around that stage's call, main thread only) and dumped; the dumps are
+# parsed here. Prints the table too.
+set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: bench/instructions.sh TEAPOT CSV [teapot options...]" >&2
+  exit 2
+fi
+teapot=$1
+csv=$2
+shift 2
+valgrind=${VALGRIND:-valgrind}
+if ! command -v "$valgrind" >/dev/null 2>&1; then
+  echo "instructions.sh: FAILED: valgrind not found (install the Debian package valgrind," \
+       "scripts/install-deps.sh does)" >&2
+  exit 1
+fi
+dumps=$(mktemp -d /tmp/teapot-callgrind.XXXXXX)
+trap 'rm -rf "$dumps"' EXIT
+"$valgrind" --tool=callgrind --collect-atstart=no --callgrind-out-file="$dumps/callgrind.out" \
+  "$teapot" --instructions "$@" >"$dumps/log" 2>&1 || {
+  cat "$dumps/log" >&2
+  echo "instructions.sh: FAILED: teapot --instructions under callgrind" >&2
+  exit 1
+}
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
+{
+  echo "# device: ${device:-${DEVICE:-unknown}}"
+  echo "# driver: $(dpkg-query -W -f='mesa-vulkan-drivers ${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+  echo "# date: $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "# command: bench/instructions.sh TEAPOT CSV $*"
+  echo "# git: $(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$(dirname "$teapot")/../CMakeCache.txt" | cut -d= -f2 || true)"
+} >"$dumps/header"
+python3 - "$dumps" "$csv" <<'PY'
+import glob, os, re, sys
+dumps, csv = sys.argv[1], sys.argv[2]
+# The driver: the ICD and what it links (lavapipe's LLVM and gallium, GPU
+# vendors' user-mode drivers). Calls from any other object into one of them
+# are the driver's work; their inclusive cost is subtracted to give the
+# instructions outside the driver (application, wrapper, loader, libc).
+DRIVER = re.compile(r"libvulkan_|libLLVM|libgallium|libnvidia|libdrm|libamdgpu|libGLX_nvidia|lvp|radv|anv")
+rows = {}
+for path in glob.glob(os.path.join(dumps, "callgrind.out*")):
+    desc, total, driver = None, None, 0
+    names, ob, cob, call_target = {}, None, None, None
+    with open(path, errors="replace") as f:
+        for line in f:
+            m = re.match(r"desc: Trigger: Client Request: teapot (.*)", line)
+            if m:
+                desc = dict(kv.split("=", 1) for kv in m.group(1).split())
+            m = re.match(r"(?:summary|totals): (\d+)", line)
+            if m:
+                total = int(m.group(1))
+            m = re.match(r"(c?ob)=(?:\((\d+)\))?\s*(.*)", line)
+            if m:
+                key, ident, name = m.group(1), m.group(2), m.group(3).strip()
+                if ident and name:
+                    names[ident] = name
+                obj = names.get(ident, name) if ident else name
+                if key == "ob":
+                    ob, cob = obj, None
+                else:
+                    cob = obj
+                continue
+            if line.startswith("calls="):
+                call_target = cob if cob is not None else ob
+                cob = None
+                continue
+            if call_target is not None and re.match(r"[+\-*\d]", line):
+                cost = int(line.split()[1]) if len(line.split()) > 1 else 0
+                if DRIVER.search(call_target or "") and not DRIVER.search(ob or ""):
+                    driver += cost
+                call_target = None
+            elif line.startswith(("fn=", "cfn=", "cfi=", "cfl=")) and line.startswith("fn="):
+                cob = None
+    if desc and total is not None:
+        rows[(desc["variant"], desc["stage"])] = (int(desc["calls"]), total, total - driver)
+if not rows:
+    sys.exit("instructions.sh: FAILED: no per-stage dumps (teapot built without valgrind/callgrind.h?)")
+order = ["acquire", "uniform", "command", "submit", "present", "wait", "update"]
+variants = []
+for v, _ in sorted(rows, key=lambda k: k[0]):
+    if v not in variants:
+        variants.append(v)
+if "raw-direct" in variants:
+    variants.remove("raw-direct")
+    variants.insert(0, "raw-direct")
+os.makedirs(os.path.dirname(os.path.abspath(csv)), exist_ok=True)
+with open(csv, "w") as out:
+    out.write(open(os.path.join(dumps, "header")).read())
+    out.write("variant,stage,calls,instructions,instructions_per_call,ratio_to_ref,"
+              "outside_driver_per_call,outside_driver_ratio_to_ref\n")
+    print(f"{'stage':8} {'variant':16} {'calls':>6} {'instructions':>14} {'per_call':>12} {'ratio':>8}"
+          f" {'outside_driver':>15} {'ratio':>8}")
+    for stage in order:
+        ref = rows.get(("raw-direct", stage))
+        for v in variants:
+            if (v, stage) not in rows:
+                continue
+            calls, total, outside = rows[(v, stage)]
+            per, per_out = total / calls, outside / calls
+            ratio = "" if not ref or ref[1] == 0 else f"{per / (ref[1] / ref[0]):.4f}"
+            ratio_out = "" if not ref or ref[2] == 0 else f"{per_out / (ref[2] / ref[0]):.4f}"
+            out.write(f"{v},{stage},{calls},{total},{per:.1f},{ratio},{per_out:.1f},{ratio_out}\n")
+            print(f"{stage:8} {v:16} {calls:6} {total:14} {per:12.1f} {ratio:>8} {per_out:15.1f} {ratio_out:>8}")
+print(f"CSV in {csv}")
+PY
