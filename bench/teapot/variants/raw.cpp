@@ -92,6 +92,27 @@ void pipeline_barrier(PFN_vkCmdPipelineBarrier2 barrier, VkCommandBuffer cmd,
 }
 
 // Begins a one-time-submit recording of cmd after resetting its pool.
+// Copies the first mip level of a colour image (already in TRANSFER_SRC
+// layout) to a host-visible buffer and makes the bytes visible to the host;
+// after_copy, when given, rides in the same barrier (a layout change back).
+void copy_image_to_host(const DeviceFunctions& fn, VkCommandBuffer cmd, VkImage image, VkExtent2D extent,
+                        VkBuffer buffer, std::span<const VkImageMemoryBarrier2> after_copy = {}) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {extent.width, extent.height, 1};
+    fn.vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
+    VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+    to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+    to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+    to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    to_host.buffer = buffer;
+    to_host.size = VK_WHOLE_SIZE;
+    pipeline_barrier(fn.vkCmdPipelineBarrier2, cmd, after_copy, {&to_host, 1});
+}
+
 void begin_one_time(const DeviceFunctions& fn, VkDevice device, VkCommandPool pool, VkCommandBuffer cmd) {
     check(fn.vkResetCommandPool(device, pool, 0), "vkResetCommandPool");
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
@@ -342,23 +363,10 @@ public:
             image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
             VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {window_sc_.extent.width, window_sc_.extent.height, 1};
-        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
         const VkImageMemoryBarrier2 back = image_barrier(
             image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
             VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
-        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.buffer = readback_buffer_;
-        to_host.size = VK_WHOLE_SIZE;
-        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&back, 1}, {&to_host, 1});
+        copy_image_to_host(fn_, f.cmd, image, window_sc_.extent, readback_buffer_, {&back, 1});
         check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
         cmd_info.commandBuffer = f.cmd;
         VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
@@ -458,20 +466,7 @@ private:
             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {config_.width, config_.height, 1};
-        fn_.vkCmdCopyImageToBuffer(f.cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_buffer_, 1, &region);
-        VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-        to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-        to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-        to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_host.buffer = readback_buffer_;
-        to_host.size = VK_WHOLE_SIZE;
-        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {}, {&to_host, 1});
+        copy_image_to_host(fn_, f.cmd, image, {config_.width, config_.height}, readback_buffer_);
         submit_and_wait(fn_, device_, queue_, f.cmd, f.fence);
         const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
         std::vector<std::uint8_t> image_bytes(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
