@@ -171,12 +171,12 @@ void DeferredDestructor::take_ready(DeviceState& device, List<DeferredAction>& o
     }
     // The only allocation comes first, so a failure leaves the queue as it was.
     out.reserve(out.size() + actions);
-    for (; batches > 0; --batches) {
-        auto& batch = batches_.front();
+    for (std::size_t i = 0; i < batches; ++i) {
+        const auto& batch = batches_[i];
         out.append(batch.actions.data(), batch.actions.size());
-        count_.fetch_sub(batch.actions.size(), std::memory_order_relaxed);
-        batches_.pop_front();
     }
+    count_.fetch_sub(actions, std::memory_order_relaxed);
+    batches_.erase_front(batches);
 }
 
 void DeferredDestructor::collect(DeviceState& device) noexcept {

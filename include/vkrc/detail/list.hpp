@@ -81,10 +81,11 @@ public:
         for (; size_ < count; ++size_) new (data_ + size_) T();
         while (size_ > count) data_[--size_].~T();
     }
-    // Removes the first element; for short queues (moves the rest down).
-    void pop_front() noexcept {
-        for (std::size_t i = 1; i < size_; ++i) data_[i - 1] = std::move(data_[i]);
-        data_[--size_].~T();
+    // Removes the first count elements (at most size()), moving the rest down
+    // once: a List used as a queue drains what is ready in one pass.
+    void erase_front(std::size_t count) noexcept {
+        for (std::size_t i = count; i < size_; ++i) data_[i - count] = std::move(data_[i]);
+        while (count-- > 0) data_[--size_].~T();
     }
     void clear() noexcept {
         while (size_ > 0) data_[--size_].~T();

@@ -30,11 +30,14 @@ public:
     // Caller holds the pool's lock. Moves the handles whose GPU work has
     // completed into out, in the order they were pushed.
     void take_ready(DeviceState& device, List<VkHandle>& out) {
-        while (!batches_.empty() && device.reached(batches_.front().wait_values)) {
-            auto& h = batches_.front().handles;
-            out.append(h.data(), h.size());
-            batches_.pop_front();
+        std::size_t ready = 0, handles = 0;
+        for (; ready < batches_.size() && device.reached(batches_[ready].wait_values); ++ready) {
+            handles += batches_[ready].handles.size();
         }
+        // The only allocation comes first, so a failure leaves the queue as it was.
+        out.reserve(out.size() + handles);
+        for (std::size_t i = 0; i < ready; ++i) out.append(batches_[i].handles.data(), batches_[i].handles.size());
+        batches_.erase_front(ready);
     }
     bool empty() const noexcept { return batches_.empty(); }
     std::size_t size() const noexcept {
