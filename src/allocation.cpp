@@ -56,6 +56,12 @@ void AllocationState::on_last_release() noexcept {
                      "VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)");
 }
 
+[[noreturn]] void throw_not_host_coherent(const char* who) {
+    throw UsageError(std::string(who) +
+                     ": the memory is not host-coherent (require VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, or use "
+                     "Allocation::write, which flushes)");
+}
+
 [[noreturn]] void throw_out_of_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
                                      VkDeviceSize size) {
     throw UsageError(std::string(who) + ": " + std::to_string(count) + " elements of " + std::to_string(element) +

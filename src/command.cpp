@@ -85,7 +85,7 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
 }  // namespace
 
 CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept
-    : Handle(std::move(state)), fn_(state_->fn) {}
+    : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
 
 void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
@@ -132,34 +132,6 @@ void CommandBuffer::end() const {
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
     LockGuard lock(state_->pool.state()->mutex);
     check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
-}
-
-VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
-                                    VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                    VkImageAspectFlags aspect) noexcept {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    b.oldLayout = old_layout;
-    b.newLayout = new_layout;
-    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-    return b;
-}
-
-VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    return b;
 }
 
 VKRC_END_NAMESPACE

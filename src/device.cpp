@@ -179,10 +179,9 @@ void DeferredDestructor::take_ready(DeviceState& device, List<DeferredAction>& o
     batches_.erase_front(batches);
 }
 
-void DeferredDestructor::collect(DeviceState& device) noexcept {
+void DeferredDestructor::collect_queued(DeviceState& device) noexcept {
     List<DeferredAction> ready;
     {
-        if (count_.load(std::memory_order_relaxed) == 0) return;
         LockGuard lock(mutex_);
         if (batches_.empty()) return;
         try {

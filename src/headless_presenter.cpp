@@ -10,20 +10,37 @@ VKRC_BEGIN_NAMESPACE
 
 namespace {
 
-void make_ring(detail::HeadlessPresenterState& s) {
+detail::Ref<detail::FrameImages> make_ring(const detail::HeadlessPresenterState& s, VkExtent2D extent) {
     ImageCreateInfo info;
     info.format = s.info.format;
-    info.extent = {s.info.extent.width, s.info.extent.height, 1};
+    info.extent = {extent.width, extent.height, 1};
     info.usage = s.info.image_usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    std::vector<Image> images;
-    std::vector<ImageView> views;
+    detail::Ref<detail::FrameImages> ring(new detail::FrameImages);
+    ring->extent = extent;
+    ring->images.reserve(s.info.image_count);
+    ring->views.reserve(s.info.image_count);
     for (std::uint32_t i = 0; i < s.info.image_count; ++i) {
-        images.push_back(Image::create(s.queue.device(), info));
-        views.push_back(ImageView::create(images.back()));
+        ring->images.push_back(Image::create(s.queue.device(), info));
+        ring->views.push_back(ImageView::create(ring->images.back()));
     }
-    s.images = std::move(images);
-    s.views = std::move(views);
-    s.needs_resize = false;
+    return ring;
+}
+
+// Makes the ring a pending resize() asked for; false while its extent is
+// zero. The new ring is made outside the spin lock, which acquire holds.
+// Cold: kept out of acquire's fast path.
+[[gnu::cold, gnu::noinline]] bool apply_resize(detail::HeadlessPresenterState& s) {
+    LockGuard resizing(s.resize_mutex);
+    if (!s.needs_resize.load(std::memory_order_acquire)) return true;  // another thread did it
+    const VkExtent2D extent = s.info.extent;
+    if (extent.width == 0 || extent.height == 0) return false;
+    detail::Ref<detail::FrameImages> ring = make_ring(s, extent);
+    {
+        LockGuard lock(s.lock);
+        std::swap(s.ring, ring);
+    }
+    s.needs_resize.store(false, std::memory_order_release);
+    return true;  // the old ring goes with ring, outside the spin lock
 }
 
 }  // namespace
@@ -37,36 +54,40 @@ HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPr
     detail::Ref<detail::HeadlessPresenterState> state(new detail::HeadlessPresenterState);
     state->queue = queue;
     state->info = info;
-    make_ring(*state);
+    state->ring = make_ring(*state, info.extent);
     return HeadlessPresenter(std::move(state));
 }
 
-Frame HeadlessPresenter::acquire() {
+PresentStatus HeadlessPresenter::acquire(Frame& frame) {
     auto& s = *state_;
-    LockGuard lock(s.mutex);
-    Frame frame;
-    if (s.needs_resize) {
-        if (s.info.extent.width == 0 || s.info.extent.height == 0) {
-            frame.status = PresentStatus::zero_extent;
-            return frame;
-        }
-        make_ring(s);
+    if (s.needs_resize.load(std::memory_order_acquire) && !apply_resize(s)) [[unlikely]] {
+        frame.clear(PresentStatus::zero_extent);
+        return frame.status;
     }
+    LockGuard lock(s.lock);
     const auto index = static_cast<std::uint32_t>(s.acquired++ % s.info.image_count);
+    if (frame.filled_from_ != s.ring.get()) [[unlikely]]
+        return refill(frame, s, index);  // a tail call: the common path has no call
+    frame.point_at(*s.ring, index);
     frame.status = PresentStatus::success;
-    frame.image_index = index;
-    frame.image = s.images[index];
-    frame.view = s.views[index];
-    frame.extent = s.info.extent;
+    return PresentStatus::success;
+}
+
+PresentStatus HeadlessPresenter::refill(Frame& frame, detail::HeadlessPresenterState& s, std::uint32_t index) noexcept {
+    frame.hold(s.ring);
     frame.format = s.info.format;
     frame.present_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    frame.sync_count_ = 0;
+    frame.chain_ = nullptr;
     frame.source_ = &s;
-    return frame;
+    frame.point_at(*s.ring, index);
+    frame.status = PresentStatus::success;
+    return PresentStatus::success;
 }
 
 PresentStatus HeadlessPresenter::present(const Frame& frame) {
     auto& s = *state_;
-    if (!frame.image || frame.source_ != &s) {
+    if (!frame || frame.source_ != &s) {
         throw UsageError("vkrc::HeadlessPresenter::present: the frame was not acquired from this presenter");
     }
     s.last_presented.store(frame.image_index, std::memory_order_relaxed);
@@ -75,24 +96,25 @@ PresentStatus HeadlessPresenter::present(const Frame& frame) {
 
 List<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
     auto& s = *state_;
-    Image image;
+    detail::Ref<detail::FrameImages> ring;
     {
-        LockGuard lock(s.mutex);
-        if (image_index >= s.images.size()) {
-            throw UsageError("vkrc::HeadlessPresenter::read_back: image " + std::to_string(image_index) +
-                             " does not exist (the ring has " + std::to_string(s.images.size()) + ")");
-        }
-        image = s.images[image_index];
+        LockGuard lock(s.lock);
+        ring = s.ring;
     }
+    if (image_index >= ring->images.size()) {
+        throw UsageError("vkrc::HeadlessPresenter::read_back: image " + std::to_string(image_index) +
+                         " does not exist (the ring has " + std::to_string(ring->images.size()) + ")");
+    }
+    const Image& image = ring->images[image_index];
     s.queue.device().state()->await_submission(*s.queue.state(), s.queue.state()->timeline.last_submitted());
     return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
 }
 
 void HeadlessPresenter::resize(VkExtent2D extent) {
     auto& s = *state_;
-    LockGuard lock(s.mutex);
+    LockGuard resizing(s.resize_mutex);
     s.info.extent = extent;
-    s.needs_resize = true;
+    s.needs_resize.store(true, std::memory_order_release);
 }
 
 VkExtent2D HeadlessPresenter::extent() const noexcept { return state_->info.extent; }

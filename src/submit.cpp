@@ -1,72 +1,112 @@
 #include "vkrc/submit.hpp"
 
-#include <string>
-
 VKRC_BEGIN_NAMESPACE
 
-void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence) {
-    if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
-    VkSubmitInfo2 infos[SubmitLimits::batches];
-    VkSemaphoreSubmitInfo waits[SubmitLimits::semaphores];
-    VkSemaphoreSubmitInfo signals[SubmitLimits::semaphores];
-    VkCommandBufferSubmitInfo cmds[SubmitLimits::command_buffers];
-    std::size_t n_waits = 0, n_signals = 0, n_cmds = 0;
-    if (batches.size() > SubmitLimits::batches) {
-        throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::batches) + " batches");
-    }
-    auto semaphore_info = [](const SemaphoreSubmit& s) {
-        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        i.semaphore = s.semaphore;
-        i.value = s.value;
-        i.stageMask = s.stage_mask;
-        return i;
-    };
-    for (std::size_t b = 0; b < batches.size(); ++b) {
-        const auto& batch = batches[b];
-        if (batch.waits.size() > SubmitLimits::semaphores - n_waits ||
-            batch.signals.size() > SubmitLimits::semaphores - n_signals) {
-            throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::semaphores) +
-                             " wait or signal semaphores");
-        }
-        if (batch.command_buffers.size() > SubmitLimits::command_buffers - n_cmds) {
-            throw UsageError("vkrc::submit: more than " + std::to_string(SubmitLimits::command_buffers) +
-                             " command buffers");
-        }
-        VkSubmitInfo2& info = infos[b];
-        info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
-        info.pWaitSemaphoreInfos = waits + n_waits;
-        for (const auto& w : batch.waits) waits[n_waits++] = semaphore_info(w);
-        info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
-        info.pSignalSemaphoreInfos = signals + n_signals;
-        for (const auto& s : batch.signals) signals[n_signals++] = semaphore_info(s);
-        info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
-        info.pCommandBufferInfos = cmds + n_cmds;
-        for (const auto& c : batch.command_buffers) {
-            if (!c) throw UsageError("vkrc::submit: a CommandBuffer handle is empty");
+namespace {
+
+// What one batch of a frame loop needs fits on the stack; more goes to the heap.
+constexpr std::size_t inline_semaphores = 4;
+constexpr std::size_t inline_command_buffers = 8;
+constexpr std::size_t inline_batches = 4;
+
+VkSemaphoreSubmitInfo semaphore_info(const SemaphoreSubmit& s) noexcept {
+    VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    i.semaphore = s.semaphore;
+    i.value = s.value;
+    i.stageMask = s.stage_mask;
+    return i;
+}
+
+// Fills info for batch, its semaphores and command buffers going to the
+// given arrays, which have room for them. Inlined into the one-batch submit,
+// the frame loop's.
+[[gnu::always_inline]] inline void fill_batch(const Queue& queue, const SubmitBatch& batch, VkSubmitInfo2& info,
+                                              VkSemaphoreSubmitInfo* waits, VkSemaphoreSubmitInfo* signals,
+                                              VkCommandBufferSubmitInfo* cmds) {
+    info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
+    info.pWaitSemaphoreInfos = waits;
+    for (const auto& w : batch.waits) *waits++ = semaphore_info(w);
+    info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
+    info.pSignalSemaphoreInfos = signals;
+    for (const auto& s : batch.signals) *signals++ = semaphore_info(s);
+    info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
+    info.pCommandBufferInfos = cmds;
+    for (const auto& c : batch.command_buffers) {
+        if (!c) [[unlikely]]
+            throw UsageError("vkrc::submit: a CommandBuffer handle is empty");
 #if VKRC_RUNTIME_CHECKS
-            if (!(c.pool().device() == queue.device())) {
-                throw UsageError("vkrc::submit: a CommandBuffer belongs to another device than the queue");
-            }
-#endif
-            cmds[n_cmds] = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-            cmds[n_cmds++].commandBuffer = c.vk();
+        if (!(c.pool().device() == queue.device())) {
+            throw UsageError("vkrc::submit: a CommandBuffer belongs to another device than the queue");
         }
+#else
+        (void)queue;
+#endif
+        *cmds = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmds++->commandBuffer = c.vk();
     }
+}
+
+void submit_infos(const Queue& queue, std::span<const VkSubmitInfo2> infos, const Fence& fence) {
 #if VKRC_RUNTIME_CHECKS
     if (fence && !(fence.device() == queue.device())) {
         throw UsageError("vkrc::submit: the Fence belongs to another device than the queue");
     }
 #endif
-    const std::uint64_t number =
-        queue.submit(std::span<const VkSubmitInfo2>(infos, batches.size()), fence ? fence.vk() : VK_NULL_HANDLE);
-    if (fence) {
-        fence.state()->note_submitted(*queue.state(), number);
+    const std::uint64_t number = queue.submit(infos, fence ? fence.vk() : VK_NULL_HANDLE);
+    if (fence) fence.state()->note_submitted(*queue.state(), number);
+}
+
+// An array of n elements: on the stack up to N, on the heap beyond.
+template <class T, std::size_t N>
+class Scratch {
+public:
+    explicit Scratch(std::size_t n) : data_(n <= N ? inline_ : (heap_.resize(n), heap_.data())) {}
+    T* data() noexcept { return data_; }
+
+private:
+    T inline_[N];
+    List<T> heap_;
+    T* data_;
+};
+
+}  // namespace
+
+void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence) {
+    if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
+    std::size_t n_waits = 0, n_signals = 0, n_cmds = 0;
+    for (const auto& b : batches) {
+        n_waits += b.waits.size();
+        n_signals += b.signals.size();
+        n_cmds += b.command_buffers.size();
     }
+    Scratch<VkSubmitInfo2, inline_batches> infos(batches.size());
+    Scratch<VkSemaphoreSubmitInfo, inline_semaphores> waits(n_waits);
+    Scratch<VkSemaphoreSubmitInfo, inline_semaphores> signals(n_signals);
+    Scratch<VkCommandBufferSubmitInfo, inline_command_buffers> cmds(n_cmds);
+    std::size_t w = 0, s = 0, c = 0;
+    for (std::size_t i = 0; i < batches.size(); ++i) {
+        const SubmitBatch& b = batches[i];
+        fill_batch(queue, b, infos.data()[i], waits.data() + w, signals.data() + s, cmds.data() + c);
+        w += b.waits.size();
+        s += b.signals.size();
+        c += b.command_buffers.size();
+    }
+    submit_infos(queue, std::span<const VkSubmitInfo2>(infos.data(), batches.size()), fence);
 }
 
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
-    submit(queue, std::span<const SubmitBatch>(&batch, 1), fence);
+    if (batch.waits.size() > inline_semaphores || batch.signals.size() > inline_semaphores ||
+        batch.command_buffers.size() > inline_command_buffers) [[unlikely]] {
+        return submit(queue, std::span<const SubmitBatch>(&batch, 1), fence);
+    }
+    if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
+    VkSubmitInfo2 info;
+    VkSemaphoreSubmitInfo waits[inline_semaphores];
+    VkSemaphoreSubmitInfo signals[inline_semaphores];
+    VkCommandBufferSubmitInfo cmds[inline_command_buffers];
+    fill_batch(queue, batch, info, waits, signals, cmds);
+    submit_infos(queue, std::span<const VkSubmitInfo2>(&info, 1), fence);
 }
 
 VKRC_END_NAMESPACE

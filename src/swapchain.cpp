@@ -224,7 +224,7 @@ void log_present_mode(const detail::SwapchainState& s) {
 
 void log_images(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR& caps, const std::string& extent_reason,
                 bool replacing) {
-    log(s, std::to_string(s.images.size()) + " images (asked for " + std::to_string(s.info.min_image_count) +
+    log(s, std::to_string(s.images->images.size()) + " images (asked for " + std::to_string(s.info.min_image_count) +
                ", the surface allows " + std::to_string(caps.minImageCount) + " to " +
                (caps.maxImageCount ? std::to_string(caps.maxImageCount) : std::string("any number")) + "), extent " +
                std::to_string(s.extent.width) + "x" + std::to_string(s.extent.height) + " (" + extent_reason + ")" +
@@ -270,12 +270,8 @@ VkSwapchainCreateInfoKHR swapchain_create_info(const detail::SwapchainState& s, 
 }
 
 // A new chain's images (borrowed, each keeping the chain alive) and views.
-struct ChainImages {
-    std::vector<Image> images;
-    std::vector<ImageView> views;
-};
-
-ChainImages wrap_images(const detail::SwapchainState& s, detail::SwapchainChainState& chain, VkExtent2D extent) {
+detail::Ref<detail::FrameImages> wrap_images(const detail::SwapchainState& s, detail::SwapchainChainState& chain,
+                                             VkExtent2D extent) {
     const Device& device = s.queue.device();
     std::uint32_t n = 0;
     check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain.swapchain, &n, nullptr), "vkGetSwapchainImagesKHR");
@@ -285,12 +281,13 @@ ChainImages wrap_images(const detail::SwapchainState& s, detail::SwapchainChainS
     info.format = s.surface_format.format;
     info.extent = {extent.width, extent.height, 1};
     info.usage = s.info.image_usage;
-    ChainImages out;
+    detail::Ref<detail::FrameImages> out(new detail::FrameImages);
+    out->extent = extent;
     for (VkImage image : raw) {
         auto wrapped = Image::adopt(device, image, info, Ownership::borrowed);
         wrapped.state()->owner = detail::Ref<detail::RefCounted>::share(&chain);
-        out.views.push_back(ImageView::create(wrapped));
-        out.images.push_back(std::move(wrapped));
+        out->views.push_back(ImageView::create(wrapped));
+        out->images.push_back(std::move(wrapped));
         chain.render_done.push_back(Semaphore::create_binary(device));
     }
     return out;
@@ -308,8 +305,7 @@ void grow_acquire_ring(detail::SwapchainState& s, std::size_t image_count) {
 // After a failed creation: the old swapchain is retired even so; dropping
 // it lets the next attempt start without an oldSwapchain.
 void drop_chain(detail::SwapchainState& s) noexcept {
-    s.views.clear();
-    s.images.clear();
+    s.images.reset();
     s.chain.reset();
     s.needs_recreate = true;
 }
@@ -330,11 +326,11 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     detail::Ref<detail::SwapchainChainState> chain(new detail::SwapchainChainState);
     chain->queue = s.queue;
     chain->surface = s.surface;
-    ChainImages made;
+    detail::Ref<detail::FrameImages> made;
     try {
         check(device.fn().vkCreateSwapchainKHR(device.vk(), &ci, nullptr, &chain->swapchain), "vkCreateSwapchainKHR");
         made = wrap_images(s, *chain, extent.value);
-        grow_acquire_ring(s, made.images.size());
+        grow_acquire_ring(s, made->images.size());
     } catch (...) {
         drop_chain(s);
         throw;
@@ -342,8 +338,7 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     // The old images and views go; the old swapchain follows once no frame
     // holds its images (its destruction then waits for the GPU).
     const bool replacing = static_cast<bool>(s.chain);
-    s.views = std::move(made.views);
-    s.images = std::move(made.images);
+    s.images = std::move(made);
     s.chain = std::move(chain);
     s.extent = extent.value;
     s.needs_recreate = false;
@@ -382,13 +377,15 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const Sw
     return Swapchain(std::move(state));
 }
 
-Frame Swapchain::acquire() {
+PresentStatus Swapchain::acquire(Frame& frame) {
     auto& s = *state_;
     LockGuard lock(s.mutex);
-    Frame frame;
     if (s.needs_recreate || !s.chain) {
-        frame.status = recreate_locked(s);
-        if (frame.status != PresentStatus::success) return frame;
+        const PresentStatus status = recreate_locked(s);
+        if (status != PresentStatus::success) {
+            frame.clear(status);
+            return status;
+        }
     }
     const Device& device = s.queue.device();
     const std::uint32_t slot = s.next_acquire;
@@ -400,30 +397,31 @@ Frame Swapchain::acquire() {
                                                    s.acquire_semaphores[slot].vk(), VK_NULL_HANDLE, &index);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         s.needs_recreate = true;
-        frame.status = PresentStatus::out_of_date;
-        return frame;
+        frame.clear(PresentStatus::out_of_date);
+        return frame.status;
     }
     device.state()->check_result(r, "vkAcquireNextImageKHR");
     if (r == VK_SUBOPTIMAL_KHR) s.needs_recreate = true;
     s.next_acquire = (slot + 1) % static_cast<std::uint32_t>(s.acquire_semaphores.size());
+    if (frame.filled_from_ != s.images.get()) {
+        frame.hold(s.images);
+        frame.format = s.surface_format.format;
+        frame.present_layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+        frame.source_ = nullptr;
+    }
+    frame.point_at(*s.images, index);
     frame.status = r == VK_SUBOPTIMAL_KHR ? PresentStatus::suboptimal : PresentStatus::success;
-    frame.image_index = index;
-    frame.image = s.images[index];
-    frame.view = s.views[index];
-    frame.extent = s.extent;
-    frame.format = s.surface_format.format;
-    frame.present_layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
     frame.wait_ = SemaphoreSubmit(s.acquire_semaphores[slot], 0, Frame::acquire_stage);
     frame.signal_ = SemaphoreSubmit(s.chain->render_done[index], 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
     frame.sync_count_ = 1;
     frame.acquire_slot_ = slot;
     frame.chain_ = s.chain.get();
-    return frame;
+    return frame.status;
 }
 
 PresentStatus Swapchain::present(const Frame& frame) {
     auto& s = *state_;
-    if (!frame.chain_ || frame.chain_->surface.state() != s.surface.state()) {
+    if (!frame || !frame.chain_ || frame.chain_->surface.state() != s.surface.state()) {
         throw UsageError("vkrc::Swapchain::present: the frame was not acquired from this swapchain");
     }
     LockGuard lock(s.mutex);
@@ -469,12 +467,19 @@ void Swapchain::set_extent(VkExtent2D extent) {
     s.info.extent = extent;
 }
 
+void Frame::hold(const detail::Ref<detail::FrameImages>& set) noexcept {
+    if (set_.get() != set.get()) set_ = detail::Ref<detail::RefCounted>::share(set.get());
+    filled_from_ = set.get();
+}
+
 std::span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
 std::span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
 
 VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
 VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
-std::uint32_t Swapchain::image_count() const noexcept { return static_cast<std::uint32_t>(state_->images.size()); }
+std::uint32_t Swapchain::image_count() const noexcept {
+    return state_->images ? static_cast<std::uint32_t>(state_->images->images.size()) : 0;
+}
 VkSwapchainKHR Swapchain::vk() const noexcept { return state_->chain ? state_->chain->swapchain : VK_NULL_HANDLE; }
 const Surface& Swapchain::surface() const noexcept { return state_->surface; }
 const Queue& Swapchain::queue() const noexcept { return state_->queue; }

@@ -156,15 +156,32 @@ TEST_F(VulkanTest, SecondariesFromFourThreads) {
     }
 }
 
-TEST_F(VulkanTest, SubmitLimitsAreUsageErrors) {
+// Past what fits on the stack (4 batches, 4 semaphores and 8 command
+// buffers per batch), submit builds its Vulkan structures on the heap.
+TEST_F(VulkanTest, SubmitBeyondTheStackArraysRuns) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
-    std::vector<vkrc::CommandBuffer> many(vkrc::SubmitLimits::command_buffers + 1, pool.allocate());
-    try {
-        vkrc::submit(queue, {.command_buffers = many});
-        FAIL() << "no UsageError";
-    } catch (const vkrc::UsageError& e) {
-        EXPECT_STREQ(e.what(), "vkrc::submit: more than 128 command buffers");
+    std::vector<vkrc::CommandBuffer> many;
+    for (int i = 0; i < 40; ++i) {
+        many.push_back(pool.allocate());
+        many.back().begin();
+        many.back().end();
     }
+    std::vector<vkrc::Semaphore> signals;
+    std::vector<vkrc::SemaphoreSubmit> signal_infos;
+    for (int i = 0; i < 6; ++i) {
+        signals.push_back(vkrc::Semaphore::create_timeline(device, 0));
+        signal_infos.emplace_back(signals.back(), 1);
+    }
+    auto fence = vkrc::Fence::create(device);
+    // One batch with 20 command buffers and 6 signals, then 5 more batches.
+    std::vector<vkrc::SubmitBatch> batches{{.command_buffers = std::span(many).first(20), .signals = signal_infos}};
+    for (int b = 0; b < 5; ++b) batches.push_back({.command_buffers = std::span(many).subspan(20 + 4 * b, 4)});
+    vkrc::submit(queue, std::span<const vkrc::SubmitBatch>(batches), fence);
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
+    for (const auto& s : signals) EXPECT_EQ(s.value(), 1u);
+    fence.unsignal();
+    vkrc::submit(queue, {.command_buffers = std::span(many).first(20)}, fence);  // one batch, on the heap
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
 }
 
 }  // namespace

@@ -66,7 +66,8 @@ struct Renderer {
     vkrc::PresentStatus frame(vkrc::Presenter& presenter, const vkrc::Buffer* readback = nullptr) {
         auto& slot = slots[count % frames_in_flight];
         EXPECT_EQ(slot.fence.wait(), VK_SUCCESS);
-        vkrc::Frame frame = presenter.acquire();
+        vkrc::Frame frame;
+        presenter.acquire(frame);
         if (!frame) return frame.status;
         slot.fence.unsignal();
         record(slot.cmd, frame, readback);
@@ -81,11 +82,11 @@ struct Renderer {
     void record(const vkrc::CommandBuffer& cmd, const vkrc::Frame& frame, const vkrc::Buffer* readback) {
         cmd.begin();
         auto to_attachment =
-            vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                 vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
         cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
-        vkrc::RenderingAttachment target{.image_view = frame.view.vk()};
+        vkrc::RenderingAttachment target{.image_view = frame.view().vk()};
         target.clear_value.color = {{0.1f, 0.2f, 0.3f, 1.0f}};
         cmd.begin_rendering({.render_area = {{0, 0}, frame.extent}, .color_attachments = std::span(&target, 1)});
         cmd.bind_pipeline(pipeline);
@@ -97,13 +98,13 @@ struct Renderer {
         VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
         VkAccessFlags2 access = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
         if (readback) {
-            auto to_copy = vkrc::image_barrier(frame.image.vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage,
+            auto to_copy = vkrc::image_barrier(frame.image().vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, stage,
                                                access, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
             cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
             VkBufferImageCopy region{};
             region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
             region.imageExtent = {frame.extent.width, frame.extent.height, 1};
-            cmd.copy_image_to_buffer(frame.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, *readback,
+            cmd.copy_image_to_buffer(frame.image(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, *readback,
                                      std::span(&region, 1));
             auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                                 VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
@@ -112,7 +113,7 @@ struct Renderer {
             stage = VK_PIPELINE_STAGE_2_COPY_BIT;
             access = 0;
         }
-        auto to_present = vkrc::image_barrier(frame.image.vk(), layout, frame.present_layout, stage, access,
+        auto to_present = vkrc::image_barrier(frame.image().vk(), layout, frame.present_layout, stage, access,
                                               VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
         cmd.end();
@@ -264,7 +265,8 @@ TEST_F(PresentationTest, OneLiveSwapchainPerSurface) {
     }
     // A frame that outlives its Swapchain keeps the Vulkan swapchain, so the
     // surface is not free until the frame goes.
-    auto frame = swapchain.acquire();
+    vkrc::Frame frame;
+    swapchain.acquire(frame);
     ASSERT_TRUE(frame);
     Renderer renderer(queue, swapchain.format());
     renderer.record(renderer.slots[0].cmd, frame, nullptr);
@@ -284,7 +286,8 @@ TEST_F(PresentationTest, OneLiveSwapchainPerSurface) {
 TEST_F(PresentationTest, RetiredSwapchainLivesWhileAFrameHoldsItsImage) {
     auto swapchain = make_swapchain();
     Renderer renderer(queue, swapchain.format());
-    auto frame = swapchain.acquire();
+    vkrc::Frame frame;
+    swapchain.acquire(frame);
     ASSERT_TRUE(frame);
     renderer.record(renderer.slots[0].cmd, frame, nullptr);
     renderer.slots[0].fence.unsignal();
@@ -297,7 +300,7 @@ TEST_F(PresentationTest, RetiredSwapchainLivesWhileAFrameHoldsItsImage) {
     EXPECT_NE(swapchain.vk(), old);
     // Presenting an image of the retired swapchain is still allowed.
     EXPECT_NE(swapchain.present(frame), vkrc::PresentStatus::zero_extent);
-    EXPECT_GE(frame.image.use_count(), 1u);
+    EXPECT_GE(frame.image().use_count(), 1u);
     frame = {};
     renderer.count = 1;
     for (int i = 0; i < 4; ++i) EXPECT_EQ(renderer.frame(swapchain), vkrc::PresentStatus::success);
@@ -372,7 +375,7 @@ void lose_while_presenting(LossObserver how, unsigned seed, const vkrc::glfw::Wi
     if (how == LossObserver::present) {
         auto& slot = renderer->slots[renderer->count % Renderer::frames_in_flight];
         EXPECT_EQ(slot.fence.wait(), VK_SUCCESS);
-        frame = swapchain.acquire();
+        swapchain.acquire(frame);
         ASSERT_TRUE(frame);
         slot.fence.unsignal();
         renderer->record(slot.cmd, frame, nullptr);
@@ -385,7 +388,7 @@ void lose_while_presenting(LossObserver how, unsigned seed, const vkrc::glfw::Wi
         if (how == LossObserver::present) {
             swapchain.present(frame);
         } else {
-            frame = swapchain.acquire();
+            swapchain.acquire(frame);
         }
         ADD_FAILURE() << "no DeviceLostError";
     } catch (const vkrc::DeviceLostError& e) {
@@ -395,8 +398,8 @@ void lose_while_presenting(LossObserver how, unsigned seed, const vkrc::glfw::Wi
     EXPECT_TRUE(device.lost());
 
     // Later calls report the loss too, none waits.
-    EXPECT_THROW(swapchain.acquire(), vkrc::DeviceLostError);
-    EXPECT_THROW(swapchain.acquire(), vkrc::DeviceLostError);
+    EXPECT_THROW(swapchain.acquire(frame), vkrc::DeviceLostError);
+    EXPECT_THROW(swapchain.acquire(frame), vkrc::DeviceLostError);
     if (frame) EXPECT_THROW(swapchain.present(frame), vkrc::DeviceLostError);
     for (auto& slot : renderer->slots) EXPECT_THROW(slot.fence.wait(), vkrc::DeviceLostError);
     EXPECT_THROW(queue.wait_idle(), vkrc::DeviceLostError);

@@ -109,12 +109,13 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     // 5. The frame loop: acquire, animate, record, submit, present.
     const auto start = std::chrono::steady_clock::now();
     const long frames = options.frame_limit();
+    vkrc::Frame frame;  // refilled by every acquire
     for (long n = 0; frames < 0 || n < frames;) {
         if (!options.headless) vkrc::glfw::Window::poll_events();
         if (window.window && window.window.should_close()) break;
         FrameResources& f = in_flight[n % 2];
         f.done.wait();
-        vkrc::Frame frame = presenter.acquire();
+        presenter.acquire(frame);
         if (!frame) {  // minimised (wait for the window to come back) or being re-created
             if (frame.status == vkrc::PresentStatus::zero_extent) vkrc::glfw::Window::wait_events();
             continue;
@@ -139,7 +140,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_attachments[2] = {
-            vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                 vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
             vkrc::image_barrier(
@@ -149,7 +150,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                 VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, to_attachments);
-        vkrc::RenderingAttachment colour_target{.image_view = frame.view.vk()};
+        vkrc::RenderingAttachment colour_target{.image_view = frame.view().vk()};
         colour_target.clear_value.color = {{0.08f, 0.09f, 0.11f, 1.0f}};
         vkrc::RenderingAttachment depth_target{depth_view.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                                                VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
@@ -167,7 +168,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             cmd.draw_indexed(static_cast<std::uint32_t>(mesh.indices.size()));
         }
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        auto to_present = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                               frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));

@@ -69,13 +69,14 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     // 5. The frame loop. acquire() re-creates a resized window's swapchain
     //    and returns no image while it is minimised.
     const long frames = options.frame_limit();
+    vkrc::Frame frame;  // refilled by every acquire
     for (long n = 0; frames < 0 || n < frames;) {
         if (!options.headless) vkrc::glfw::Window::poll_events();
         if (window.window && window.window.should_close()) break;
         const auto& cmd = commands[n % 2];
         const auto& done = fences[n % 2];
         done.wait();
-        vkrc::Frame frame = presenter.acquire();
+        presenter.acquire(frame);
         if (!frame) {  // minimised (wait for the window to come back) or being re-created
             if (frame.status == vkrc::PresentStatus::zero_extent) vkrc::glfw::Window::wait_events();
             continue;
@@ -83,11 +84,11 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         done.unsignal();
         cmd.begin();
         auto to_attachment = vkrc::image_barrier(  // after the presentation engine is done with it
-            frame.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
             vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
         cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
-        vkrc::RenderingAttachment target{.image_view = frame.view.vk()};
+        vkrc::RenderingAttachment target{.image_view = frame.view().vk()};
         target.clear_value.color = {{0.1f, 0.1f, 0.12f, 1.0f}};  // the plain background
         cmd.begin_rendering({.render_area = {{0, 0}, frame.extent}, .color_attachments = std::span(&target, 1)});
         cmd.bind_pipeline(pipeline);
@@ -95,7 +96,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.bind_vertex_buffer(0, vertex_buffer);
         cmd.draw(3);
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(frame.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        auto to_present = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                               frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));

@@ -24,6 +24,7 @@ struct SingleThreadPolicy {
         bool try_lock() noexcept { return true; }
         void unlock() noexcept {}
     };
+    using SpinLock = Mutex;
     static constexpr bool multi_thread = false;
     static void increment(Count& c) noexcept { ++c; }
     // True when the count reached zero.
@@ -107,6 +108,24 @@ struct MultiThreadPolicy {
     private:
         pthread_mutex_t m_ = PTHREAD_MUTEX_INITIALIZER;
     };
+    // For critical sections of a few instructions, where a pthread mutex
+    // would cost more than the work: one exchange to lock, one store to unlock.
+    class SpinLock {
+    public:
+        void lock() noexcept {
+            while (locked_.exchange(true, __ATOMIC_ACQUIRE)) {
+                while (locked_.load(__ATOMIC_RELAXED)) {
+#if defined(__x86_64__) || defined(__i386__)
+                    __builtin_ia32_pause();
+#endif
+                }
+            }
+        }
+        void unlock() noexcept { locked_.store(false, __ATOMIC_RELEASE); }
+
+    private:
+        detail::Atomic<bool> locked_{false};
+    };
     static constexpr bool multi_thread = true;
     static void increment(Count& c) noexcept { c.fetch_add(1, __ATOMIC_RELAXED); }
     static bool decrement(Count& c) noexcept { return c.fetch_sub(1, __ATOMIC_ACQ_REL) == 1; }
@@ -119,17 +138,19 @@ using ThreadPolicy = MultiThreadPolicy;
 using ThreadPolicy = SingleThreadPolicy;
 #endif
 using Mutex = ThreadPolicy::Mutex;
+using SpinLock = ThreadPolicy::SpinLock;
 
-// Holds a Mutex locked for its scope (std::lock_guard without <mutex>).
+// Holds a Mutex (or SpinLock) locked for its scope (std::lock_guard without <mutex>).
+template <class Lockable = Mutex>
 class LockGuard {
 public:
-    explicit LockGuard(Mutex& mutex) noexcept : mutex_(mutex) { mutex_.lock(); }
+    explicit LockGuard(Lockable& mutex) noexcept : mutex_(mutex) { mutex_.lock(); }
     LockGuard(const LockGuard&) = delete;
     LockGuard& operator=(const LockGuard&) = delete;
     ~LockGuard() { mutex_.unlock(); }
 
 private:
-    Mutex& mutex_;
+    Lockable& mutex_;
 };
 
 namespace detail {

@@ -240,6 +240,7 @@ private:
 };
 
 [[noreturn]] void throw_not_host_visible(const char* who);
+[[noreturn]] void throw_not_host_coherent(const char* who);
 [[noreturn]] void throw_out_of_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
                                      VkDeviceSize size);
 
@@ -278,19 +279,21 @@ inline void write_mapped(const char* who, const AllocationState* s, std::byte* m
 
 }  // namespace detail
 
-// Writes to upload memory. Reading write-combined memory is slow, so this
-// view has no read; it flushes each write on non-coherent memory. It holds
-// copies of the mapping's address, size and coherence (fixed for the
-// allocation's life), so a view kept next to the other per-frame data writes
-// with no pointer chase through the Allocation (the per-frame uniform write
-// costs what a raw pointer's memcpy costs). Use it while its Allocation lives.
+// Writes to host-coherent upload memory as plain copies. Reading
+// write-combined memory is slow, so this view has no read; coherent memory
+// needs no flush, so a write is the memcpy alone (with VKRC_RUNTIME_CHECKS, a
+// range check before it). It holds copies of the mapping's address and size
+// (fixed for the allocation's life), so a view kept next to the other
+// per-frame data writes with no pointer chase through the Allocation. Use it
+// while its Allocation lives.
 class WriteOnlyView {
 public:
     // An empty view (size 0), to be assigned from Allocation::write_only().
     WriteOnlyView() noexcept = default;
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
-        detail::write_mapped("vkrc::WriteOnlyView::write", s_, mapped_, size_, coherent_, offset, data, count);
+        // Coherent: write_mapped's flush branch folds away.
+        detail::write_mapped("vkrc::WriteOnlyView::write", nullptr, mapped_, size_, true, offset, data, count);
     }
     template <class T>
     void write(VkDeviceSize offset, std::span<const T> data) const {
@@ -304,12 +307,9 @@ public:
 
 private:
     friend class Allocation;
-    explicit WriteOnlyView(const detail::AllocationState* s) noexcept
-        : s_(s), mapped_(s->info.mapped), size_(s->info.size), coherent_(s->coherent) {}
-    const detail::AllocationState* s_ = nullptr;  // for flushes
+    explicit WriteOnlyView(const detail::AllocationState* s) noexcept : mapped_(s->info.mapped), size_(s->info.size) {}
     std::byte* mapped_ = nullptr;
     VkDeviceSize size_ = 0;
-    bool coherent_ = true;
 };
 
 // A range of device memory owned by its handles; keeps its Device alive and
@@ -378,9 +378,13 @@ public:
         read(offset, &value, 1);
         return value;
     }
-    // For upload memory: a view that can only write.
+    // For host-coherent upload memory: a view whose writes are plain copies.
+    // UsageError on memory that is not host-visible or not host-coherent
+    // (request VK_MEMORY_PROPERTY_HOST_COHERENT_BIT in MemoryIntent's
+    // required_flags, or use write(), which flushes).
     WriteOnlyView write_only() const {
         if (!state_->info.mapped) detail::throw_not_host_visible("vkrc::Allocation::write_only");
+        if (!state_->coherent) detail::throw_not_host_coherent("vkrc::Allocation::write_only");
         return WriteOnlyView(state_.get());
     }
 

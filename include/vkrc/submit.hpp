@@ -26,15 +26,10 @@ struct SubmitBatch {
     std::span<const SemaphoreSubmit> signals{};
 };
 
-// Limits of one submit() call, whose Vulkan structures are built on the stack.
-struct SubmitLimits {
-    static constexpr std::size_t batches = 16;
-    static constexpr std::size_t semaphores = 32;        // waits and signals, each, over all batches
-    static constexpr std::size_t command_buffers = 128;  // over all batches
-};
-
 // Queue::submit with typed batches; the fence (if any) signals when all are
-// done. No heap allocation; throws UsageError beyond SubmitLimits.
+// done. The Vulkan structures are built on the stack up to 4 wait and 4
+// signal semaphores and 8 command buffers per batch (4 batches), on the heap
+// beyond.
 void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence = {});
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence = {});
 

@@ -2,10 +2,12 @@
 // HeadlessPresenter (a ring of offscreen images), so that one frame loop
 // serves a window and a machine without a display:
 //
-//     vkrc::Frame frame = presenter.acquire();
+//     vkrc::Frame frame;  // kept across frames: refilled by each acquire
+//     ...
+//     presenter.acquire(frame);
 //     if (!frame) continue;  // minimised, or re-created next time: no image this time
 //     ... record: barrier UNDEFINED -> attachment (src stage frame.acquire_stage),
-//         render into frame.view (frame.extent), barrier -> frame.present_layout
+//         render into frame.view() (frame.extent), barrier -> frame.present_layout
 //     vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = ...,
 //                          .signals = frame.signals()}, fence);
 //     presenter.present(frame);
@@ -25,6 +27,7 @@ namespace detail {
 class SwapchainState;
 class SwapchainChainState;
 class HeadlessPresenterState;
+class FrameImages;
 }  // namespace detail
 
 // What acquire() and present() report; none of them is an exception.
@@ -42,13 +45,15 @@ enum class PresentStatus : std::uint8_t {
     zero_extent,
 };
 
-// One acquired image and what its submission waits on and signals.
+// One acquired image and what its submission waits on and signals. Keep one
+// Frame across the frame loop and let acquire() refill it: it then holds the
+// presenter's image set by one reference taken when the set changes (first
+// acquire, re-creation), so a steady frame loop has no reference-count
+// traffic, and a frame's image stays alive across a resize.
 class Frame {
 public:
     PresentStatus status = PresentStatus::out_of_date;
     std::uint32_t image_index = 0;
-    Image image;  // borrowed from the presenter; keeps it (its swapchain) alive
-    ImageView view;
     VkExtent2D extent{};
     VkFormat format = VK_FORMAT_UNDEFINED;
     // The layout the image must be in when present() is called:
@@ -59,7 +64,11 @@ public:
     static constexpr VkPipelineStageFlags2 acquire_stage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
 
     // True when there is an image to render.
-    explicit operator bool() const noexcept { return static_cast<bool>(image); }
+    explicit operator bool() const noexcept { return image_ != nullptr; }
+    // The image and its view, borrowed from the presenter's image set, which
+    // this Frame keeps alive. Only on a frame that has an image.
+    const Image& image() const noexcept { return *image_; }
+    const ImageView& view() const noexcept { return *view_; }
     // For the submission that renders the image: it waits until the image is
     // free and signals when rendering is done. Empty spans headless.
     // Out of line: building a std::span in a header makes every includer
@@ -70,11 +79,32 @@ public:
 private:
     friend class Swapchain;
     friend class HeadlessPresenter;
+    // The per-image fields from image index of set, which the frame holds.
+    void point_at(const detail::FrameImages& set, std::uint32_t index) noexcept;
+    // For a frame last filled from another set (or none): takes a reference
+    // to set; the caller then fills the fields that stay the same for a
+    // presenter (format, layout, ...). A steady loop never comes here, so it
+    // has no reference-count traffic.
+    void hold(const detail::Ref<detail::FrameImages>& set) noexcept;
+    // Marks the frame empty (status says why); keeps the set it holds.
+    void clear(PresentStatus why) noexcept {
+        status = why;
+        image_ = nullptr;
+        view_ = nullptr;
+        filled_from_ = nullptr;
+        sync_count_ = 0;
+        chain_ = nullptr;
+        source_ = nullptr;
+    }
+    detail::Ref<detail::RefCounted> set_;
+    const void* filled_from_ = nullptr;  // the set the per-presenter fields were filled from
+    const Image* image_ = nullptr;
+    const ImageView* view_ = nullptr;
     SemaphoreSubmit wait_;
     SemaphoreSubmit signal_;
     std::uint32_t sync_count_ = 0;
     std::uint32_t acquire_slot_ = 0;
-    detail::SwapchainChainState* chain_ = nullptr;  // kept alive by image
+    detail::SwapchainChainState* chain_ = nullptr;  // kept alive by set_ (its images keep it)
     const void* source_ = nullptr;                  // the headless presenter's state that made it
 };
 
@@ -84,8 +114,9 @@ private:
 class Presenter {
 public:
     virtual ~Presenter() = default;
-    // The next image to render; see PresentStatus for an empty frame.
-    virtual Frame acquire() = 0;
+    // Refills frame with the next image to render and returns frame.status;
+    // see PresentStatus for an empty frame.
+    virtual PresentStatus acquire(Frame& frame) = 0;
     // Hands the rendered image over (after the submission that renders it).
     virtual PresentStatus present(const Frame& frame) = 0;
     virtual VkExtent2D extent() const noexcept = 0;
@@ -124,7 +155,7 @@ struct SwapchainCreateInfo {
 // Queue and Device alive. Its images are borrowed Image handles that keep
 // the Vulkan swapchain they belong to alive, so a retired swapchain stays
 // until every frame that used it is dropped and its work has completed.
-class Swapchain : public Handle<detail::SwapchainState>, public Presenter {
+class Swapchain final : public Handle<detail::SwapchainState>, public Presenter {
 public:
     Swapchain() noexcept = default;
     // Creates the swapchain and takes the surface: a second live Swapchain
@@ -138,7 +169,7 @@ public:
     static Swapchain create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info);
     static Swapchain create(const Queue& queue, const Surface& surface);  // the defaults
 
-    Frame acquire() override;
+    PresentStatus acquire(Frame& frame) override;
     PresentStatus present(const Frame& frame) override;
     // As of the last (re)creation; under the multi-thread policy read them on
     // the thread that acquires, or use the Frame's.
@@ -183,12 +214,12 @@ struct HeadlessPresenterCreateInfo {
 // (bench/teapot/harness/variant.hpp). Like a swapchain image, a ring image
 // is reused image_count frames later: the frame loop's fences keep it from
 // being rewritten while the GPU still renders into it.
-class HeadlessPresenter : public Handle<detail::HeadlessPresenterState>, public Presenter {
+class HeadlessPresenter final : public Handle<detail::HeadlessPresenterState>, public Presenter {
 public:
     HeadlessPresenter() noexcept = default;
     static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
 
-    Frame acquire() override;
+    PresentStatus acquire(Frame& frame) override;
     PresentStatus present(const Frame& frame) override;
     VkExtent2D extent() const noexcept override;
     VkFormat format() const noexcept override;
@@ -205,9 +236,21 @@ public:
 
 private:
     using Handle::Handle;
+    // acquire() for a frame last filled from elsewhere; under the state's lock.
+    [[gnu::noinline]] static PresentStatus refill(Frame& frame, detail::HeadlessPresenterState& s,
+                                                  std::uint32_t index) noexcept;
 };
 
 namespace detail {
+
+// The images a Frame points into: one Vulkan swapchain's (each keeping its
+// chain alive) or one headless ring. Replaced, not changed, by a re-creation.
+class FrameImages final : public RefCounted {
+public:
+    List<Image> images;
+    List<ImageView> views;
+    VkExtent2D extent{};
+};
 
 // One Vulkan swapchain (current or retired) and its per-image semaphores.
 class SwapchainChainState final : public RefCounted {
@@ -235,8 +278,7 @@ public:
     Surface surface;
     SwapchainCreateInfo info;
     Ref<SwapchainChainState> chain;  // null until the surface has an area
-    List<Image> images;
-    List<ImageView> views;
+    Ref<FrameImages> images;         // the chain's; null with it
     // Ring of acquire semaphores, each reused once the queue has reached the
     // value recorded when the frame that waited on it was presented.
     List<Semaphore> acquire_semaphores;
@@ -253,16 +295,25 @@ class HeadlessPresenterState final : public RefCounted {
 public:
     Queue queue;
     HeadlessPresenterCreateInfo info;
-    List<Image> images;
-    List<ImageView> views;
-    std::uint64_t acquired = 0;  // under mutex
+    Ref<FrameImages> ring;       // under lock
+    std::uint64_t acquired = 0;  // under lock
     // Written by present without the lock: present then touches no state it
     // must read first (its frame is checked against the frame's own fields).
     Atomic<std::uint32_t> last_presented{UINT32_MAX};
-    bool needs_resize = false;
-    mutable Mutex mutex;
+    Atomic<bool> needs_resize{false};
+    // Guards ring and acquired: held for a few instructions per acquire.
+    mutable SpinLock lock;
+    // Serialises re-making the ring (Vulkan calls, allocation) outside lock.
+    mutable Mutex resize_mutex;
 };
 
 }  // namespace detail
+
+inline void Frame::point_at(const detail::FrameImages& set, std::uint32_t index) noexcept {
+    image_index = index;
+    image_ = &set.images[index];
+    view_ = &set.views[index];
+    extent = set.extent;
+}
 
 VKRC_END_NAMESPACE

@@ -5,16 +5,17 @@
 // factory, and vkrc's inline namespaces keep the two copies' vkrc symbols
 // apart.
 //
-// Presentation goes through vkrc's Presenter interface in both modes, so
-// headless and windowed share one code path: a HeadlessPresenter (headless)
-// or a Swapchain on a vkrc::glfw surface (--window). Per frame they do
-// somewhat more than the convention of harness/variant.hpp, being general
+// Presentation goes through vkrc's presenters in both modes, so headless
+// and windowed share one code path: a HeadlessPresenter (headless) or a
+// Swapchain on a vkrc::glfw surface (--window), called directly (both are
+// final: no virtual call). Per frame they do somewhat more than the
+// convention of harness/variant.hpp, being general
 // (include/vkrc/swapchain.hpp, src/swapchain.cpp):
-//   * both: acquire returns a Frame holding the image and its view as
-//     handles (two reference-count increments, and two decrements when the
-//     previous frame is replaced; atomic under vkrc-mt), and acquire takes
-//     the presenter's mutex (a no-op under vkrc-st). The headless presenter
-//     makes no Vulkan call and uses no semaphore; its present takes no lock.
+//   * both: acquire refills one Frame kept across frames, pointing into the
+//     presenter's image set (a reference is taken only when the set changes,
+//     so none per frame). The headless presenter's acquire takes a spin lock
+//     (an exchange and a store under vkrc-mt, nothing under vkrc-st), makes
+//     no Vulkan call and uses no semaphore; its present takes no lock.
 //   * Swapchain: its acquire semaphores are a ring of image count + 1 rather
 //     than one per frame slot, since the presenter does not see the
 //     application's fences; before reusing one, acquire checks that the
@@ -60,20 +61,32 @@ public:
         create_device();
         create_presenters();
         create_geometry(*scene.mesh);
-        create_depth(presenter_->extent());
+        create_depth(to_swapchain_ ? swapchain_.extent() : offscreen_.extent());
         create_pipeline();
         create_frames();
     }
 
     void acquire() override {
-        slot_ = static_cast<std::uint32_t>(frame_count_ % frames_.size());
-        frame_ = presenter_->acquire();
+        slot_ = static_cast<std::uint32_t>(frame_count_ % config_.frames_in_flight);
+        acquire_frame();
+        // Headless the ring keeps its extent (as raw.cpp's, unchecked there).
+        if (!frame_ || (to_swapchain_ && (frame_.extent.width > depth_extent_.width ||
+                                          frame_.extent.height > depth_extent_.height))) [[unlikely]]
+            finish_acquire();
+    }
+
+    // Direct calls to the final classes: no virtual call the raw path lacks.
+    void acquire_frame() { to_swapchain_ ? swapchain_.acquire(frame_) : offscreen_.acquire(frame_); }
+
+    // Out of the per-frame path (as raw.cpp's re-creation): no image yet, or a
+    // re-created swapchain outgrew the depth image (the old one goes after the GPU).
+    [[gnu::noinline]] void finish_acquire() {
         while (!frame_) {  // out of date: re-created by the next acquire; zero extent: a minimised window
             if (frame_.status == vkrc::PresentStatus::zero_extent) wait_window_events();
-            frame_ = presenter_->acquire();
+            acquire_frame();
         }
         if (frame_.extent.width > depth_extent_.width || frame_.extent.height > depth_extent_.height)
-            create_depth(frame_.extent);  // a re-created swapchain outgrew it; the old one goes after the GPU
+            create_depth(frame_.extent);
     }
 
     void uniform() override {
@@ -93,8 +106,9 @@ public:
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_render[2] = {
-            vkrc::image_barrier(frame_.image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+            vkrc::image_barrier(frame_.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED,
+                                VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, vkrc::Frame::acquire_stage, 0,
+                                VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
                                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
             vkrc::image_barrier(
                 depth_.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages,
@@ -103,7 +117,7 @@ public:
                 VK_IMAGE_ASPECT_DEPTH_BIT)};
         cmd.pipeline_barrier({}, {}, to_render);
 
-        vkrc::RenderingAttachment colour{frame_.view.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+        vkrc::RenderingAttachment colour{frame_.view().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                                          VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE};
         std::memcpy(colour.clear_value.color.float32, clear_colour, sizeof clear_colour);
         vkrc::RenderingAttachment depth{depth_view_.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -128,7 +142,7 @@ public:
 
         // PRESENT_SRC_KHR for a swapchain, TRANSFER_SRC_OPTIMAL headless.
         const VkImageMemoryBarrier2 to_present =
-            vkrc::image_barrier(frame_.image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
+            vkrc::image_barrier(frame_.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
                                 VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
                                 VK_PIPELINE_STAGE_2_NONE, 0);
         cmd.pipeline_barrier({}, {}, {&to_present, 1});
@@ -144,12 +158,13 @@ public:
 
     void present() override {
         // Out of date or suboptimal: the next acquire re-creates the swapchain.
-        presenter_->present(frame_);
+        if (to_swapchain_) swapchain_.present(frame_);
+        else offscreen_.present(frame_);
         ++frame_count_;
     }
 
     void wait() override {
-        Frame& next = frames_[frame_count_ % frames_.size()];
+        Frame& next = frames_[frame_count_ % config_.frames_in_flight];
         if (!next.submitted) return;
         next.fence.wait();
         next.fence.unsignal();
@@ -164,15 +179,15 @@ public:
         drain();
         update(t);
         // Offscreen in both modes: the same stages with the headless presenter.
-        vkrc::Presenter* const timed = presenter_;
-        presenter_ = &offscreen_;
+        const bool timed = to_swapchain_;
+        to_swapchain_ = false;
         acquire();
         uniform();
         command();
         submit();
         present();
         wait();  // the other slot's last frame: every slot is free afterwards
-        presenter_ = timed;
+        to_swapchain_ = timed;
         return read_back_offscreen();
     }
 
@@ -200,7 +215,7 @@ public:
         f.pool.reset_commands();
         const vkrc::CommandBuffer& cmd = f.cmd;
         cmd.begin();
-        const VkImage image = frame_.image.vk();
+        const VkImage image = frame_.image().vk();
         const VkImageMemoryBarrier2 to_copy = vkrc::image_barrier(
             image, frame_.present_layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -329,7 +344,7 @@ private:
             queue_, {.extent = {config_.width, config_.height},
                      .format = format,
                      .image_count = static_cast<std::uint32_t>(config_.window ? 1 : config_.frames_in_flight + 1)});
-        presenter_ = config_.window ? static_cast<vkrc::Presenter*>(&swapchain_) : &offscreen_;
+        to_swapchain_ = config_.window;
         colour_format_ = format;
     }
 
@@ -423,8 +438,8 @@ private:
     vkrc::Buffer readback_;              // windowed: the presented-image check
     vkrc::Swapchain swapchain_;          // windowed
     vkrc::HeadlessPresenter offscreen_;  // headless: every frame; windowed: the reference frame
-    vkrc::Presenter* presenter_ = nullptr;
-    vkrc::Frame frame_;  // the frame between acquire and the next acquire
+    bool to_swapchain_ = false;          // frames go to swapchain_, else to offscreen_
+    vkrc::Frame frame_;                  // the frame between acquire and the next acquire
     vkrc::Image depth_;
     vkrc::ImageView depth_view_;
     VkExtent2D depth_extent_{};
