@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Checks the formatting, builds vkrc and runs every test: both thread policies
-# under the validation layer, with GCC and with clang, then the whole suite
+# under the validation layer, with GCC and with clang, the instruction budget
+# of the teapot benchmark (optimised build, callgrind), then the whole suite
 # under AddressSanitizer+UndefinedBehaviorSanitizer and the multi-thread tests
 # under ThreadSanitizer. Installs missing Debian packages first.
 # Usage: scripts/test.sh [--quick]   (--quick: no sanitizers)
@@ -33,6 +34,13 @@ run_config test "" -DVKRC_BUILD_BENCH=ON -DVKRC_BUILD_EXAMPLES=ON
 # clang: the library, the tests (hot_path included) and the consumer tests;
 # the benchmarks and examples are GCC's only, to keep CI time down.
 run_config clang "" -DCMAKE_CXX_COMPILER=clang++ -DVKRC_BUILD_BENCH=OFF -DVKRC_BUILD_EXAMPLES=OFF
+# The instruction budget (issue 12): callgrind counts of an optimised teapot
+# benchmark against raw-direct; only that target is built.
+echo "=== budget"
+cmake -S . -B build-budget -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_BENCH=ON -DVKRC_BUILD_EXAMPLES=OFF \
+    -DVKRC_INSTRUCTION_BUDGET=ON >/dev/null
+cmake --build build-budget -j "$jobs" --target teapot
+(cd build-budget && ctest --output-on-failure -L instructions)
 if [ "${1:-}" != "--quick" ]; then
     san="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
     run_config asan "" -DVKRC_BUILD_BENCH=OFF -DVKRC_BUILD_EXAMPLES=OFF \
