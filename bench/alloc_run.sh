@@ -41,7 +41,7 @@ prefix=$name
 [ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
 {
   echo "# device: $device"
-  echo "# driver: ${driver_name:-unknown} ${driver:-}"
+  echo "# driver: ${driver_name:-unknown}${driver:+ $driver}"
   echo "# date: $date_utc"
   echo "# command: bench/alloc --csv FILE (Release build)"
   echo "# git: $revision"

@@ -27,7 +27,7 @@ revision=$(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unkno
 if git -C "$source_dir" status --porcelain 2>/dev/null | grep -q .; then revision="$revision (with local changes)"; fi
 compiler=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$build/CMakeCache.txt")
 version=$("$compiler" --version | head -1)
-slug=$(basename "$compiler" | sed 's/[^a-z+]//g; s/+/x/g')
+case "$("$compiler" -dM -E -x c++ /dev/null)" in *__clang__*) slug=clang ;; *) slug=gcc ;; esac
 vulkan_include=$(sed -n 's/^Vulkan_INCLUDE_DIR:[A-Z]*=//p' "$build/CMakeCache.txt")
 headers=$(awk '/^#define VK_HEADER_VERSION_COMPLETE/ {s = $0; sub(/.*\(/, "", s); gsub(/[^0-9,A-Z_]/, "", s); split(s, v, ","); mm = v[2] "." v[3]}
                /^#define VK_HEADER_VERSION / {patch = $3} END {print mm "." patch}' \
