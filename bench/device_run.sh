@@ -9,7 +9,8 @@
 #
 # BUILD_DIR: a Release build with the bench (BUILD_DIR/bench/teapot), e.g.
 #   cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_TESTS=OFF
-#   cmake --build build-release -j --target teapot
+#   cmake --build build-release -j --target teapot alloc
+# (with alloc built, bench/alloc_run.sh runs too: the allocation results).
 # NAME: the results' file prefix (default: the date and a device slug).
 # FRAMES_25 / FRAMES_2500 (environment) override the frames per run (2500 / 400).
 set -euo pipefail
@@ -58,3 +59,9 @@ run() {  # run FILE-SUFFIX teapot-args...
 
 run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
 run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"
+
+if [ -x "$build/bench/alloc" ]; then
+  "$source_dir/bench/alloc_run.sh" "$build" "$out" ${name:+"$name"}
+else
+  echo "device_run.sh: no $build/bench/alloc: the allocation run is skipped" >&2
+fi

@@ -9,13 +9,15 @@
 // most 0.08 of vk::raii's (issue 18). CPU time is the steadier figure on a shared
 // machine; wall time is what a developer waits.
 //
-// Usage: header_cost [repetitions] [extra compiler flags...]
+// Usage: header_cost [--csv FILE] [repetitions] [extra compiler flags...]
 //   repetitions defaults to 5; extra flags come after the build's (so -O0
-//   overrides the build's -O level).
+//   overrides the build's -O level). --csv writes the medians (one row per
+//   probe) for docs/results/ (bench/header_cost_run.sh adds the run's header).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -86,13 +88,19 @@ double median(std::vector<double> values) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    int repetitions = argc > 1 ? std::atoi(argv[1]) : 5;
+    std::string csv;
+    int first = 1;
+    if (argc > 2 && std::string(argv[1]) == "--csv") {
+        csv = argv[2];
+        first = 3;
+    }
+    int repetitions = argc > first ? std::atoi(argv[first]) : 5;
     if (repetitions < 1) {
-        std::fprintf(stderr, "usage: header_cost [repetitions] [extra compiler flags...]\n");
+        std::fprintf(stderr, "usage: header_cost [--csv FILE] [repetitions] [extra compiler flags...]\n");
         return 2;
     }
     std::vector<std::string> flags = split(VKRC_BENCH_CXX_FLAGS);
-    for (int i = 2; i < argc; ++i) flags.push_back(argv[i]);
+    for (int i = first + 1; i < argc; ++i) flags.push_back(argv[i]);
 
     struct Probe {
         const char* label;
@@ -101,6 +109,7 @@ int main(int argc, char** argv) {
         std::vector<Sample> samples;
     };
     // vkrc, vk::raii, and the floor: the headers vkrc's API names, no vkrc.
+    const char* names[] = {"vkrc", "vk::raii", "floor"};
     Probe probes[] = {{"<vkrc/vkrc.hpp>, device", VKRC_BENCH_SOURCE_DIR "/vkrc_device.cpp", {}, {}},
                       {"<vulkan/vulkan_raii.hpp>, device", VKRC_BENCH_SOURCE_DIR "/raii_device.cpp", {}, {}},
                       {"floor: std/Vulkan headers of API", VKRC_BENCH_SOURCE_DIR "/api_floor.cpp", {}, {}}};
@@ -136,5 +145,21 @@ int main(int argc, char** argv) {
     std::printf("%-34s %10.3f %10.3f   (goal: at most 0.080)\n", "ratio vkrc / vk::raii", wall[0] / wall[1],
                 cpu[0] / cpu[1]);
     std::printf("%-34s %10.3f %10.3f\n", "ratio floor / vk::raii", wall[2] / wall[1], cpu[2] / cpu[1]);
+    if (!csv.empty()) {
+        std::ofstream out(csv);
+        out << "probe,compiler,flags,repetitions,wall_ms,cpu_ms,cpu_ratio_to_raii,wall_ratio_to_raii\n";
+        std::string all_flags = shown_flags + " -std=c++20";
+        all_flags.erase(0, all_flags.find_first_not_of(' '));
+        for (int i = 0; i < 3; ++i) {
+            char row[160];
+            std::snprintf(row, sizeof row, ",%d,%.0f,%.0f,%.3f,%.3f\n", repetitions, wall[i], cpu[i], cpu[i] / cpu[1],
+                          wall[i] / wall[1]);
+            out << names[i] << ',' << VKRC_BENCH_CXX_COMPILER << ",\"" << all_flags << '"' << row;
+        }
+        if (!out) {
+            std::fprintf(stderr, "header_cost: cannot write %s\n", csv.c_str());
+            return 1;
+        }
+    }
     return 0;
 }

@@ -20,7 +20,9 @@ class CommandBufferState;
 
 // Mirrors VkCommandPoolCreateInfo.
 struct CommandPoolCreateInfo {
+    // Optional (default: command buffers reset one by one).
     VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    // The family the pool's command buffers are submitted to (default 0; usually queue.family_index()).
     std::uint32_t queue_family_index = 0;
 };
 
@@ -56,10 +58,13 @@ private:
 // with VkCommandBufferInheritanceRenderingInfo for dynamic rendering). Leave
 // render_pass empty and color_formats empty for secondaries used outside
 // rendering; set either for RENDER_PASS_CONTINUE secondaries.
+// Every member is optional and read during begin_secondary() (the command buffer keeps no reference).
 struct CommandBufferInheritance {
+    // A render pass; subpass and framebuffer (empty: not known) go with it.
     RenderPass render_pass{};
     std::uint32_t subpass = 0;
     Framebuffer framebuffer{};
+    // Dynamic rendering, without render_pass: need not outlive begin_secondary().
     std::span<const VkFormat> color_formats{};
     VkFormat depth_format = VK_FORMAT_UNDEFINED;
     VkFormat stencil_format = VK_FORMAT_UNDEFINED;
@@ -69,21 +74,31 @@ struct CommandBufferInheritance {
 // One attachment of dynamic rendering (VkRenderingAttachmentInfo, no resolve).
 // image_view: view.vk() of an ImageView that lives until the work is submitted.
 struct RenderingAttachment {
+    // Required.
     VkImageView image_view = VK_NULL_HANDLE;
+    // Optional (default colour attachment optimal; set it for depth).
     VkImageLayout image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    // Optional (default clear, then store).
     VkAttachmentLoadOp load_op = VK_ATTACHMENT_LOAD_OP_CLEAR;
     VkAttachmentStoreOp store_op = VK_ATTACHMENT_STORE_OP_STORE;
+    // Used with load_op CLEAR (default zero).
     VkClearValue clear_value{};
 };
 
 // VkRenderingInfo. At most max_color_attachments colour attachments.
+// Read during begin_rendering(): the span and pointers need not outlive the call.
 struct RenderingInfo {
     static constexpr std::uint32_t max_color_attachments = 8;
+    // Required (the default is empty).
     VkRect2D render_area{};
+    // Optional (empty: none).
     std::span<const RenderingAttachment> color_attachments{};
+    // Optional (null: none).
     const RenderingAttachment* depth_attachment = nullptr;
     const RenderingAttachment* stencil_attachment = nullptr;
+    // Optional (default none).
     VkRenderingFlags flags = 0;
+    // Optional (default 1).
     std::uint32_t layer_count = 1;
 };
 

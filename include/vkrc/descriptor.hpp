@@ -16,6 +16,7 @@ class DescriptorSetState;
 }  // namespace detail
 
 // Mirrors VkDescriptorSetLayoutBinding (without immutable samplers).
+// Every member is optional (defaults: binding 0, one uniform buffer, all stages).
 struct DescriptorSetLayoutBinding {
     std::uint32_t binding = 0;
     VkDescriptorType descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
@@ -25,7 +26,9 @@ struct DescriptorSetLayoutBinding {
 
 // Mirrors VkDescriptorSetLayoutCreateInfo.
 struct DescriptorSetLayoutCreateInfo {
+    // Optional (default none).
     VkDescriptorSetLayoutCreateFlags flags = 0;
+    // Optional (empty: an empty layout). Copied: the layout checks writes against it.
     List<DescriptorSetLayoutBinding> bindings{};
 };
 
@@ -44,8 +47,11 @@ private:
 // a dropped set returns to the pool once the GPU is done with it; without it
 // sets are reclaimed only by reset_sets() or the pool's destruction.
 struct DescriptorPoolCreateInfo {
+    // Optional (default: sets freed one by one, see above).
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
+    // Required, non-zero.
     std::uint32_t max_sets = 0;
+    // Required, not empty. Read during create().
     List<VkDescriptorPoolSize> pool_sizes{};
 };
 

@@ -17,7 +17,9 @@ class QueueState;
 
 // Queues wanted from one family (VkDeviceQueueCreateInfo).
 struct QueueRequest {
+    // Must exist on the device (default 0).
     std::uint32_t queue_family_index = 0;
+    // One per queue, 1 to the family's queueCount (default one queue, priority 1).
     List<float> queue_priorities = {1.0f};
 };
 
@@ -25,17 +27,21 @@ struct QueueRequest {
 // synchronization2, dynamicRendering and maintenance4 (it is built on them, and
 // SPIR-V compiled for Vulkan 1.3 needs maintenance4); set any other
 // feature in the structs below. vkrc fills their sType and pNext.
+// Every member is optional and read during create() (lists and extension names
+// are copied): nothing need outlive the call.
 struct DeviceCreateInfo {
     // Empty: one queue from the first family with graphics and compute.
     List<QueueRequest> queue_requests{};
+    // Default none (vkrc adds VK_EXT_memory_budget, see below).
     List<const char*> enabled_extension_names{};
+    // Default none (besides the four above).
     VkPhysicalDeviceFeatures enabled_features{};
     VkPhysicalDeviceVulkan11Features vulkan11_features{};
     VkPhysicalDeviceVulkan12Features vulkan12_features{};
     VkPhysicalDeviceVulkan13Features vulkan13_features{};
-    // Enable VK_EXT_memory_budget when the device has it (for allocator statistics).
+    // Enable VK_EXT_memory_budget when the device has it (for allocator statistics). Default true.
     bool enable_memory_budget = true;
-    // Chained after vkrc's feature structs (must not repeat them).
+    // Chained after vkrc's feature structs (must not repeat them). Null: none.
     const void* next = nullptr;
 };
 

@@ -23,10 +23,14 @@ List<const char*> required_instance_extensions();
 // surface and every swapchain made for it.
 Surface create_surface(const Instance& instance, GLFWwindow* window);
 
+// Every member is optional.
 struct WindowCreateInfo {
+    // Screen coordinates (default 800x600).
     int width = 800;
     int height = 600;
+    // Default "vkrc". Read during create() (GLFW copies it); need not outlive the call.
     const char* title = "vkrc";
+    // Defaults true.
     bool resizable = true;
     bool visible = true;
 };

@@ -30,23 +30,33 @@ using DebugCallback = Function<void(const DebugMessage&)>;
 void print_debug_message(const DebugMessage& message);
 
 // Mirrors VkInstanceCreateInfo, plus vkrc conveniences.
+// Every member is optional. Pointers and lists are read during create() (the
+// enabled extension names are copied): they need not outlive the call.
 struct InstanceCreateInfo {
+    // Default "vkrc application".
     const char* application_name = "vkrc application";
+    // Default 0.
     std::uint32_t application_version = 0;
+    // The highest Vulkan version the application uses (default 1.3, what vkrc needs).
     std::uint32_t api_version = VK_API_VERSION_1_3;
+    // Default none.
     List<const char*> enabled_layer_names{};
+    // Default none (vkrc adds what validation and debug_callback need).
     List<const char*> enabled_extension_names{};
-    // Adds VK_LAYER_KHRONOS_validation and VK_EXT_debug_utils.
+    // Adds VK_LAYER_KHRONOS_validation and VK_EXT_debug_utils. Default false.
     bool validation = false;
     // Installs a debug-utils messenger for the instance's whole life (and for
     // vkCreateInstance/vkDestroyInstance themselves). Null with validation on
     // means print_debug_message. Set it without validation to hear other layers.
+    // Copied into the Instance: what it refers to must outlive the Instance.
     DebugCallback debug_callback{};
+    // Which messages reach the callback (default warnings and errors).
     VkDebugUtilsMessageSeverityFlagsEXT debug_severities =
         VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     // Entry point every function is loaded through; null means the loader's.
     PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr;
     // Chained into VkInstanceCreateInfo::pNext (e.g. VkValidationFeaturesEXT).
+    // Null: none. Read during create() only.
     const void* next = nullptr;
 };
 
@@ -79,17 +89,21 @@ private:
 };
 
 // What a device must offer to be chosen. Every unmet item is reported.
+// Every member is optional and read during select() only.
 struct DeviceRequirements {
+    // Default 1.3 (what vkrc needs).
     std::uint32_t min_api_version = VK_API_VERSION_1_3;
+    // A queue family must have all of them (default graphics and compute).
     VkQueueFlags queue_flags = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
+    // Default none.
     List<const char*> required_extensions{};
-    // A queue family of the chosen device must be able to present to it.
+    // A queue family of the chosen device must be able to present to it (default: no surface).
     VkSurfaceKHR present_surface = VK_NULL_HANDLE;
     // Devices of earlier types in this list win; CPU devices (lavapipe) are accepted.
     List<VkPhysicalDeviceType> preferred_types = {
         VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU,
         VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU, VK_PHYSICAL_DEVICE_TYPE_CPU, VK_PHYSICAL_DEVICE_TYPE_OTHER};
-    // Only a device whose name contains this text (e.g. from an environment variable).
+    // Only a device whose name contains this text (e.g. from an environment variable). Null: any.
     const char* name_contains = nullptr;
 };
 

@@ -27,27 +27,33 @@ enum class MemoryUsage : std::uint8_t {
 };
 
 // The intent of a resource's memory.
+// Every member is optional.
 struct MemoryIntent {
+    // Default gpu_only.
     MemoryUsage usage = MemoryUsage::gpu_only;
-    // Added to what the usage requires / prefers.
+    // Added to what the usage requires / prefers (default none).
     VkMemoryPropertyFlags required_flags = 0;
     VkMemoryPropertyFlags preferred_flags = 0;
-    // Always its own VkDeviceMemory (the driver may also ask for it).
+    // Always its own VkDeviceMemory (the driver may also ask for it). Default false.
     bool dedicated = false;
 };
 
 // Everything an allocator needs to place one resource.
+// Buffer::create and Image::create fill it; Allocation::create takes one from the caller.
 struct AllocationRequest {
+    // Required: size non-zero, memoryTypeBits from the resource.
     VkMemoryRequirements requirements{};
+    // Optional (default: GPU-only memory).
     MemoryIntent intent{};
-    // From VkMemoryDedicatedRequirements (Vulkan 1.1 core).
+    // From VkMemoryDedicatedRequirements (Vulkan 1.1 core). Optional (default false).
     bool prefers_dedicated = false;
     bool requires_dedicated = false;
     // The resource, for VkMemoryDedicatedAllocateInfo when dedicated; at most one set.
+    // Optional (default none); only the handle is passed on, during allocate().
     VkBuffer dedicated_buffer = VK_NULL_HANDLE;
     VkImage dedicated_image = VK_NULL_HANDLE;
     // Buffers and linear images are "linear"; optimal-tiling images are not
-    // (bufferImageGranularity separates the two).
+    // (bufferImageGranularity separates the two). Optional (default true).
     bool linear = true;
 };
 
@@ -157,9 +163,11 @@ private:
     std::uint32_t memory_objects_ = 0;
 };
 
+// Every member is optional. Copied by the PoolAllocator's constructor.
 struct PoolAllocatorCreateInfo {
     // Blocks start at min_block_size and double up to max_block_size (both
-    // capped at an eighth of small heaps).
+    // capped at an eighth of small heaps). Defaults 64 MiB and 256 MiB;
+    // min_block_size non-zero and at most max_block_size.
     VkDeviceSize min_block_size = VkDeviceSize{64} << 20;
     VkDeviceSize max_block_size = VkDeviceSize{256} << 20;
     // Requests larger than this get their own VkDeviceMemory; 0: max_block_size / 2.

@@ -19,7 +19,9 @@ class PipelineCacheState;
 
 // Mirrors VkPipelineLayoutCreateInfo.
 struct PipelineLayoutCreateInfo {
+    // Optional (empty: no sets). Read during create(); the PipelineLayout does not keep them.
     List<DescriptorSetLayout> set_layouts{};
+    // Optional (empty: no push constants). Read during create().
     List<VkPushConstantRange> push_constant_ranges{};
 };
 
@@ -36,6 +38,7 @@ private:
 };
 
 // Mirrors VkSubpassDescription (graphics subpasses).
+// Every list is optional (empty: none) and read during RenderPass::create().
 struct SubpassDescription {
     List<VkAttachmentReference> input_attachments{};
     List<VkAttachmentReference> color_attachments{};
@@ -46,9 +49,13 @@ struct SubpassDescription {
 };
 
 // Mirrors VkRenderPassCreateInfo.
+// Read during create(); the RenderPass keeps only each subpass's colour count.
 struct RenderPassCreateInfo {
+    // Optional (empty: an attachment-less render pass).
     List<VkAttachmentDescription> attachments{};
+    // Required: at least one.
     List<SubpassDescription> subpasses{};
+    // Optional (empty: none).
     List<VkSubpassDependency> dependencies{};
 };
 
@@ -66,10 +73,15 @@ private:
 
 // Mirrors VkFramebufferCreateInfo.
 struct FramebufferCreateInfo {
+    // Required. The Framebuffer keeps it alive.
     RenderPass render_pass{};
+    // One per render-pass attachment; the Framebuffer keeps them alive.
     List<ImageView> attachments{};
+    // Required, non-zero.
     std::uint32_t width = 0;
+    // Required, non-zero.
     std::uint32_t height = 0;
+    // Optional (default 1), non-zero.
     std::uint32_t layers = 1;
 };
 
@@ -148,24 +160,36 @@ class GraphicsPipelineBuilder {
 public:
     explicit GraphicsPipelineBuilder(PipelineLayout layout);
 
+    // Adds a stage (required: at least one). Keeps the module alive until the builder dies; entry_point
+    // is kept as a pointer: it must outlive build().
     GraphicsPipelineBuilder& shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                     const char* entry_point = "main");
+    // Adds a vertex buffer binding (default: none).
     GraphicsPipelineBuilder& vertex_binding(std::uint32_t binding, std::uint32_t stride,
                                             VkVertexInputRate input_rate = VK_VERTEX_INPUT_RATE_VERTEX);
+    // Adds a vertex attribute (default: none).
     GraphicsPipelineBuilder& vertex_attribute(std::uint32_t location, std::uint32_t binding, VkFormat format,
                                               std::uint32_t offset);
+    // Primitive topology (default: triangle list).
     GraphicsPipelineBuilder& topology(VkPrimitiveTopology topology);
+    // Polygon mode (default: fill).
     GraphicsPipelineBuilder& polygon_mode(VkPolygonMode mode);
+    // Cull mode (default: back faces).
     GraphicsPipelineBuilder& cull_mode(VkCullModeFlags mode);
+    // Front face winding (default: counter-clockwise).
     GraphicsPipelineBuilder& front_face(VkFrontFace face);
+    // Depth test, write and compare op (default: test and write with LESS).
     GraphicsPipelineBuilder& depth_test(bool test, bool write = true, VkCompareOp compare = VK_COMPARE_OP_LESS);
-    // The blend state of every colour attachment.
+    // The blend state of every colour attachment (default: no blending, all channels written).
     GraphicsPipelineBuilder& blend(const VkPipelineColorBlendAttachmentState& state);
+    // Rasterization samples (default: one).
     GraphicsPipelineBuilder& samples(VkSampleCountFlagBits samples);
-    // Adds to viewport and scissor.
+    // Adds a dynamic state to viewport and scissor (the default set).
     GraphicsPipelineBuilder& dynamic_state(VkDynamicState state);
+    // Targets a render pass subpass (default: none, dynamic rendering); wins over rendering().
     GraphicsPipelineBuilder& render_pass(const RenderPass& render_pass, std::uint32_t subpass = 0);
-    // Dynamic rendering (Vulkan 1.3) instead of a render pass.
+    // Dynamic rendering (Vulkan 1.3) instead of a render pass (default: no attachments). The formats
+    // are copied: the span need not outlive the call.
     GraphicsPipelineBuilder& rendering(std::span<const VkFormat> color_formats,
                                        VkFormat depth_format = VK_FORMAT_UNDEFINED,
                                        VkFormat stencil_format = VK_FORMAT_UNDEFINED);

@@ -17,14 +17,21 @@ class SamplerState;
 
 // Mirrors VkBufferCreateInfo, plus where its memory comes from.
 struct BufferCreateInfo {
+    // Optional (default none).
     VkBufferCreateFlags flags = 0;
+    // Required, non-zero.
     VkDeviceSize size = 0;
+    // Required, non-zero.
     VkBufferUsageFlags usage = 0;
+    // Optional (default exclusive).
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
+    // For concurrent sharing only. Read during create().
     List<std::uint32_t> queue_family_indices{};
+    // Optional (default: GPU-only memory).
     MemoryIntent memory{};
-    // Null: the device's default allocator (a PoolAllocator).
+    // Null: the device's default allocator (a PoolAllocator). The Device keeps it alive once used.
     SharedAllocator allocator{};
+    // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
 
@@ -52,20 +59,35 @@ private:
 
 // Mirrors VkImageCreateInfo, plus where its memory comes from.
 struct ImageCreateInfo {
+    // Optional (default none).
     VkImageCreateFlags flags = 0;
+    // Optional (default 2D).
     VkImageType image_type = VK_IMAGE_TYPE_2D;
+    // Required.
     VkFormat format = VK_FORMAT_UNDEFINED;
+    // Optional (default 1x1x1); no dimension may be 0.
     VkExtent3D extent{1, 1, 1};
+    // Optional (default 1), non-zero.
     std::uint32_t mip_levels = 1;
+    // Optional (default 1), non-zero.
     std::uint32_t array_layers = 1;
+    // Optional (default one sample).
     VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
+    // Optional (default optimal; linear asks the allocator for linear placement).
     VkImageTiling tiling = VK_IMAGE_TILING_OPTIMAL;
+    // Required, non-zero.
     VkImageUsageFlags usage = 0;
+    // Optional (default exclusive).
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
+    // For concurrent sharing only. Read during create().
     List<std::uint32_t> queue_family_indices{};
+    // Optional (default undefined).
     VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    // Optional (default: GPU-only memory). Ignored by adopt().
     MemoryIntent memory{};
+    // Null: the device's default allocator. The Device keeps it alive once used. Ignored by adopt().
     SharedAllocator allocator{};
+    // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
 
@@ -97,13 +119,18 @@ private:
 };
 
 // Mirrors VkImageViewCreateInfo (the image is the parent).
+// Every member is optional.
 struct ImageViewCreateInfo {
+    // Default none.
     VkImageViewCreateFlags flags = 0;
+    // Default 2D.
     VkImageViewType view_type = VK_IMAGE_VIEW_TYPE_2D;
     VkFormat format = VK_FORMAT_UNDEFINED;  // UNDEFINED: the image's format
+    // Default identity.
     VkComponentMapping components{};
     // aspectMask 0: colour, or depth for depth formats (and stencil for depth-stencil ones).
     VkImageSubresourceRange subresource_range{0, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+    // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
 
@@ -124,10 +151,15 @@ private:
 
 // Mirrors VkBufferViewCreateInfo (the buffer is the parent).
 struct BufferViewCreateInfo {
+    // Optional (default none).
     VkBufferViewCreateFlags flags = 0;
+    // Required.
     VkFormat format = VK_FORMAT_UNDEFINED;
+    // Optional (default 0).
     VkDeviceSize offset = 0;
+    // Optional (default: to the end of the buffer).
     VkDeviceSize range = VK_WHOLE_SIZE;
+    // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
 
@@ -145,6 +177,7 @@ private:
 };
 
 // Mirrors VkSamplerCreateInfo.
+// Every member is optional; the defaults (as initialised) give a trilinear, repeating sampler.
 struct SamplerCreateInfo {
     VkSamplerCreateFlags flags = 0;
     VkFilter mag_filter = VK_FILTER_LINEAR;
@@ -162,6 +195,7 @@ struct SamplerCreateInfo {
     float max_lod = VK_LOD_CLAMP_NONE;
     VkBorderColor border_color = VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK;
     bool unnormalized_coordinates = false;
+    // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
 

@@ -14,14 +14,19 @@ struct SemaphoreSubmit {
     SemaphoreSubmit(const Semaphore& s, std::uint64_t v = 0,
                     VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) noexcept
         : semaphore(s.vk()), value(v), stage_mask(stages) {}
+    // Required. The Semaphore must be alive at submit(); dropping it later is deferred past the GPU's use.
     VkSemaphore semaphore = VK_NULL_HANDLE;
+    // The timeline value to wait for or signal (default 0; binary: ignored).
     std::uint64_t value = 0;
+    // Optional (default all commands).
     VkPipelineStageFlags2 stage_mask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
 };
 
 // One batch of a submission (VkSubmitInfo2).
+// Every span is optional (empty: none) and read during submit(); it need not outlive the call.
 struct SubmitBatch {
     std::span<const SemaphoreSubmit> waits{};
+    // Their handles must not be empty; dropping them after submit() is deferred past the GPU's use.
     std::span<const CommandBuffer> command_buffers{};
     std::span<const SemaphoreSubmit> signals{};
 };

@@ -129,25 +129,30 @@ protected:
     Presenter& operator=(const Presenter&) = default;
 };
 
-// Mirrors what vkrc chooses for VkSwapchainCreateInfoKHR.
+// Mirrors what vkrc chooses for VkSwapchainCreateInfoKHR. Every member is
+// optional; the Swapchain keeps a copy and re-reads it at every re-creation.
 struct SwapchainCreateInfo {
     // Tried in order; the first the surface supports wins, otherwise the
-    // surface's first format.
+    // surface's first format. Default: 8-bit BGRA, then RGBA, sRGB.
     List<VkSurfaceFormatKHR> preferred_formats = {{VK_FORMAT_B8G8R8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR},
                                                   {VK_FORMAT_R8G8B8A8_SRGB, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}};
     // IMMEDIATE falls back to MAILBOX, MAILBOX to IMMEDIATE, both then to
-    // FIFO (which every surface supports).
+    // FIFO (which every surface supports), the default.
     VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
-    // Clamped to the surface's minimum and maximum.
+    // Clamped to the surface's minimum and maximum (default 3).
     std::uint32_t min_image_count = 3;
+    // Default colour attachment; must be supported by the surface.
     VkImageUsageFlags image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-    // Falls back to the first alpha mode the surface supports.
+    // Falls back to the first alpha mode the surface supports (default opaque).
     VkCompositeAlphaFlagBitsKHR composite_alpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
+    // Default true.
     bool clipped = true;
     // Only for surfaces that leave the extent to the swapchain (currentExtent
     // 0xFFFFFFFF, e.g. Wayland): the window's size in pixels; see set_extent.
     VkExtent2D extent{};
-    // Receives the choices made and why, at creation and every re-creation.
+    // Receives the choices made and why, at creation and every re-creation (empty: no log).
+    // Copied into the Swapchain: what it refers to must outlive the Swapchain. The text lives
+    // for the call only.
     Function<void(const char*)> log{};
 };
 
@@ -198,12 +203,15 @@ private:
 };
 
 // Mirrors what a swapchain would be made of, for rendering offscreen.
+// Copied by create().
 struct HeadlessPresenterCreateInfo {
+    // Required, non-zero.
     VkExtent2D extent{};
+    // Optional (default 8-bit RGBA, unorm).
     VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
-    // The ring's size: frames in flight + 1, as a swapchain would have.
+    // The ring's size: frames in flight + 1, as a swapchain would have. Optional (default 3), non-zero.
     std::uint32_t image_count = 3;
-    // TRANSFER_SRC is always added (for read_back).
+    // TRANSFER_SRC is always added (for read_back). Optional (default colour attachment).
     VkImageUsageFlags image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
 };
 

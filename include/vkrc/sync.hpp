@@ -85,8 +85,11 @@ private:
 
 // Mirrors VkQueryPoolCreateInfo.
 struct QueryPoolCreateInfo {
+    // Optional (default timestamps).
     VkQueryType query_type = VK_QUERY_TYPE_TIMESTAMP;
+    // Required, non-zero.
     std::uint32_t query_count = 0;
+    // For pipeline-statistics pools only (default none).
     VkQueryPipelineStatisticFlags pipeline_statistics = 0;
 };
 

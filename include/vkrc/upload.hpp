@@ -22,10 +22,11 @@ void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset
 // Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
 List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size);
 
+// Both members optional.
 struct ImageUploadInfo {
-    // The image's layout before the upload; UNDEFINED discards its contents.
+    // The image's layout before the upload; UNDEFINED (the default) discards its contents.
     VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    // The layout the image is left in, for the work that reads it next.
+    // The layout the image is left in, for the work that reads it next (default shader read-only).
     VkImageLayout new_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 };
 

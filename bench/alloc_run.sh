@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The allocation run behind docs/benchmarks.md and README, on whatever device
+# this machine has: bench/alloc with its defaults (100 000 allocations, seed 1).
+# Writes one CSV into OUT, headed by '# key: value' lines (device, driver,
+# date, command, git revision, host) that scripts/gen_bench_docs.py reads;
+# copy it into docs/results/ and run the generator. bench/device_run.sh calls
+# it too when the alloc target is built.
+#
+#   bench/alloc_run.sh BUILD_DIR OUT [NAME]
+#
+# BUILD_DIR: a Release build with the bench (BUILD_DIR/bench/alloc), e.g.
+#   cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_TESTS=OFF -DVKRC_BUILD_EXAMPLES=OFF
+#   cmake --build build-release -j --target alloc
+# NAME: the result's file prefix (default: the date and a device slug).
+set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: bench/alloc_run.sh BUILD_DIR OUT [NAME]" >&2
+  exit 2
+fi
+build=$1
+out=$2
+name=${3:-}
+alloc="$build/bench/alloc"
+[ -x "$alloc" ] || { echo "alloc_run.sh: no $alloc (build the alloc target first)" >&2; exit 1; }
+mkdir -p "$out"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+revision=$(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)
+if git -C "$source_dir" status --porcelain 2>/dev/null | grep -q .; then revision="$revision (with local changes)"; fi
+driver=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverInfo/ {print $2; exit}' || true)
+driver_name=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverName/ {print $2; exit}' || true)
+[ -n "$driver_name" ] || driver_name="mesa-vulkan-drivers $(dpkg-query -W -f="\${Version}" mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+
+csv="$out/tmp-alloc.csv"
+log="$out/tmp-alloc.log"
+echo "== bench/alloc --csv FILE" >&2
+"$alloc" --csv "$csv" | tee "$log"
+device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$log" | head -1)
+prefix=$name
+[ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+{
+  echo "# device: $device"
+  echo "# driver: ${driver_name:-unknown}${driver:+ $driver}"
+  echo "# date: $date_utc"
+  echo "# command: bench/alloc --csv FILE (Release build)"
+  echo "# git: $revision"
+  echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  cat "$csv"
+} >"$out/$prefix-alloc.csv"
+rm -f "$csv" "$log"
+echo "wrote $out/$prefix-alloc.csv" >&2
