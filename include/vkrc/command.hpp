@@ -229,7 +229,8 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
                                            VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                            VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                            VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    VkImageMemoryBarrier2 b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
+    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
     b.srcStageMask = src_stage;
     b.srcAccessMask = src_access;
     b.dstStageMask = dst_stage;
@@ -245,7 +246,8 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
 // A global memory barrier.
 inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                        VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    VkMemoryBarrier2 b{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    VkMemoryBarrier2 b{};
+    b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
     b.srcStageMask = src_stage;
     b.srcAccessMask = src_access;
     b.dstStageMask = dst_stage;
