@@ -7,7 +7,10 @@
 
 #include "shaders/spec_color.frag.h"
 #include "shaders/spec_fill.comp.h"
+#include "shaders/half_left.geom.h"
 #include "shaders/spec_rect.vert.h"
+#include "shaders/tess_pass.tesc.h"
+#include "shaders/tess_pass.tese.h"
 
 #include <array>
 #include <cstddef>
@@ -405,6 +408,75 @@ TEST_F(VulkanTest, PipelineStateMultisampleShadingAndViewMask) {
         targets.end(cmd);
     });
     EXPECT_EQ(targets.at(0, 4, 4), (Rgba{255, 0, 0, 255}));
+}
+
+TEST_F(VulkanTest, PipelineStateTessellationAndGeometryStages) {
+    VkPhysicalDeviceFeatures supported{};
+    physical_device.fn().vkGetPhysicalDeviceFeatures(physical_device.vk(), &supported);
+    if (!supported.tessellationShader || !supported.geometryShader)
+        GTEST_SKIP() << "the device lacks tessellationShader or geometryShader";
+    vkrc::DeviceCreateInfo info;
+    info.enabled_features.tessellationShader = VK_TRUE;
+    info.enabled_features.geometryShader = VK_TRUE;
+    auto dev = vkrc::Device::create(physical_device, info);
+    // The full-screen rect as two patches of three, tessellated as they are,
+    // then squeezed into the left half by the geometry stage.
+    const float full = 1.0f, green[2] = {0.0f, 1.0f};
+    auto pipeline =
+        rect_builder(dev, full, green)
+            .shader(VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT,
+                    vkrc::ShaderModule::create(dev, vkrc_shaders::tess_pass_tesc))
+            .shader(VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT,
+                    vkrc::ShaderModule::create(dev, vkrc_shaders::tess_pass_tese))
+            .shader(VK_SHADER_STAGE_GEOMETRY_BIT, vkrc::ShaderModule::create(dev, vkrc_shaders::half_left_geom))
+            .topology(VK_PRIMITIVE_TOPOLOGY_PATCH_LIST)
+            .tessellation(3)
+            .rendering(std::array{rgba8})
+            .build();
+    Targets targets(dev, 1);
+    run(dev.default_queue(), [&](const vkrc::CommandBuffer& cmd) {
+        const VkClearColorValue clear{{0, 0, 0, 1}};
+        targets.begin(cmd, std::span(&clear, 1));
+        cmd.bind_pipeline(pipeline);
+        viewport_and_scissor(cmd);
+        cmd.draw(6);
+        targets.end(cmd);
+    });
+    EXPECT_EQ(targets.at(0, 1, 4), (Rgba{0, 255, 0, 255}));
+    EXPECT_EQ(targets.at(0, 6, 4), black);
+}
+
+// RawInterop: a pipeline bound by its raw handle and sets by its layout, as
+// for pipelines made by other code.
+TEST_F(VulkanTest, RawInteropBindsPipelineAndSetsByLayout) {
+    const std::uint32_t constants[] = {4, 7, 2};
+    const VkSpecializationMapEntry entries[] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
+    auto buffer = vkrc::Buffer::create(
+        device,
+        {.size = 4 * 4, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
+    auto compute = vkrc::ComputePipeline::create(
+        layout, {.module = vkrc::ShaderModule::create(device, vkrc_shaders::spec_fill_comp),
+                 .specialization = {entries, std::as_bytes(std::span(constants))}});
+    auto descriptors =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto set = descriptors.allocate(set_layout);
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer);
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.bind_pipeline(VK_PIPELINE_BIND_POINT_COMPUTE, compute.vk());
+        const VkDescriptorSet sets[] = {set.vk()};
+        cmd.bind_descriptor_sets(VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, sets);
+        cmd.dispatch(1);
+        auto to_host = vkrc::buffer_barrier(buffer.vk(), VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                                            VK_ACCESS_2_HOST_READ_BIT);
+        cmd.pipeline_barrier({}, std::span(&to_host, 1), {});
+    });
+    EXPECT_EQ(buffer.allocation().read_value<std::uint32_t>(12), 7u + 2u * 3u);
 }
 
 }  // namespace

@@ -339,6 +339,20 @@ public:
     void set_depth_bias_enable(bool enable) const noexcept;
     void set_primitive_restart_enable(bool enable) const noexcept;
 
+    // Binding by raw handles or by a PipelineLayout, for pipelines and
+    // layouts made by other code (or adopted): the same single calls.
+    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept;
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
+                              std::span<const VkDescriptorSet> sets,
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept {
+        bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
+    }
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
+                              std::span<const VkDescriptorSet> sets,
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+    void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
+                        const void* data) const noexcept;
+
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
@@ -820,6 +834,21 @@ inline void CommandBuffer::set_depth_bias_enable(bool enable) const noexcept {
 }
 inline void CommandBuffer::set_primitive_restart_enable(bool enable) const noexcept {
     fn_->vkCmdSetPrimitiveRestartEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+
+inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept {
+    fn_->vkCmdBindPipeline(state_->cmd, bind_point, pipeline);
+}
+inline void CommandBuffer::bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
+                                                std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
+                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+    fn_->vkCmdBindDescriptorSets(state_->cmd, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
+                                 sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
+                                 dynamic_offsets.data());
+}
+inline void CommandBuffer::push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset,
+                                          std::uint32_t size, const void* data) const noexcept {
+    fn_->vkCmdPushConstants(state_->cmd, layout, stages, offset, size, data);
 }
 
 VKRC_END_NAMESPACE

@@ -86,3 +86,10 @@ void hot_set_stencil_op(const Cmd& c) {
 void hot_set_rasterizer_discard_enable(const Cmd& c, bool e) { c.set_rasterizer_discard_enable(e); }
 void hot_set_depth_bias_enable(const Cmd& c, bool e) { c.set_depth_bias_enable(e); }
 void hot_set_primitive_restart_enable(const Cmd& c, bool e) { c.set_primitive_restart_enable(e); }
+void hot_bind_raw_pipeline(const Cmd& c, VkPipeline p) { c.bind_pipeline(VK_PIPELINE_BIND_POINT_COMPUTE, p); }
+void hot_bind_sets_by_layout(const Cmd& c, const vkrc::PipelineLayout& l, std::span<const VkDescriptorSet> s) {
+    c.bind_descriptor_sets(VK_PIPELINE_BIND_POINT_COMPUTE, l, 0, s);
+}
+void hot_push_raw(const Cmd& c, VkPipelineLayout l, const float (&m)[4]) {
+    c.push_constants(l, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof m, m);
+}
