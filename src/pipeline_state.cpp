@@ -175,6 +175,11 @@ VkPipelineViewportStateCreateInfo GraphicsPipelineBuilder::viewport_state() cons
     // With counts dynamic, Vulkan wants 0 here.
     const bool dynamic_viewports = contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT_WITH_COUNT);
     const bool dynamic_scissors = contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR_WITH_COUNT);
+    // Static ones must be given: Vulkan would read them from a null pointer.
+    require(viewports_.size() > 0 || dynamic_viewports || contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT), who,
+            "viewports are neither dynamic nor given with viewports()");
+    require(scissors_.size() > 0 || dynamic_scissors || contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR), who,
+            "scissors are neither dynamic nor given with scissors()");
     v.viewportCount = dynamic_viewports ? 0 : count;
     v.pViewports = viewports_.empty() ? nullptr : viewports_.data();
     v.scissorCount = dynamic_scissors ? 0 : count;

@@ -348,6 +348,8 @@ TEST_F(VulkanTest, PipelineStateRejectsMismatchedCounts) {
                  vkrc::UsageError);
     const VkViewport viewports[2] = {};
     const VkRect2D scissor{};
+    EXPECT_THROW(rect_builder(device, full, yellow).rendering(std::array{rgba8}).dynamic_states({}).build(),
+                 vkrc::UsageError);  // static viewport and scissor not given
     EXPECT_THROW(rect_builder(device, full, yellow)
                      .rendering(std::array{rgba8})
                      .viewports(viewports)

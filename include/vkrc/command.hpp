@@ -22,6 +22,8 @@ class CommandBufferState;
 struct CommandPoolCreateInfo {
     VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     std::uint32_t queue_family_index = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 class CommandBuffer;
