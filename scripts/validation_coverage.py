@@ -74,7 +74,7 @@ def condition_holds(condition):
 
 def wrapped_names():
     calls, stypes = set(), set()
-    call = re.compile(r"(?:fn\(\)|fn)\s*(?:\.|->)\s*(vk[A-Z]\w+)|Functions::(vk[A-Z]\w+)")
+    call = re.compile(r"(?:fn\(\)|fn_?)\s*(?:\.|->)\s*(vk[A-Z]\w+)|Functions::(vk[A-Z]\w+)")
     stype = re.compile(r"\bVK_STRUCTURE_TYPE_([A-Z0-9_]+)\b")
     for path in list((ROOT / "src").rglob("*.[ch]pp")) + list((ROOT / "include").rglob("*.hpp")):
         text = path.read_text()

@@ -38,6 +38,7 @@ CommandBufferState::~CommandBufferState() {
 CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInfo& info) {
     if (!device) throw UsageError("vkrc::CommandPool::create: the Device handle is empty");
     VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    ci.pNext = info.next;
     ci.flags = info.flags;
     ci.queueFamilyIndex = info.queue_family_index;
     detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);

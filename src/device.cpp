@@ -235,6 +235,21 @@ void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests)
     }
 }
 
+// The loader hands out debug-utils entry points even when the instance did
+// not enable the extension; calling them then is undefined, so they are
+// dropped and the label methods (which test for null) become no-ops.
+void drop_unless_debug_utils(const PhysicalDevice& physical, DeviceFunctions& fn) {
+    if (physical.instance().extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) return;
+    fn.vkSetDebugUtilsObjectNameEXT = nullptr;
+    fn.vkSetDebugUtilsObjectTagEXT = nullptr;
+    fn.vkQueueBeginDebugUtilsLabelEXT = nullptr;
+    fn.vkQueueEndDebugUtilsLabelEXT = nullptr;
+    fn.vkQueueInsertDebugUtilsLabelEXT = nullptr;
+    fn.vkCmdBeginDebugUtilsLabelEXT = nullptr;
+    fn.vkCmdEndDebugUtilsLabelEXT = nullptr;
+    fn.vkCmdInsertDebugUtilsLabelEXT = nullptr;
+}
+
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership,
                  std::span<const QueueRequest> queues, std::span<const char* const> extensions,
                  detail::Ref<detail::DeviceState>& state) {
@@ -244,6 +259,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
     s.ownership = ownership;
     s.physical_device = physical;
     s.fn = DeviceFunctions::load(physical.fn().vkGetDeviceProcAddr, raw);
+    drop_unless_debug_utils(physical, s.fn);
     for (const char* e : extensions) s.enabled_extensions.push_back(e);
     init_queues(s, queues);
 }

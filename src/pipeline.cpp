@@ -1,5 +1,6 @@
 #include "vkrc/pipeline.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <cerrno>
 #include <cstdio>
@@ -47,6 +48,8 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
         sets.push_back(l.vk());
     }
     VkPipelineLayoutCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    ci.pNext = info.next;
+    ci.flags = info.flags;
     ci.setLayoutCount = static_cast<std::uint32_t>(sets.size());
     ci.pSetLayouts = sets.data();
     ci.pushConstantRangeCount = static_cast<std::uint32_t>(info.push_constant_ranges.size());
@@ -81,6 +84,8 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
         color_counts.push_back(d.colorAttachmentCount);
     }
     VkRenderPassCreateInfo ci{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    ci.pNext = info.next;
+    ci.flags = info.flags;
     ci.attachmentCount = static_cast<std::uint32_t>(info.attachments.size());
     ci.pAttachments = info.attachments.data();
     ci.subpassCount = static_cast<std::uint32_t>(subpasses.size());
@@ -111,6 +116,8 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
         views.push_back(v.vk());
     }
     VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    ci.pNext = info.next;
+    ci.flags = info.flags;
     ci.renderPass = info.render_pass.vk();
     ci.attachmentCount = static_cast<std::uint32_t>(views.size());
     ci.pAttachments = views.data();
@@ -302,6 +309,7 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     require(static_cast<bool>(layout_), who, "the PipelineLayout handle is empty");
     require(!stages_.empty(), who, "no shader stages");
     std::vector<VkPipelineShaderStageCreateInfo> stages;
+    std::vector<VkSpecializationInfo> specs(stages_.size());
     for (const auto& st : stages_) {
         require(static_cast<bool>(st.module), who, "a ShaderModule handle is empty");
         VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
@@ -310,6 +318,8 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
         si.pName = st.entry_point;
         stages.push_back(si);
     }
+    attach_specializations(stages, specs);
+    check_tessellation();
     VkPipelineVertexInputStateCreateInfo vertex{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
     vertex.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings_.size());
     vertex.pVertexBindingDescriptions = bindings_.data();
@@ -317,21 +327,16 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     vertex.pVertexAttributeDescriptions = attributes_.data();
     VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     assembly.topology = topology_;
-    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    viewport.viewportCount = 1;
-    viewport.scissorCount = 1;
-    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    raster.polygonMode = polygon_mode_;
-    raster.cullMode = cull_mode_;
-    raster.frontFace = front_face_;
-    raster.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    multisample.rasterizationSamples = samples_;
-    VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-    depth.depthTestEnable = depth_test_ ? VK_TRUE : VK_FALSE;
-    depth.depthWriteEnable = depth_write_ ? VK_TRUE : VK_FALSE;
-    depth.depthCompareOp = depth_compare_;
-    depth.maxDepthBounds = 1.0f;
+    assembly.primitiveRestartEnable = primitive_restart_ ? VK_TRUE : VK_FALSE;
+    VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
+    tessellation.patchControlPoints = patch_control_points_;
+    const auto viewport = viewport_state();
+    const auto raster = rasterization_state();
+    const std::uint32_t sample_mask[2] = {static_cast<std::uint32_t>(multisample_.sample_mask),
+                                          static_cast<std::uint32_t>(multisample_.sample_mask >> 32)};
+    auto multisample = multisample_state();
+    multisample.pSampleMask = sample_mask;
+    const auto depth = depth_stencil_state();
 
     std::uint32_t color_count = 0;
     VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
@@ -343,17 +348,30 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
         rendering.pColorAttachmentFormats = color_formats_.data();
         rendering.depthAttachmentFormat = depth_format_;
         rendering.stencilAttachmentFormat = stencil_format_;
+        rendering.viewMask = view_mask_;
+    }
+    require(!render_pass_ || view_mask_ == 0, who, "view_mask is for dynamic rendering; a render pass has its own");
+    if (!blends_.empty() && blends_.size() != color_count) {
+        throw UsageError(std::string(who) + ": blend_attachments has " + std::to_string(blends_.size()) +
+                         " states for " + std::to_string(color_count) + " colour attachments");
     }
     std::vector<VkPipelineColorBlendAttachmentState> blends(color_count, blend_);
+    if (!blends_.empty()) blends.assign(blends_.begin(), blends_.end());
     VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = color_count;
     blend.pAttachments = blends.data();
+    blend.logicOpEnable = logic_op_enable_ ? VK_TRUE : VK_FALSE;
+    blend.logicOp = logic_op_;
+    std::copy(std::begin(blend_constants_), std::end(blend_constants_), blend.blendConstants);
     VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamic.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states_.size());
     dynamic.pDynamicStates = dynamic_states_.data();
 
     VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    ci.pNext = render_pass_ ? nullptr : &rendering;
+    rendering.pNext = next_;
+    ci.pNext = render_pass_ ? next_ : &rendering;
+    ci.flags = flags_;
+    ci.pTessellationState = patch_control_points_ ? &tessellation : nullptr;
     ci.stageCount = static_cast<std::uint32_t>(stages.size());
     ci.pStages = stages.data();
     ci.pVertexInputState = &vertex;

@@ -1,5 +1,6 @@
 #include "vkrc/sync.hpp"
 
+#include <bit>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -183,13 +184,20 @@ VkResult Event::status() const {
 QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& info) {
     require_device(device, "vkrc::QueryPool::create");
     if (info.query_count == 0) throw UsageError("vkrc::QueryPool::create: query_count is 0");
+    const bool statistics = info.query_type == VK_QUERY_TYPE_PIPELINE_STATISTICS;
+    if (statistics && info.pipeline_statistics == 0) {
+        throw UsageError("vkrc::QueryPool::create: a PIPELINE_STATISTICS pool with no pipeline_statistics flags");
+    }
     VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    ci.pNext = info.next;
     ci.queryType = info.query_type;
     ci.queryCount = info.query_count;
     ci.pipelineStatistics = info.pipeline_statistics;
     detail::Ref<detail::QueryPoolState> s(new detail::QueryPoolState);
     s->device = device;
     s->count = info.query_count;
+    s->type = info.query_type;
+    s->values_per_query = statistics ? static_cast<std::uint32_t>(std::popcount(info.pipeline_statistics)) : 1;
     check(device.fn().vkCreateQueryPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateQueryPool");
     return QueryPool(std::move(s));
 }

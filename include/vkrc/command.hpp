@@ -24,6 +24,8 @@ struct CommandPoolCreateInfo {
     VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     // The family the pool's command buffers are submitted to (default 0; usually queue.family_index()).
     std::uint32_t queue_family_index = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 class CommandBuffer;
@@ -71,7 +73,7 @@ struct CommandBufferInheritance {
     VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
 };
 
-// One attachment of dynamic rendering (VkRenderingAttachmentInfo, no resolve).
+// One attachment of dynamic rendering (VkRenderingAttachmentInfo).
 // image_view: view.vk() of an ImageView that lives until the work is submitted.
 struct RenderingAttachment {
     // Required.
@@ -83,6 +85,12 @@ struct RenderingAttachment {
     VkAttachmentStoreOp store_op = VK_ATTACHMENT_STORE_OP_STORE;
     // Used with load_op CLEAR (default zero).
     VkClearValue clear_value{};
+    // Optional multisample resolve: NONE (the default) resolves nothing;
+    // otherwise resolve_image_view (a single-sample view that lives until the
+    // work is submitted) receives the resolved image, in resolve_image_layout.
+    VkResolveModeFlagBits resolve_mode = VK_RESOLVE_MODE_NONE;
+    VkImageView resolve_image_view = VK_NULL_HANDLE;
+    VkImageLayout resolve_image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
 };
 
 // VkRenderingInfo. At most max_color_attachments colour attachments.
@@ -100,6 +108,10 @@ struct RenderingInfo {
     VkRenderingFlags flags = 0;
     // Optional (default 1).
     std::uint32_t layer_count = 1;
+    // Optional multiview mask (0: no multiview; needs the multiview feature).
+    std::uint32_t view_mask = 0;
+    // Optional pNext chain of VkRenderingInfo; must live through the call.
+    const void* next = nullptr;
 };
 
 // A command buffer; keeps its pool alive and returns to it when dropped (once
@@ -211,6 +223,153 @@ public:
     void reset_query_pool(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count) const noexcept;
     void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool, std::uint32_t query) const noexcept;
 
+    // Transfer commands on whole images and buffers. Layouts are the images'
+    // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
+    // during the call only. Typed overloads read the raw handles.
+    void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
+                    std::span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const noexcept {
+        blit_image(src.vk(), src_layout, dst.vk(), dst_layout, regions, filter);
+    }
+    void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                    std::span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const noexcept;
+    // src: multisampled; dst: single-sample, same format.
+    void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
+                       std::span<const VkImageResolve> regions) const noexcept {
+        resolve_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
+    }
+    void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                       std::span<const VkImageResolve> regions) const noexcept;
+    void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
+                    std::span<const VkImageCopy> regions) const noexcept {
+        copy_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
+    }
+    // Outside rendering; the image needs TRANSFER_DST usage.
+    void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
+                           std::span<const VkImageSubresourceRange> ranges) const noexcept {
+        clear_color_image(image.vk(), layout, color, ranges);
+    }
+    void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
+                           std::span<const VkImageSubresourceRange> ranges) const noexcept;
+    void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
+                                   std::span<const VkImageSubresourceRange> ranges) const noexcept {
+        clear_depth_stencil_image(image.vk(), layout, value, ranges);
+    }
+    void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
+                                   std::span<const VkImageSubresourceRange> ranges) const noexcept;
+    // Inside rendering (a render pass or dynamic rendering).
+    void clear_attachments(std::span<const VkClearAttachment> attachments,
+                           std::span<const VkClearRect> rects) const noexcept;
+    // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
+    // this call (data need not outlive it). size and offset are multiples of
+    // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
+    void update_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
+        update_buffer(dst.vk(), offset, size, data);
+    }
+    void update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const;
+
+    // Indirect work: parameters read by the GPU from buffer (INDIRECT_BUFFER
+    // usage) at execution. stride 0 means tightly packed commands.
+    void draw_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                       std::uint32_t stride = 0) const noexcept {
+        draw_indirect(buffer.vk(), offset, draw_count, stride);
+    }
+    void draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                       std::uint32_t stride = 0) const noexcept;
+    void draw_indexed_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                               std::uint32_t stride = 0) const noexcept {
+        draw_indexed_indirect(buffer.vk(), offset, draw_count, stride);
+    }
+    void draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                               std::uint32_t stride = 0) const noexcept;
+    void dispatch_indirect(const Buffer& buffer, VkDeviceSize offset = 0) const noexcept {
+        dispatch_indirect(buffer.vk(), offset);
+    }
+    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const noexcept;
+    // The draw count comes from count_buffer (a uint32 at count_offset),
+    // clamped to max_draw_count. Needs the Vulkan 1.2 drawIndirectCount feature.
+    void draw_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
+                             VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                             std::uint32_t stride = 0) const noexcept {
+        draw_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
+    }
+    void draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer, VkDeviceSize count_offset,
+                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const noexcept;
+    void draw_indexed_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
+                                     VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                                     std::uint32_t stride = 0) const noexcept {
+        draw_indexed_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
+    }
+    void draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
+                                     VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                                     std::uint32_t stride = 0) const noexcept;
+
+    // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
+    void begin_query(const QueryPool& pool, std::uint32_t query, VkQueryControlFlags flags = 0) const noexcept;
+    void end_query(const QueryPool& pool, std::uint32_t query) const noexcept;
+    // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
+    void copy_query_results(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count,
+                            const Buffer& dst, VkDeviceSize offset, VkDeviceSize stride,
+                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const noexcept;
+
+    // Debug-utils labels around and between commands, shown by debuggers and
+    // capture tools. No-ops when the instance has not enabled
+    // VK_EXT_debug_utils, so they may stay in release code. name is copied.
+    void begin_label(const char* name, const LabelColor& color = {}) const noexcept;
+    void end_label() const noexcept;
+    void insert_label(const char* name, const LabelColor& color = {}) const noexcept;
+
+    // Dynamic state (Vulkan 1.0): each needs its VK_DYNAMIC_STATE_* in the
+    // bound pipeline's dynamic states.
+    void set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const noexcept;
+    void set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const noexcept;
+    // Other widths than 1.0 need the wideLines feature.
+    void set_line_width(float width) const noexcept;
+    // A clamp other than 0 needs the depthBiasClamp feature.
+    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const noexcept;
+    void set_blend_constants(const float (&constants)[4]) const noexcept;
+    void set_depth_bounds(float min_bounds, float max_bounds) const noexcept;
+    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept;
+    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept;
+    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const noexcept;
+
+    // Dynamic state (Vulkan 1.3 core, formerly extended dynamic state 1 and 2).
+    void set_cull_mode(VkCullModeFlags mode) const noexcept;
+    void set_front_face(VkFrontFace face) const noexcept;
+    void set_primitive_topology(VkPrimitiveTopology topology) const noexcept;
+    // The viewport and scissor counts are dynamic too (VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT).
+    void set_viewport_with_count(std::span<const VkViewport> viewports) const noexcept;
+    void set_scissor_with_count(std::span<const VkRect2D> scissors) const noexcept;
+    // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
+    // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
+    void bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
+                              std::span<const VkDeviceSize> offsets, std::span<const VkDeviceSize> sizes = {},
+                              std::span<const VkDeviceSize> strides = {}) const noexcept;
+    void set_depth_test_enable(bool enable) const noexcept;
+    void set_depth_write_enable(bool enable) const noexcept;
+    void set_depth_compare_op(VkCompareOp op) const noexcept;
+    // Enabling needs the depthBounds feature.
+    void set_depth_bounds_test_enable(bool enable) const noexcept;
+    void set_stencil_test_enable(bool enable) const noexcept;
+    void set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op, VkStencilOp depth_fail_op,
+                        VkCompareOp compare_op) const noexcept;
+    void set_rasterizer_discard_enable(bool enable) const noexcept;
+    void set_depth_bias_enable(bool enable) const noexcept;
+    void set_primitive_restart_enable(bool enable) const noexcept;
+
+    // Binding by raw handles or by a PipelineLayout, for pipelines and
+    // layouts made by other code (or adopted): the same single calls.
+    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept;
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
+                              std::span<const VkDescriptorSet> sets,
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept {
+        bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
+    }
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
+                              std::span<const VkDescriptorSet> sets,
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+    void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
+                        const void* data) const noexcept;
+
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
@@ -254,6 +413,65 @@ inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccess
     b.dstAccessMask = dst_access;
     return b;
 }
+
+// An image barrier over range (see mip_range and layer_range).
+VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range, VkImageLayout old_layout,
+                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
+                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
+                                    VkAccessFlags2 dst_access) noexcept;
+// count mip levels from base_level, every layer.
+VkImageSubresourceRange mip_range(std::uint32_t base_level, std::uint32_t level_count = 1,
+                                  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
+// count array layers from base_layer, every mip level.
+VkImageSubresourceRange layer_range(std::uint32_t base_layer, std::uint32_t layer_count = 1,
+                                    VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
+// A buffer barrier over size bytes from offset (VK_WHOLE_SIZE: to the end).
+VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                      VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                      VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
+
+// Queue-family ownership transfer of an EXCLUSIVE resource: record the
+// release on a queue of src_family, then, after a semaphore, the acquire with
+// the same families and layouts on a queue of dst_family. The release's
+// destination and the acquire's source scopes are empty, as Vulkan ignores them.
+VkImageMemoryBarrier2 image_ownership_release(VkImage image, const VkImageSubresourceRange& range,
+                                              VkImageLayout old_layout, VkImageLayout new_layout,
+                                              std::uint32_t src_family, std::uint32_t dst_family,
+                                              VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) noexcept;
+VkImageMemoryBarrier2 image_ownership_acquire(VkImage image, const VkImageSubresourceRange& range,
+                                              VkImageLayout old_layout, VkImageLayout new_layout,
+                                              std::uint32_t src_family, std::uint32_t dst_family,
+                                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept;
+VkBufferMemoryBarrier2 buffer_ownership_release(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
+                                                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                                VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
+VkBufferMemoryBarrier2 buffer_ownership_acquire(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
+                                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                                VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
+
+// What generate_mipmaps starts from and leaves behind.
+struct MipmapInfo {
+    // Level 0's layout now and the writes that filled it (an upload's copy by default).
+    VkImageLayout base_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    VkPipelineStageFlags2 src_stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+    VkAccessFlags2 src_access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    // Every level's layout afterwards, and who reads it next.
+    VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    VkPipelineStageFlags2 dst_stage = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+    VkAccessFlags2 dst_access = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    VkFilter filter = VK_FILTER_LINEAR;
+    // The layers to process (VK_REMAINING_ARRAY_LAYERS: to the last).
+    std::uint32_t base_layer = 0;
+    std::uint32_t layer_count = VK_REMAINING_ARRAY_LAYERS;
+};
+
+// Records the blits that fill mip levels 1.. of image from level 0, each
+// level from the one above, with the barriers between them; the other
+// levels' old contents are discarded. Throws UsageError when the image lacks
+// TRANSFER_SRC and TRANSFER_DST usage, is multisampled, its format cannot be
+// blitted (or linearly filtered, for VK_FILTER_LINEAR) with optimal tiling,
+// the command buffer's queue family has no graphics, or the layers are out of range.
+void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const MipmapInfo& info = {});
 
 namespace detail {
 
@@ -327,6 +545,9 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
         r.loadOp = a.load_op;
         r.storeOp = a.store_op;
         r.clearValue = a.clear_value;
+        r.resolveMode = a.resolve_mode;
+        r.resolveImageView = a.resolve_image_view;
+        r.resolveImageLayout = a.resolve_image_layout;
         return r;
     };
     VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
@@ -338,7 +559,9 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
     VkRenderingAttachmentInfo depth, stencil;
     VkRenderingInfo r{};
     r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+    r.pNext = info.next;
     r.flags = info.flags;
+    r.viewMask = info.view_mask;
     r.renderArea = info.render_area;
     r.layerCount = info.layer_count;
     r.colorAttachmentCount = count;
@@ -475,6 +698,197 @@ inline void CommandBuffer::reset_query_pool(const QueryPool& pool, std::uint32_t
 inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
                                            std::uint32_t query) const noexcept {
     fn_->vkCmdWriteTimestamp2(cmd_, stage, pool.vk(), query);
+}
+
+inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                                      std::span<const VkImageBlit> regions, VkFilter filter) const noexcept {
+    fn_->vkCmdBlitImage(state_->cmd, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                        regions.data(), filter);
+}
+inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+                                         std::span<const VkImageResolve> regions) const noexcept {
+    fn_->vkCmdResolveImage(state_->cmd, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                           regions.data());
+}
+inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
+                                             std::span<const VkImageSubresourceRange> ranges) const noexcept {
+    fn_->vkCmdClearColorImage(state_->cmd, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
+                              ranges.data());
+}
+inline void CommandBuffer::clear_depth_stencil_image(VkImage image, VkImageLayout layout,
+                                                     const VkClearDepthStencilValue& value,
+                                                     std::span<const VkImageSubresourceRange> ranges) const noexcept {
+    fn_->vkCmdClearDepthStencilImage(state_->cmd, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
+                                     ranges.data());
+}
+inline void CommandBuffer::clear_attachments(std::span<const VkClearAttachment> attachments,
+                                             std::span<const VkClearRect> rects) const noexcept {
+    fn_->vkCmdClearAttachments(state_->cmd, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
+                               static_cast<std::uint32_t>(rects.size()), rects.data());
+}
+
+namespace detail {
+[[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
+}
+
+inline void CommandBuffer::update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
+#if VKRC_RUNTIME_CHECKS
+    if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
+        detail::throw_bad_update_buffer(offset, size);
+    }
+#endif
+    fn_->vkCmdUpdateBuffer(state_->cmd, dst, offset, size, data);
+}
+
+inline void CommandBuffer::draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                                         std::uint32_t stride) const noexcept {
+    fn_->vkCmdDrawIndirect(state_->cmd, buffer, offset, draw_count,
+                           stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+}
+inline void CommandBuffer::draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                                                 std::uint32_t stride) const noexcept {
+    fn_->vkCmdDrawIndexedIndirect(state_->cmd, buffer, offset, draw_count,
+                                  stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+}
+inline void CommandBuffer::dispatch_indirect(VkBuffer buffer, VkDeviceSize offset) const noexcept {
+    fn_->vkCmdDispatchIndirect(state_->cmd, buffer, offset);
+}
+inline void CommandBuffer::draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
+                                               VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                                               std::uint32_t stride) const noexcept {
+    fn_->vkCmdDrawIndirectCount(state_->cmd, buffer, offset, count_buffer, count_offset, max_draw_count,
+                                stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+}
+inline void CommandBuffer::draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
+                                                       VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                                                       std::uint32_t stride) const noexcept {
+    fn_->vkCmdDrawIndexedIndirectCount(state_->cmd, buffer, offset, count_buffer, count_offset, max_draw_count,
+                                       stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+}
+
+inline void CommandBuffer::begin_query(const QueryPool& pool, std::uint32_t query,
+                                       VkQueryControlFlags flags) const noexcept {
+    fn_->vkCmdBeginQuery(state_->cmd, pool.vk(), query, flags);
+}
+inline void CommandBuffer::end_query(const QueryPool& pool, std::uint32_t query) const noexcept {
+    fn_->vkCmdEndQuery(state_->cmd, pool.vk(), query);
+}
+inline void CommandBuffer::copy_query_results(const QueryPool& pool, std::uint32_t first_query,
+                                              std::uint32_t query_count, const Buffer& dst, VkDeviceSize offset,
+                                              VkDeviceSize stride, VkQueryResultFlags flags) const noexcept {
+    fn_->vkCmdCopyQueryPoolResults(state_->cmd, pool.vk(), first_query, query_count, dst.vk(), offset, stride,
+                                   flags | VK_QUERY_RESULT_64_BIT);
+}
+
+inline void CommandBuffer::begin_label(const char* name, const LabelColor& color) const noexcept {
+    if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
+        const VkDebugUtilsLabelEXT label{
+            VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+        f(state_->cmd, &label);
+    }
+}
+inline void CommandBuffer::end_label() const noexcept {
+    if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(state_->cmd);
+}
+inline void CommandBuffer::insert_label(const char* name, const LabelColor& color) const noexcept {
+    if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
+        const VkDebugUtilsLabelEXT label{
+            VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+        f(state_->cmd, &label);
+    }
+}
+
+inline void CommandBuffer::set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const noexcept {
+    fn_->vkCmdSetViewport(state_->cmd, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+}
+inline void CommandBuffer::set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const noexcept {
+    fn_->vkCmdSetScissor(state_->cmd, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+}
+inline void CommandBuffer::set_line_width(float width) const noexcept { fn_->vkCmdSetLineWidth(state_->cmd, width); }
+inline void CommandBuffer::set_depth_bias(float constant_factor, float clamp, float slope_factor) const noexcept {
+    fn_->vkCmdSetDepthBias(state_->cmd, constant_factor, clamp, slope_factor);
+}
+inline void CommandBuffer::set_blend_constants(const float (&constants)[4]) const noexcept {
+    fn_->vkCmdSetBlendConstants(state_->cmd, constants);
+}
+inline void CommandBuffer::set_depth_bounds(float min_bounds, float max_bounds) const noexcept {
+    fn_->vkCmdSetDepthBounds(state_->cmd, min_bounds, max_bounds);
+}
+inline void CommandBuffer::set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
+    fn_->vkCmdSetStencilCompareMask(state_->cmd, faces, mask);
+}
+inline void CommandBuffer::set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
+    fn_->vkCmdSetStencilWriteMask(state_->cmd, faces, mask);
+}
+inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const noexcept {
+    fn_->vkCmdSetStencilReference(state_->cmd, faces, reference);
+}
+
+inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const noexcept {
+    fn_->vkCmdSetCullMode(state_->cmd, mode);
+}
+inline void CommandBuffer::set_front_face(VkFrontFace face) const noexcept {
+    fn_->vkCmdSetFrontFace(state_->cmd, face);
+}
+inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const noexcept {
+    fn_->vkCmdSetPrimitiveTopology(state_->cmd, topology);
+}
+inline void CommandBuffer::set_viewport_with_count(std::span<const VkViewport> viewports) const noexcept {
+    fn_->vkCmdSetViewportWithCount(state_->cmd, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+}
+inline void CommandBuffer::set_scissor_with_count(std::span<const VkRect2D> scissors) const noexcept {
+    fn_->vkCmdSetScissorWithCount(state_->cmd, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+}
+inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
+                                                std::span<const VkDeviceSize> offsets,
+                                                std::span<const VkDeviceSize> sizes,
+                                                std::span<const VkDeviceSize> strides) const noexcept {
+    fn_->vkCmdBindVertexBuffers2(state_->cmd, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                                 offsets.data(), sizes.empty() ? nullptr : sizes.data(),
+                                 strides.empty() ? nullptr : strides.data());
+}
+inline void CommandBuffer::set_depth_test_enable(bool enable) const noexcept {
+    fn_->vkCmdSetDepthTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_depth_write_enable(bool enable) const noexcept {
+    fn_->vkCmdSetDepthWriteEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const noexcept {
+    fn_->vkCmdSetDepthCompareOp(state_->cmd, op);
+}
+inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const noexcept {
+    fn_->vkCmdSetDepthBoundsTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_stencil_test_enable(bool enable) const noexcept {
+    fn_->vkCmdSetStencilTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
+                                          VkStencilOp depth_fail_op, VkCompareOp compare_op) const noexcept {
+    fn_->vkCmdSetStencilOp(state_->cmd, faces, fail_op, pass_op, depth_fail_op, compare_op);
+}
+inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const noexcept {
+    fn_->vkCmdSetRasterizerDiscardEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_depth_bias_enable(bool enable) const noexcept {
+    fn_->vkCmdSetDepthBiasEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+inline void CommandBuffer::set_primitive_restart_enable(bool enable) const noexcept {
+    fn_->vkCmdSetPrimitiveRestartEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+}
+
+inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept {
+    fn_->vkCmdBindPipeline(state_->cmd, bind_point, pipeline);
+}
+inline void CommandBuffer::bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
+                                                std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
+                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+    fn_->vkCmdBindDescriptorSets(state_->cmd, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
+                                 sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
+                                 dynamic_offsets.data());
+}
+inline void CommandBuffer::push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset,
+                                          std::uint32_t size, const void* data) const noexcept {
+    fn_->vkCmdPushConstants(state_->cmd, layout, stages, offset, size, data);
 }
 
 VKRC_END_NAMESPACE

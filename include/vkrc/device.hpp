@@ -86,6 +86,11 @@ private:
     friend class Queue;
 };
 
+// The colour of a debug-utils label (all zero: none).
+struct LabelColor {
+    float r = 0.0f, g = 0.0f, b = 0.0f, a = 0.0f;
+};
+
 // A queue; keeps its Device alive. Submission and presentation take the
 // queue's lock under the multi-thread policy (Vulkan requires external
 // synchronisation of queues); nothing else does.
@@ -120,6 +125,12 @@ public:
     VkSemaphore timeline_semaphore() const noexcept;
     // The queue's lock, for applications that call vkQueue* themselves from several threads.
     Mutex& mutex() const noexcept;
+
+    // Debug-utils labels around and between submissions (the queue's lock is
+    // taken). No-ops when the instance has not enabled VK_EXT_debug_utils.
+    void begin_label(const char* name, const LabelColor& color = {}) const;
+    void end_label() const;
+    void insert_label(const char* name, const LabelColor& color = {}) const;
 
     friend bool operator==(const Queue& a, const Queue& b) noexcept { return a.queue_ == b.queue_; }
     detail::QueueState* state() const noexcept { return queue_; }

@@ -23,6 +23,9 @@ struct PipelineLayoutCreateInfo {
     List<DescriptorSetLayout> set_layouts{};
     // Optional (empty: no push constants). Read during create().
     List<VkPushConstantRange> push_constant_ranges{};
+    VkPipelineLayoutCreateFlags flags = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 class PipelineLayout : public Handle<detail::PipelineLayoutState> {
@@ -57,6 +60,9 @@ struct RenderPassCreateInfo {
     List<SubpassDescription> subpasses{};
     // Optional (empty: none).
     List<VkSubpassDependency> dependencies{};
+    VkRenderPassCreateFlags flags = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 class RenderPass : public Handle<detail::RenderPassState> {
@@ -83,6 +89,9 @@ struct FramebufferCreateInfo {
     std::uint32_t height = 0;
     // Optional (default 1), non-zero.
     std::uint32_t layers = 1;
+    VkFramebufferCreateFlags flags = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 // Keeps its render pass and attachments alive.
@@ -120,6 +129,26 @@ private:
     using Handle::Handle;
 };
 
+// Specialization constants of one shader stage (VkSpecializationInfo). The
+// builder and ComputePipeline::create copy both spans: they need only live
+// through the call. Each entry's offset + size must lie within data.
+struct Specialization {
+    std::span<const VkSpecializationMapEntry> map_entries{};
+    std::span<const std::byte> data{};
+};
+
+// Mirrors VkComputePipelineCreateInfo and its one stage.
+struct ComputePipelineCreateInfo {
+    VkPipelineCreateFlags flags = 0;
+    ShaderModule module{};             // required; kept alive by nothing after create
+    const char* entry_point = "main";  // read during create only
+    Specialization specialization{};   // optional
+    VkPipelineShaderStageCreateFlags stage_flags = 0;
+    PipelineCache cache{};             // optional
+    const void* stage_next = nullptr;  // optional pNext of the stage; read during create only
+    const void* next = nullptr;        // optional pNext; read during create only
+};
+
 // A graphics or compute pipeline; keeps its layout alive.
 class Pipeline : public Handle<detail::PipelineState> {
 public:
@@ -146,9 +175,52 @@ public:
     ComputePipeline() noexcept = default;
     static ComputePipeline create(const PipelineLayout& layout, const ShaderModule& module,
                                   const char* entry_point = "main", const PipelineCache& cache = {});
+    static ComputePipeline create(const PipelineLayout& layout, const ComputePipelineCreateInfo& info);
 
 private:
     using Pipeline::Pipeline;
+};
+
+// Mirrors VkPipelineRasterizationStateCreateInfo (defaults: the builder's).
+struct RasterizationState {
+    bool depth_clamp_enable = false;  // needs the depthClamp feature
+    bool rasterizer_discard_enable = false;
+    VkPolygonMode polygon_mode = VK_POLYGON_MODE_FILL;  // LINE and POINT need fillModeNonSolid
+    VkCullModeFlags cull_mode = VK_CULL_MODE_BACK_BIT;
+    VkFrontFace front_face = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+    bool depth_bias_enable = false;
+    float depth_bias_constant_factor = 0.0f;
+    float depth_bias_clamp = 0.0f;  // non-zero needs depthBiasClamp
+    float depth_bias_slope_factor = 0.0f;
+    float line_width = 1.0f;     // other than 1 needs wideLines
+    const void* next = nullptr;  // optional pNext; must live until build()
+};
+
+// Mirrors VkPipelineDepthStencilStateCreateInfo (defaults: the builder's).
+struct DepthStencilState {
+    VkPipelineDepthStencilStateCreateFlags flags = 0;
+    bool depth_test_enable = true;
+    bool depth_write_enable = true;
+    VkCompareOp depth_compare_op = VK_COMPARE_OP_LESS;
+    bool depth_bounds_test_enable = false;  // needs the depthBounds feature
+    bool stencil_test_enable = false;
+    // Per face; reference, compare_mask and write_mask are static unless made dynamic.
+    VkStencilOpState front{};
+    VkStencilOpState back{};
+    float min_depth_bounds = 0.0f;
+    float max_depth_bounds = 1.0f;
+    const void* next = nullptr;  // optional pNext; must live until build()
+};
+
+// Mirrors VkPipelineMultisampleStateCreateInfo.
+struct MultisampleState {
+    VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
+    bool sample_shading_enable = false;  // needs sampleRateShading
+    float min_sample_shading = 0.0f;
+    std::uint64_t sample_mask = ~std::uint64_t{0};  // bit i: sample i (copied; up to 64 samples)
+    bool alpha_to_coverage_enable = false;
+    bool alpha_to_one_enable = false;  // needs alphaToOne
+    const void* next = nullptr;        // optional pNext; must live until build()
 };
 
 // Builds a GraphicsPipeline. Defaults: triangle list, fill, back-face culling
@@ -194,6 +266,39 @@ public:
                                        VkFormat depth_format = VK_FORMAT_UNDEFINED,
                                        VkFormat stencil_format = VK_FORMAT_UNDEFINED);
 
+    // Full state (issue 14). Each replaces what the narrower calls above set:
+    // rasterization their polygon mode, cull mode and front face; depth_stencil
+    // depth_test's; multisample samples'.
+    GraphicsPipelineBuilder& rasterization(const RasterizationState& state);
+    GraphicsPipelineBuilder& depth_stencil(const DepthStencilState& state);
+    GraphicsPipelineBuilder& multisample(const MultisampleState& state);
+    // One blend state per colour attachment (build() checks the count);
+    // replaces blend() for every attachment. Different states need independentBlend.
+    GraphicsPipelineBuilder& blend_attachments(std::span<const VkPipelineColorBlendAttachmentState> states);
+    GraphicsPipelineBuilder& blend_constants(const float (&constants)[4]);
+    // Enables the logic op (needs the logicOp feature) instead of blending.
+    GraphicsPipelineBuilder& logic_op(VkLogicOp op);
+    // Static viewports and scissors (copied). Their counts are the pipeline's
+    // (more than one needs multiViewport); the values count only when
+    // VIEWPORT / SCISSOR are not dynamic (see dynamic_states).
+    GraphicsPipelineBuilder& viewports(std::span<const VkViewport> viewports);
+    GraphicsPipelineBuilder& scissors(std::span<const VkRect2D> scissors);
+    // Replaces the dynamic state list (viewport and scissor by default).
+    // With VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT the counts are dynamic too.
+    GraphicsPipelineBuilder& dynamic_states(std::span<const VkDynamicState> states);
+    GraphicsPipelineBuilder& primitive_restart(bool enable);
+    // Specialization constants of the shader at stage (added with shader();
+    // build() throws UsageError when there is none). Copied.
+    GraphicsPipelineBuilder& specialization(VkShaderStageFlagBits stage, const Specialization& spec);
+    // Patch size, required with tessellation shaders (topology PATCH_LIST).
+    GraphicsPipelineBuilder& tessellation(std::uint32_t patch_control_points);
+    // Multiview mask for dynamic rendering (needs the multiview feature).
+    GraphicsPipelineBuilder& view_mask(std::uint32_t mask);
+    GraphicsPipelineBuilder& flags(VkPipelineCreateFlags flags);
+    // Chained into VkGraphicsPipelineCreateInfo (after vkrc's rendering info);
+    // must live until build().
+    GraphicsPipelineBuilder& next(const void* chain);
+
     GraphicsPipeline build(const PipelineCache& cache = {}) const;
 
 private:
@@ -229,6 +334,35 @@ private:
     List<VkFormat> color_formats_;
     VkFormat depth_format_ = VK_FORMAT_UNDEFINED;
     VkFormat stencil_format_ = VK_FORMAT_UNDEFINED;
+    // Full state: the fields the members above do not hold.
+    struct Specialized {
+        VkShaderStageFlagBits stage;
+        List<VkSpecializationMapEntry> entries;
+        List<std::byte> data;
+    };
+    RasterizationState raster_{};
+    DepthStencilState depth_stencil_{};
+    MultisampleState multisample_{};
+    List<VkPipelineColorBlendAttachmentState> blends_;  // empty: blend_ for each attachment
+    float blend_constants_[4] = {};
+    bool logic_op_enable_ = false;
+    VkLogicOp logic_op_ = VK_LOGIC_OP_COPY;
+    List<VkViewport> viewports_;  // empty: one, dynamic
+    List<VkRect2D> scissors_;
+    List<Specialized> specializations_;
+    bool primitive_restart_ = false;
+    std::uint32_t patch_control_points_ = 0;
+    std::uint32_t view_mask_ = 0;
+    VkPipelineCreateFlags flags_ = 0;
+    const void* next_ = nullptr;
+    // build()'s pieces (src/pipeline_state.cpp); the results point into *this.
+    void attach_specializations(std::span<VkPipelineShaderStageCreateInfo> stages,
+                                std::span<VkSpecializationInfo> infos) const;
+    void check_tessellation() const;
+    VkPipelineViewportStateCreateInfo viewport_state() const;
+    VkPipelineRasterizationStateCreateInfo rasterization_state() const;
+    VkPipelineMultisampleStateCreateInfo multisample_state() const;
+    VkPipelineDepthStencilStateCreateInfo depth_stencil_state() const;
 };
 
 namespace detail {

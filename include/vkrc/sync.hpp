@@ -91,6 +91,8 @@ struct QueryPoolCreateInfo {
     std::uint32_t query_count = 0;
     // For pipeline-statistics pools only (default none).
     VkQueryPipelineStatisticFlags pipeline_statistics = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
 };
 
 class QueryPool : public Handle<detail::QueryPoolState> {
@@ -107,6 +109,10 @@ public:
                      VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
     // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
     double timestamp_period_ns() const noexcept;
+    VkQueryType query_type() const noexcept;
+    // Values per query in results(): one per statistic for a pipeline
+    // statistics pool, otherwise 1 (pass it as stride_words).
+    std::uint32_t values_per_query() const noexcept;
 
 private:
     using Handle::Handle;
@@ -173,6 +179,8 @@ public:
     Device device;
     VkQueryPool pool = VK_NULL_HANDLE;
     std::uint32_t count = 0;
+    VkQueryType type = VK_QUERY_TYPE_TIMESTAMP;
+    std::uint32_t values_per_query = 1;
 };
 
 }  // namespace detail
@@ -185,5 +193,7 @@ inline const Device& Semaphore::device() const noexcept { return state_->device;
 inline VkEvent Event::vk() const noexcept { return state_->event; }
 inline VkQueryPool QueryPool::vk() const noexcept { return state_->pool; }
 inline std::uint32_t QueryPool::query_count() const noexcept { return state_->count; }
+inline VkQueryType QueryPool::query_type() const noexcept { return state_->type; }
+inline std::uint32_t QueryPool::values_per_query() const noexcept { return state_->values_per_query; }
 
 VKRC_END_NAMESPACE
