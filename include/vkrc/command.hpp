@@ -702,28 +702,28 @@ inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, const Qu
 
 inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
                                       std::span<const VkImageBlit> regions, VkFilter filter) const noexcept {
-    fn_->vkCmdBlitImage(state_->cmd, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+    fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                         regions.data(), filter);
 }
 inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
                                          std::span<const VkImageResolve> regions) const noexcept {
-    fn_->vkCmdResolveImage(state_->cmd, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+    fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                            regions.data());
 }
 inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
                                              std::span<const VkImageSubresourceRange> ranges) const noexcept {
-    fn_->vkCmdClearColorImage(state_->cmd, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
+    fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
                               ranges.data());
 }
 inline void CommandBuffer::clear_depth_stencil_image(VkImage image, VkImageLayout layout,
                                                      const VkClearDepthStencilValue& value,
                                                      std::span<const VkImageSubresourceRange> ranges) const noexcept {
-    fn_->vkCmdClearDepthStencilImage(state_->cmd, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
+    fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
                                      ranges.data());
 }
 inline void CommandBuffer::clear_attachments(std::span<const VkClearAttachment> attachments,
                                              std::span<const VkClearRect> rects) const noexcept {
-    fn_->vkCmdClearAttachments(state_->cmd, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
+    fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
                                static_cast<std::uint32_t>(rects.size()), rects.data());
 }
 
@@ -737,46 +737,46 @@ inline void CommandBuffer::update_buffer(VkBuffer dst, VkDeviceSize offset, VkDe
         detail::throw_bad_update_buffer(offset, size);
     }
 #endif
-    fn_->vkCmdUpdateBuffer(state_->cmd, dst, offset, size, data);
+    fn_->vkCmdUpdateBuffer(cmd_, dst, offset, size, data);
 }
 
 inline void CommandBuffer::draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
                                          std::uint32_t stride) const noexcept {
-    fn_->vkCmdDrawIndirect(state_->cmd, buffer, offset, draw_count,
+    fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
                            stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
 }
 inline void CommandBuffer::draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
                                                  std::uint32_t stride) const noexcept {
-    fn_->vkCmdDrawIndexedIndirect(state_->cmd, buffer, offset, draw_count,
+    fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
                                   stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
 }
 inline void CommandBuffer::dispatch_indirect(VkBuffer buffer, VkDeviceSize offset) const noexcept {
-    fn_->vkCmdDispatchIndirect(state_->cmd, buffer, offset);
+    fn_->vkCmdDispatchIndirect(cmd_, buffer, offset);
 }
 inline void CommandBuffer::draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                                VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                                std::uint32_t stride) const noexcept {
-    fn_->vkCmdDrawIndirectCount(state_->cmd, buffer, offset, count_buffer, count_offset, max_draw_count,
+    fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
                                 stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
 }
 inline void CommandBuffer::draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                                        VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                                        std::uint32_t stride) const noexcept {
-    fn_->vkCmdDrawIndexedIndirectCount(state_->cmd, buffer, offset, count_buffer, count_offset, max_draw_count,
+    fn_->vkCmdDrawIndexedIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
                                        stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
 }
 
 inline void CommandBuffer::begin_query(const QueryPool& pool, std::uint32_t query,
                                        VkQueryControlFlags flags) const noexcept {
-    fn_->vkCmdBeginQuery(state_->cmd, pool.vk(), query, flags);
+    fn_->vkCmdBeginQuery(cmd_, pool.vk(), query, flags);
 }
 inline void CommandBuffer::end_query(const QueryPool& pool, std::uint32_t query) const noexcept {
-    fn_->vkCmdEndQuery(state_->cmd, pool.vk(), query);
+    fn_->vkCmdEndQuery(cmd_, pool.vk(), query);
 }
 inline void CommandBuffer::copy_query_results(const QueryPool& pool, std::uint32_t first_query,
                                               std::uint32_t query_count, const Buffer& dst, VkDeviceSize offset,
                                               VkDeviceSize stride, VkQueryResultFlags flags) const noexcept {
-    fn_->vkCmdCopyQueryPoolResults(state_->cmd, pool.vk(), first_query, query_count, dst.vk(), offset, stride,
+    fn_->vkCmdCopyQueryPoolResults(cmd_, pool.vk(), first_query, query_count, dst.vk(), offset, stride,
                                    flags | VK_QUERY_RESULT_64_BIT);
 }
 
@@ -784,111 +784,111 @@ inline void CommandBuffer::begin_label(const char* name, const LabelColor& color
     if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
         const VkDebugUtilsLabelEXT label{
             VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
-        f(state_->cmd, &label);
+        f(cmd_, &label);
     }
 }
 inline void CommandBuffer::end_label() const noexcept {
-    if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(state_->cmd);
+    if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(cmd_);
 }
 inline void CommandBuffer::insert_label(const char* name, const LabelColor& color) const noexcept {
     if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
         const VkDebugUtilsLabelEXT label{
             VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
-        f(state_->cmd, &label);
+        f(cmd_, &label);
     }
 }
 
 inline void CommandBuffer::set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const noexcept {
-    fn_->vkCmdSetViewport(state_->cmd, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+    fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
 inline void CommandBuffer::set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const noexcept {
-    fn_->vkCmdSetScissor(state_->cmd, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+    fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
-inline void CommandBuffer::set_line_width(float width) const noexcept { fn_->vkCmdSetLineWidth(state_->cmd, width); }
+inline void CommandBuffer::set_line_width(float width) const noexcept { fn_->vkCmdSetLineWidth(cmd_, width); }
 inline void CommandBuffer::set_depth_bias(float constant_factor, float clamp, float slope_factor) const noexcept {
-    fn_->vkCmdSetDepthBias(state_->cmd, constant_factor, clamp, slope_factor);
+    fn_->vkCmdSetDepthBias(cmd_, constant_factor, clamp, slope_factor);
 }
 inline void CommandBuffer::set_blend_constants(const float (&constants)[4]) const noexcept {
-    fn_->vkCmdSetBlendConstants(state_->cmd, constants);
+    fn_->vkCmdSetBlendConstants(cmd_, constants);
 }
 inline void CommandBuffer::set_depth_bounds(float min_bounds, float max_bounds) const noexcept {
-    fn_->vkCmdSetDepthBounds(state_->cmd, min_bounds, max_bounds);
+    fn_->vkCmdSetDepthBounds(cmd_, min_bounds, max_bounds);
 }
 inline void CommandBuffer::set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
-    fn_->vkCmdSetStencilCompareMask(state_->cmd, faces, mask);
+    fn_->vkCmdSetStencilCompareMask(cmd_, faces, mask);
 }
 inline void CommandBuffer::set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
-    fn_->vkCmdSetStencilWriteMask(state_->cmd, faces, mask);
+    fn_->vkCmdSetStencilWriteMask(cmd_, faces, mask);
 }
 inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const noexcept {
-    fn_->vkCmdSetStencilReference(state_->cmd, faces, reference);
+    fn_->vkCmdSetStencilReference(cmd_, faces, reference);
 }
 
 inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const noexcept {
-    fn_->vkCmdSetCullMode(state_->cmd, mode);
+    fn_->vkCmdSetCullMode(cmd_, mode);
 }
 inline void CommandBuffer::set_front_face(VkFrontFace face) const noexcept {
-    fn_->vkCmdSetFrontFace(state_->cmd, face);
+    fn_->vkCmdSetFrontFace(cmd_, face);
 }
 inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const noexcept {
-    fn_->vkCmdSetPrimitiveTopology(state_->cmd, topology);
+    fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
 }
 inline void CommandBuffer::set_viewport_with_count(std::span<const VkViewport> viewports) const noexcept {
-    fn_->vkCmdSetViewportWithCount(state_->cmd, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+    fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
 inline void CommandBuffer::set_scissor_with_count(std::span<const VkRect2D> scissors) const noexcept {
-    fn_->vkCmdSetScissorWithCount(state_->cmd, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+    fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
 inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
                                                 std::span<const VkDeviceSize> offsets,
                                                 std::span<const VkDeviceSize> sizes,
                                                 std::span<const VkDeviceSize> strides) const noexcept {
-    fn_->vkCmdBindVertexBuffers2(state_->cmd, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+    fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                  offsets.data(), sizes.empty() ? nullptr : sizes.data(),
                                  strides.empty() ? nullptr : strides.data());
 }
 inline void CommandBuffer::set_depth_test_enable(bool enable) const noexcept {
-    fn_->vkCmdSetDepthTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetDepthTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_depth_write_enable(bool enable) const noexcept {
-    fn_->vkCmdSetDepthWriteEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetDepthWriteEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const noexcept {
-    fn_->vkCmdSetDepthCompareOp(state_->cmd, op);
+    fn_->vkCmdSetDepthCompareOp(cmd_, op);
 }
 inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const noexcept {
-    fn_->vkCmdSetDepthBoundsTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetDepthBoundsTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_stencil_test_enable(bool enable) const noexcept {
-    fn_->vkCmdSetStencilTestEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetStencilTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
                                           VkStencilOp depth_fail_op, VkCompareOp compare_op) const noexcept {
-    fn_->vkCmdSetStencilOp(state_->cmd, faces, fail_op, pass_op, depth_fail_op, compare_op);
+    fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
 }
 inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const noexcept {
-    fn_->vkCmdSetRasterizerDiscardEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetRasterizerDiscardEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_depth_bias_enable(bool enable) const noexcept {
-    fn_->vkCmdSetDepthBiasEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetDepthBiasEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_primitive_restart_enable(bool enable) const noexcept {
-    fn_->vkCmdSetPrimitiveRestartEnable(state_->cmd, enable ? VK_TRUE : VK_FALSE);
+    fn_->vkCmdSetPrimitiveRestartEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 
 inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept {
-    fn_->vkCmdBindPipeline(state_->cmd, bind_point, pipeline);
+    fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
 }
 inline void CommandBuffer::bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
                                                 std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
                                                 std::span<const std::uint32_t> dynamic_offsets) const noexcept {
-    fn_->vkCmdBindDescriptorSets(state_->cmd, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
+    fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
                                  sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
                                  dynamic_offsets.data());
 }
 inline void CommandBuffer::push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset,
                                           std::uint32_t size, const void* data) const noexcept {
-    fn_->vkCmdPushConstants(state_->cmd, layout, stages, offset, size, data);
+    fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
 }
 
 VKRC_END_NAMESPACE
