@@ -712,8 +712,7 @@ inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, 
 }
 inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
                                              std::span<const VkImageSubresourceRange> ranges) const noexcept {
-    fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
-                              ranges.data());
+    fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()), ranges.data());
 }
 inline void CommandBuffer::clear_depth_stencil_image(VkImage image, VkImageLayout layout,
                                                      const VkClearDepthStencilValue& value,
@@ -824,12 +823,8 @@ inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces, std::
     fn_->vkCmdSetStencilReference(cmd_, faces, reference);
 }
 
-inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const noexcept {
-    fn_->vkCmdSetCullMode(cmd_, mode);
-}
-inline void CommandBuffer::set_front_face(VkFrontFace face) const noexcept {
-    fn_->vkCmdSetFrontFace(cmd_, face);
-}
+inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const noexcept { fn_->vkCmdSetCullMode(cmd_, mode); }
+inline void CommandBuffer::set_front_face(VkFrontFace face) const noexcept { fn_->vkCmdSetFrontFace(cmd_, face); }
 inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const noexcept {
     fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
 }
