@@ -24,6 +24,17 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange
     return b;
 }
 
+namespace {
+// A barrier of the ownership transfer from src_family to dst_family: the
+// release and acquire helpers differ only in which half carries the stages.
+template <class Barrier>
+Barrier between_families(Barrier b, std::uint32_t src_family, std::uint32_t dst_family) noexcept {
+    b.srcQueueFamilyIndex = src_family;
+    b.dstQueueFamilyIndex = dst_family;
+    return b;
+}
+}  // namespace
+
 VkImageSubresourceRange mip_range(std::uint32_t base_level, std::uint32_t level_count,
                                   VkImageAspectFlags aspect) noexcept {
     return {aspect, base_level, level_count, 0, VK_REMAINING_ARRAY_LAYERS};
@@ -56,9 +67,7 @@ VkImageMemoryBarrier2 image_ownership_release(VkImage image, const VkImageSubres
                                               VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) noexcept {
     auto b = image_barrier(image, range, old_layout, new_layout, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE,
                            VK_ACCESS_2_NONE);
-    b.srcQueueFamilyIndex = src_family;
-    b.dstQueueFamilyIndex = dst_family;
-    return b;
+    return between_families(b, src_family, dst_family);
 }
 
 VkImageMemoryBarrier2 image_ownership_acquire(VkImage image, const VkImageSubresourceRange& range,
@@ -67,27 +76,21 @@ VkImageMemoryBarrier2 image_ownership_acquire(VkImage image, const VkImageSubres
                                               VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
     auto b = image_barrier(image, range, old_layout, new_layout, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, dst_stage,
                            dst_access);
-    b.srcQueueFamilyIndex = src_family;
-    b.dstQueueFamilyIndex = dst_family;
-    return b;
+    return between_families(b, src_family, dst_family);
 }
 
 VkBufferMemoryBarrier2 buffer_ownership_release(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
                                                 VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                                 VkDeviceSize offset, VkDeviceSize size) noexcept {
     auto b = buffer_barrier(buffer, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, offset, size);
-    b.srcQueueFamilyIndex = src_family;
-    b.dstQueueFamilyIndex = dst_family;
-    return b;
+    return between_families(b, src_family, dst_family);
 }
 
 VkBufferMemoryBarrier2 buffer_ownership_acquire(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
                                                 VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                                 VkDeviceSize offset, VkDeviceSize size) noexcept {
     auto b = buffer_barrier(buffer, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, dst_stage, dst_access, offset, size);
-    b.srcQueueFamilyIndex = src_family;
-    b.dstQueueFamilyIndex = dst_family;
-    return b;
+    return between_families(b, src_family, dst_family);
 }
 
 // generate_mipmaps

@@ -262,21 +262,21 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::topology(VkPrimitiveTopology t
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::polygon_mode(VkPolygonMode m) {
-    polygon_mode_ = m;
+    raster_.polygon_mode = m;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::cull_mode(VkCullModeFlags m) {
-    cull_mode_ = m;
+    raster_.cull_mode = m;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::front_face(VkFrontFace f) {
-    front_face_ = f;
+    raster_.front_face = f;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::depth_test(bool test, bool write, VkCompareOp compare) {
-    depth_test_ = test;
-    depth_write_ = write;
-    depth_compare_ = compare;
+    depth_stencil_.depth_test_enable = test;
+    depth_stencil_.depth_write_enable = write;
+    depth_stencil_.depth_compare_op = compare;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend(const VkPipelineColorBlendAttachmentState& state) {
@@ -284,7 +284,7 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend(const VkPipelineColorBle
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::samples(VkSampleCountFlagBits s) {
-    samples_ = s;
+    multisample_.rasterization_samples = s;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_state(VkDynamicState state) {

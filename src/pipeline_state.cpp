@@ -68,21 +68,14 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Comp
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::rasterization(const RasterizationState& state) {
     raster_ = state;
-    polygon_mode_ = state.polygon_mode;
-    cull_mode_ = state.cull_mode;
-    front_face_ = state.front_face;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::depth_stencil(const DepthStencilState& state) {
     depth_stencil_ = state;
-    depth_test_ = state.depth_test_enable;
-    depth_write_ = state.depth_write_enable;
-    depth_compare_ = state.depth_compare_op;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::multisample(const MultisampleState& state) {
     multisample_ = state;
-    samples_ = state.rasterization_samples;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_attachments(
@@ -192,9 +185,9 @@ VkPipelineRasterizationStateCreateInfo GraphicsPipelineBuilder::rasterization_st
     r.pNext = raster_.next;
     r.depthClampEnable = vk_bool(raster_.depth_clamp_enable);
     r.rasterizerDiscardEnable = vk_bool(raster_.rasterizer_discard_enable);
-    r.polygonMode = polygon_mode_;
-    r.cullMode = cull_mode_;
-    r.frontFace = front_face_;
+    r.polygonMode = raster_.polygon_mode;
+    r.cullMode = raster_.cull_mode;
+    r.frontFace = raster_.front_face;
     r.depthBiasEnable = vk_bool(raster_.depth_bias_enable);
     r.depthBiasConstantFactor = raster_.depth_bias_constant_factor;
     r.depthBiasClamp = raster_.depth_bias_clamp;
@@ -206,7 +199,7 @@ VkPipelineRasterizationStateCreateInfo GraphicsPipelineBuilder::rasterization_st
 VkPipelineMultisampleStateCreateInfo GraphicsPipelineBuilder::multisample_state() const {
     VkPipelineMultisampleStateCreateInfo m{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
     m.pNext = multisample_.next;
-    m.rasterizationSamples = samples_;
+    m.rasterizationSamples = multisample_.rasterization_samples;
     m.sampleShadingEnable = vk_bool(multisample_.sample_shading_enable);
     m.minSampleShading = multisample_.min_sample_shading;
     m.alphaToCoverageEnable = vk_bool(multisample_.alpha_to_coverage_enable);
@@ -218,9 +211,9 @@ VkPipelineDepthStencilStateCreateInfo GraphicsPipelineBuilder::depth_stencil_sta
     VkPipelineDepthStencilStateCreateInfo d{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
     d.pNext = depth_stencil_.next;
     d.flags = depth_stencil_.flags;
-    d.depthTestEnable = vk_bool(depth_test_);
-    d.depthWriteEnable = vk_bool(depth_write_);
-    d.depthCompareOp = depth_compare_;
+    d.depthTestEnable = vk_bool(depth_stencil_.depth_test_enable);
+    d.depthWriteEnable = vk_bool(depth_stencil_.depth_write_enable);
+    d.depthCompareOp = depth_stencil_.depth_compare_op;
     d.depthBoundsTestEnable = vk_bool(depth_stencil_.depth_bounds_test_enable);
     d.stencilTestEnable = vk_bool(depth_stencil_.stencil_test_enable);
     d.front = depth_stencil_.front;

@@ -312,12 +312,6 @@ private:
     List<VkVertexInputBindingDescription> bindings_;
     List<VkVertexInputAttributeDescription> attributes_;
     VkPrimitiveTopology topology_ = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPolygonMode polygon_mode_ = VK_POLYGON_MODE_FILL;
-    VkCullModeFlags cull_mode_ = VK_CULL_MODE_BACK_BIT;
-    VkFrontFace front_face_ = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    bool depth_test_ = true;
-    bool depth_write_ = true;
-    VkCompareOp depth_compare_ = VK_COMPARE_OP_LESS;
     VkPipelineColorBlendAttachmentState blend_{
         VK_FALSE,
         VK_BLEND_FACTOR_ONE,
@@ -327,7 +321,6 @@ private:
         VK_BLEND_FACTOR_ZERO,
         VK_BLEND_OP_ADD,
         VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
-    VkSampleCountFlagBits samples_ = VK_SAMPLE_COUNT_1_BIT;
     List<VkDynamicState> dynamic_states_;  // viewport and scissor, from the constructor
     RenderPass render_pass_;
     std::uint32_t subpass_ = 0;
@@ -340,6 +333,8 @@ private:
         List<VkSpecializationMapEntry> entries;
         List<std::byte> data;
     };
+    // The state structs also hold what polygon_mode(), cull_mode(), front_face(),
+    // depth_test() and samples() set: one place per value.
     RasterizationState raster_{};
     DepthStencilState depth_stencil_{};
     MultisampleState multisample_{};
