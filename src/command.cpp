@@ -14,7 +14,7 @@ void throw_too_many_color_attachments(std::size_t count) {
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
-    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool);
+    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool, serial());
 }
 
 void CommandPoolState::free_completed() {
@@ -29,8 +29,12 @@ void CommandPoolState::free_completed() {
 CommandBufferState::~CommandBufferState() {
     if (cmd == VK_NULL_HANDLE) return;
     auto& p = *pool.state();
+    auto& device = *p.device.state();
+    // Closed first: it holds nothing once gone, but a primary it was
+    // executed in may still hold it.
+    device.commands.remove(device, window);
     LockGuard lock(p.mutex);
-    p.pending.push(*p.device.state(), cmd);
+    p.pending.push(device, cmd, serial());
 }
 
 }  // namespace detail
@@ -53,6 +57,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     s->fn = &p.device.fn();
     s->pool = *this;
     s->level = level;
+    s->window.pool = &p;
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = p.pool;
     ai.level = level;
@@ -60,14 +65,24 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     LockGuard lock(p.mutex);
     p.free_completed();
     check(p.device.fn().vkAllocateCommandBuffers(p.device.vk(), &ai, &s->cmd), "vkAllocateCommandBuffers");
+    try {
+        p.device.state()->commands.add(s->window);
+    } catch (...) {
+        p.device.fn().vkFreeCommandBuffers(p.device.vk(), p.pool, 1, &s->cmd);
+        s->cmd = VK_NULL_HANDLE;
+        throw;
+    }
     return CommandBuffer(std::move(s));
 }
 
 void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
     auto& p = *state_;
-    LockGuard lock(p.mutex);
-    p.free_completed();
-    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+    {
+        LockGuard lock(p.mutex);
+        p.free_completed();
+        check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+    }
+    p.device.state()->commands.close_pool(*p.device.state(), &p);
 }
 
 std::size_t CommandPool::pending_free_count() const {
@@ -81,6 +96,10 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
     LockGuard lock(p.mutex);
     p.free_completed();
     check(s.fn->vkBeginCommandBuffer(s.cmd, &info), "vkBeginCommandBuffer");
+    // Only a primary's submit closes it: a ONE_TIME secondary stays open until reset, re-begin or free.
+    const bool one_time =
+        s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && (info.flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0;
+    p.device.state()->commands.begin(s.window, one_time);
 }
 }  // namespace
 
@@ -125,14 +144,30 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
 }
 
 void CommandBuffer::end() const {
-    LockGuard lock(state_->pool.state()->mutex);
+    auto& p = *state_->pool.state();
+    LockGuard lock(p.mutex);
     check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
+    p.device.state()->commands.end(state_->window);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
-    LockGuard lock(state_->pool.state()->mutex);
-    check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
+    auto& p = *state_->pool.state();
+    {
+        LockGuard lock(p.mutex);
+        check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
+    }
+    p.device.state()->commands.close(*p.device.state(), state_->window);
 }
+
+namespace detail {
+void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept {
+    for (const CommandBuffer& c : command_buffers) {
+        auto& s = *c.state();
+        if (s.window.one_time)
+            s.pool.state()->device.state()->commands.close(*s.pool.state()->device.state(), s.window);
+    }
+}
+}  // namespace detail
 
 VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
                                     VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,

@@ -23,7 +23,9 @@ DeviceState::~DeviceState() {
         // its submissions are done.
         for (auto& q : queues) wait_for_submission(q, q.timeline.last_submitted());
     }
+    // Children before what they were made from: held drops are older.
     deferred.run_all(*this);
+    commands.run_all(*this);
     allocators.release_all(*this);
     for (auto& q : queues) {
         if (q.semaphore != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.semaphore, nullptr);
@@ -363,8 +365,8 @@ void Device::wait_idle() const {
     state_->finish_call(r, "vkDeviceWaitIdle");
 }
 
-void Device::collect_garbage() const noexcept { state_->deferred.collect(*state_); }
-std::size_t Device::deferred_count() const noexcept { return state_->deferred.size(); }
+void Device::collect_garbage() const noexcept { state_->collect(); }
+std::size_t Device::deferred_count() const noexcept { return state_->deferred.size() + state_->commands.held_count(); }
 bool Device::lost() const noexcept { return state_->lost.load(std::memory_order_relaxed); }
 
 namespace {

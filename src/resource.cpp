@@ -16,20 +16,20 @@ namespace detail {
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
     if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
+        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer, serial());
 }
 ImageState::~ImageState() {
     if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
+        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image, serial());
 }
 ImageViewState::~ImageViewState() {
-    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view);
+    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view, serial());
 }
 BufferViewState::~BufferViewState() {
-    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view);
+    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
 }
 SamplerState::~SamplerState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler);
+    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler, serial());
 }
 
 }  // namespace detail

@@ -63,6 +63,7 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
     if (fence) {
         fence.state()->note_submitted(*queue.state(), number);
     }
+    for (const auto& batch : batches) detail::close_submitted(batch.command_buffers);
 }
 
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {

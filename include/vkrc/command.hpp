@@ -217,6 +217,10 @@ VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 
 
 namespace detail {
 
+// After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
+// (OpenCommandBuffers), whose held drops then wait for that submission.
+void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept;
+
 class CommandPoolState final : public RefCounted {
 public:
     ~CommandPoolState() override;
@@ -239,6 +243,7 @@ public:
     const DeviceFunctions* fn = nullptr;
     CommandPool pool;
     VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    RecordingWindow window;  // registered with the device's OpenCommandBuffers
 };
 
 }  // namespace detail

@@ -134,11 +134,17 @@ private:
 
 namespace detail {
 
+// Creation order of every state block, process-wide: a command buffer ended
+// at counter value v may refer to objects whose serial is below v, never to
+// later ones (docs/design.md, "Dropped while recorded").
+inline Atomic<std::uint64_t> creation_counter{1};
+inline std::uint64_t current_serial() noexcept { return creation_counter.load(__ATOMIC_RELAXED); }
+
 // Base of every state block. The count starts at one: the creator owns it.
 template <class Policy>
 class BasicRefCounted {
 public:
-    BasicRefCounted() = default;
+    BasicRefCounted() noexcept : serial_(creation_counter.fetch_add(1, __ATOMIC_RELAXED)) {}
     BasicRefCounted(const BasicRefCounted&) = delete;
     BasicRefCounted& operator=(const BasicRefCounted&) = delete;
 
@@ -150,6 +156,8 @@ public:
         }
     }
     std::uint32_t use_count() const noexcept { return Policy::load(refs_); }
+    // Taken at construction (creation or adoption); see creation_counter.
+    std::uint64_t serial() const noexcept { return serial_; }
 
 protected:
     virtual ~BasicRefCounted() = default;
@@ -159,6 +167,7 @@ protected:
 
 private:
     mutable typename Policy::Count refs_{1};
+    std::uint64_t serial_;
 };
 
 using RefCounted = BasicRefCounted<ThreadPolicy>;

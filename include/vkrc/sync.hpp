@@ -146,7 +146,7 @@ public:
 // Queues the destruction of a fence that was submitted and may not have been
 // seen signalled: after the work submitted so far, it waits for the fence
 // (at once in practice; a lost device returns at once too), then destroys it.
-void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept;
+void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t serial) noexcept;
 
 class SemaphoreState final : public RefCounted {
 public:
