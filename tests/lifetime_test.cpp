@@ -78,7 +78,7 @@ TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
         cmd.begin();
         record_fill_copy(cmd, buffer, readback, 7);
         cmd.end();
-    }  // buffer dropped here
+    }                                        // buffer dropped here
     EXPECT_GE(device.deferred_count(), 1u);  // held, not destroyed
     submit_and_wait(queue, cmd);
     EXPECT_TRUE(all_equal(readback, 7));
@@ -109,9 +109,8 @@ TEST_F(VulkanTest, EveryKindDroppedBetweenRecordAndSubmit) {
     auto cmd = pool.allocate();
     {
         auto storage = make_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-        auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
-                                                  .extent = {4, 4, 1},
-                                                  .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+        auto image = vkrc::Image::create(
+            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
         auto view = vkrc::ImageView::create(image);
         auto sampler = vkrc::Sampler::create(device);
         auto set_layout = vkrc::DescriptorSetLayout::create(
