@@ -33,10 +33,13 @@ void OpenCommandBuffers::close_pool(DeviceState& device, const void* pool) noexc
     if (held_count_.load() != 0) release(device);
 }
 
+// A recording window counts as ending now: every object that can be dropped
+// was made before now, and its end() comes later still.
 std::uint64_t OpenCommandBuffers::limit_locked() const noexcept {
     std::uint64_t limit = 0;
     for (const RecordingWindow* w : windows_) {
-        const std::uint64_t end = w->end.load();
+        std::uint64_t end = w->end.load();
+        if (end == UINT64_MAX) end = current_serial();
         if (end > limit) limit = end;
     }
     return limit;
@@ -53,13 +56,15 @@ bool OpenCommandBuffers::holds(std::uint64_t serial) noexcept { return serial < 
 bool OpenCommandBuffers::hold(DeferredAction action, std::uint64_t serial) noexcept {
     if (open_.load() == 0) return false;
     LockGuard lock(mutex_);
-    if (serial >= limit_locked()) return false;
+    const std::uint64_t limit = limit_locked();
+    if (serial >= limit) return false;
     try {
         held_.push_back(Held{action, serial});
     } catch (...) {
         return false;  // out of host memory: the deferred queue's own fallback applies
     }
     held_count_.fetch_add(1);
+    covered_.store(limit, __ATOMIC_RELAXED);
     // A close racing with this hold may have missed it; collect() looks again.
     stale_.store(true, __ATOMIC_RELAXED);
     return true;
@@ -83,6 +88,7 @@ void OpenCommandBuffers::release(DeviceState& device) noexcept {
         }
         held_.resize(kept);
         held_count_.store(kept);
+        covered_.store(limit, __ATOMIC_RELAXED);
     }
     // In order, outside the lock: an action may drop what held it.
     for (const DeferredAction& a : released) device.deferred.destroy_after_gpu(device, a);

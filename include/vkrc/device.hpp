@@ -266,8 +266,11 @@ public:
     }
     void end(RecordingWindow& window) noexcept { window.end.store(current_serial()); }
     void close(DeviceState& device, RecordingWindow& window) noexcept {
-        if (window.end.exchange(0) != 0) open_.fetch_sub(1);
-        if (held_count_.load() != 0) release(device);
+        const std::uint64_t end = window.end.exchange(0);
+        if (end != 0) open_.fetch_sub(1);
+        // Only closing a window at the last computed limit can uncover a held
+        // drop: a long hold by a reusable command buffer costs other closes nothing.
+        if (held_count_.load() != 0 && end >= covered_.load(__ATOMIC_RELAXED)) release(device);
     }
     // Closes every window of a pool (vkResetCommandPool).
     void close_pool(DeviceState& device, const void* pool) noexcept;
@@ -295,6 +298,7 @@ private:
     Atomic<std::size_t> open_{0};
     Atomic<std::size_t> held_count_{0};
     Atomic<bool> stale_{false};
+    Atomic<std::uint64_t> covered_{0};  // limit_locked() at the last hold or release
 };
 
 // Every allocator used with the device, kept until teardown so that deferred
