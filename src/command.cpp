@@ -52,6 +52,7 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
 }
 
 CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::allocate");
     auto& p = *state_;
     detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
     s->fn = &p.device.fn();
@@ -76,6 +77,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
 }
 
 void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::reset_commands");
     auto& p = *state_;
     {
         LockGuard lock(p.mutex);
@@ -86,6 +88,7 @@ void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
 }
 
 std::size_t CommandPool::pending_free_count() const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::pending_free_count");
     LockGuard lock(state_->mutex);
     return state_->pending.size();
 }
@@ -107,6 +110,7 @@ CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noex
     : Handle(std::move(state)), fn_(state_->fn) {}
 
 void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin");
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
         throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
     }
@@ -117,6 +121,7 @@ void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
                                     VkCommandBufferUsageFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_secondary");
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
         throw UsageError("vkrc::CommandBuffer::begin_secondary: the command buffer is primary");
     }
@@ -144,6 +149,7 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
 }
 
 void CommandBuffer::end() const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
     auto& p = *state_->pool.state();
     LockGuard lock(p.mutex);
     check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
@@ -151,6 +157,7 @@ void CommandBuffer::end() const {
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_commands");
     auto& p = *state_->pool.state();
     {
         LockGuard lock(p.mutex);

@@ -337,7 +337,8 @@ Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership own
     return Device(std::move(state));
 }
 
-bool Device::extension_enabled(const char* name) const noexcept {
+bool Device::extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::extension_enabled");
     return detail::contains(state_->enabled_extensions, name);
 }
 
@@ -365,9 +366,18 @@ void Device::wait_idle() const {
     state_->finish_call(r, "vkDeviceWaitIdle");
 }
 
-void Device::collect_garbage() const noexcept { state_->collect(); }
-std::size_t Device::deferred_count() const noexcept { return state_->deferred.size() + state_->commands.held_count(); }
-bool Device::lost() const noexcept { return state_->lost.load(std::memory_order_relaxed); }
+void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::collect_garbage");
+    state_->collect();
+}
+std::size_t Device::deferred_count() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::deferred_count");
+    return state_->deferred.size() + state_->commands.held_count();
+}
+bool Device::lost() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::lost");
+    return state_->lost.load(std::memory_order_relaxed);
+}
 
 namespace {
 

@@ -213,7 +213,8 @@ VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> 
     return d.state()->finish_call(r, "vkGetQueryPoolResults");
 }
 
-double QueryPool::timestamp_period_ns() const noexcept {
+double QueryPool::timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::timestamp_period_ns");
     return state_->device.physical_device().properties().limits.timestampPeriod;
 }
 

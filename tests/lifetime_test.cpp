@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <functional>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -240,6 +241,64 @@ TEST_F(VulkanTest, ReusableCommandBufferHoldsABoundedSet) {
     EXPECT_LE(most, 6u);
     EXPECT_TRUE(all_equal(readback, 7));
 }
+
+// An adopted buffer's cleanup runs once the GPU is done with it, even when
+// it is dropped between recording and submission.
+TEST_F(VulkanTest, AdoptedBufferCleanupRunsAfterTheGpu) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto real = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    bool cleaned = false;
+    auto cmd = pool.allocate();
+    {
+        auto adopted = vkrc::Buffer::adopt(device, real.vk(), bytes, real.usage(), vkrc::Ownership::borrowed,
+                                           [&cleaned] { cleaned = true; });
+        EXPECT_FALSE(adopted.allocation());
+        cmd.begin();
+        record_fill_copy(cmd, adopted, readback, 7);
+        cmd.end();
+    }
+    EXPECT_FALSE(cleaned);
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(cleaned);
+    EXPECT_TRUE(all_equal(readback, 7));
+}
+
+// An adopted instance knows what it was created with.
+TEST_F(VulkanTest, AdoptedInstanceKnowsItsExtensionsAndLayers) {
+    const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    const char* layers[] = {"VK_LAYER_KHRONOS_validation"};
+    auto adopted = vkrc::Instance::adopt(instance.vk(), vkrc::Ownership::borrowed, instance.api_version(), nullptr,
+                                         extensions, layers);
+    EXPECT_TRUE(adopted.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME));
+    EXPECT_TRUE(adopted.layer_enabled("VK_LAYER_KHRONOS_validation"));
+    EXPECT_FALSE(adopted.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME));
+    EXPECT_TRUE(instance.layer_enabled("VK_LAYER_KHRONOS_validation"));
+}
+
+#if VKRC_RUNTIME_CHECKS
+// Accessors and recording through an empty handle name the type and the call.
+TEST(EmptyHandle, AccessorsAndRecordingThrowUsageError) {
+    auto expect_empty = [](auto call, const char* name) {
+        try {
+            call();
+            ADD_FAILURE() << name << " did not throw";
+        } catch (const vkrc::UsageError& e) {
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
+        }
+    };
+    vkrc::CommandBuffer cmd;
+    vkrc::Buffer buffer;
+    vkrc::Allocation allocation;
+    expect_empty([&] { cmd.draw(3); }, "vkrc::CommandBuffer::draw");
+    expect_empty([&] { cmd.begin(); }, "vkrc::CommandBuffer::begin");
+    expect_empty([&] { (void)cmd.vk(); }, "vkrc::CommandBuffer::vk");
+    expect_empty([&] { (void)buffer.size(); }, "vkrc::Buffer::size");
+    expect_empty([&] { allocation.write_value(0, 1u); }, "vkrc::Allocation::write");
+    expect_empty([&] { (void)vkrc::Device().vk(); }, "vkrc::Device::vk");
+}
+#endif
 
 // ---------------------------------------------------------------- randomized
 

@@ -54,11 +54,11 @@ public:
     static Device adopt(const PhysicalDevice& physical_device, VkDevice device, Ownership ownership,
                         std::span<const QueueRequest> queues, std::span<const char* const> enabled_extensions = {});
 
-    VkDevice vk() const noexcept;
-    const DeviceFunctions& fn() const noexcept;
-    const PhysicalDevice& physical_device() const noexcept;
-    const Instance& instance() const noexcept;
-    bool extension_enabled(const char* name) const noexcept;
+    VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    const PhysicalDevice& physical_device() const VKRC_UNCHECKED_NOEXCEPT;
+    const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
+    bool extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
 
     // The index-th queue of a family requested at creation; throws UsageError otherwise.
     Queue queue(std::uint32_t family_index, std::uint32_t index = 0) const;
@@ -69,12 +69,12 @@ public:
     void wait_idle() const;
     // Runs the deferred destructions whose GPU work has completed. vkrc calls
     // this on every submit and wait; applications need not.
-    void collect_garbage() const noexcept;
+    void collect_garbage() const VKRC_UNCHECKED_NOEXCEPT;
     // Number of Vulkan objects and allocations waiting for the GPU, or for an
     // open command buffer that may refer to them.
-    std::size_t deferred_count() const noexcept;
+    std::size_t deferred_count() const VKRC_UNCHECKED_NOEXCEPT;
     // True once any call reported VK_ERROR_DEVICE_LOST.
-    bool lost() const noexcept;
+    bool lost() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -413,10 +413,22 @@ void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) n
 
 }  // namespace detail
 
-inline VkDevice Device::vk() const noexcept { return state_->device; }
-inline const DeviceFunctions& Device::fn() const noexcept { return state_->fn; }
-inline const PhysicalDevice& Device::physical_device() const noexcept { return state_->physical_device; }
-inline const Instance& Device::instance() const noexcept { return state_->physical_device.instance(); }
+inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::vk");
+    return state_->device;
+}
+inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::fn");
+    return state_->fn;
+}
+inline const PhysicalDevice& Device::physical_device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::physical_device");
+    return state_->physical_device;
+}
+inline const Instance& Device::instance() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::instance");
+    return state_->physical_device.instance();
+}
 
 inline VkQueue Queue::vk() const noexcept { return queue_->queue; }
 inline std::uint32_t Queue::family_index() const noexcept { return queue_->family_index; }

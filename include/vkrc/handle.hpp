@@ -217,8 +217,29 @@ private:
 
 }  // namespace detail
 
+namespace detail {
+// Throws UsageError: call (e.g. "vkrc::Buffer::vk") was made through an empty handle.
+[[noreturn]] void throw_empty_handle(const char* call);
+}  // namespace detail
+
+// Accessors and recording methods through an empty handle: with
+// VKRC_RUNTIME_CHECKS they throw UsageError naming the type and the call (so
+// they are not noexcept); without, the check compiles away and an empty
+// handle stays a precondition violation (recording stays one call).
+// clang-format off
+#if VKRC_RUNTIME_CHECKS
+#  define VKRC_UNCHECKED_NOEXCEPT
+#  define VKRC_REQUIRE_STATE(call) \
+      if (!this->state_) [[unlikely]] ::vkrc::detail::throw_empty_handle(call)
+#else
+#  define VKRC_UNCHECKED_NOEXCEPT noexcept
+#  define VKRC_REQUIRE_STATE(call) static_cast<void>(0)
+#endif
+// clang-format on
+
 // Base of the user-facing wrappers. An empty handle (default-constructed or
-// moved-from) holds nothing; calling its accessors is a precondition violation.
+// moved-from) holds nothing; calling its accessors is a precondition violation
+// (checked with VKRC_RUNTIME_CHECKS: VKRC_REQUIRE_STATE).
 template <class State>
 class Handle {
 public:

@@ -26,8 +26,8 @@ public:
     static Fence create(const Device& device, bool signaled = false);
     static Fence adopt(const Device& device, VkFence fence, Ownership ownership);
 
-    VkFence vk() const noexcept;
-    const Device& device() const noexcept;
+    VkFence vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
     // After VK_SUCCESS for a fence given to vkrc::submit, every object dropped
     // before that submission has been destroyed.
@@ -50,9 +50,9 @@ public:
     static Semaphore create_timeline(const Device& device, std::uint64_t initial_value = 0);
     static Semaphore adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership);
 
-    VkSemaphore vk() const noexcept;
-    SemaphoreType type() const noexcept;
-    const Device& device() const noexcept;
+    VkSemaphore vk() const VKRC_UNCHECKED_NOEXCEPT;
+    SemaphoreType type() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
     // Timeline semaphores only (UsageError otherwise).
     // vkGetSemaphoreCounterValue.
@@ -72,7 +72,7 @@ public:
     // device_only: VK_EVENT_CREATE_DEVICE_ONLY_BIT (no host set/reset/status).
     static Event create(const Device& device, bool device_only = false);
 
-    VkEvent vk() const noexcept;
+    VkEvent vk() const VKRC_UNCHECKED_NOEXCEPT;
     // vkSetEvent / vkResetEvent (reset() drops the handle, as on every handle).
     void set() const;
     void unset() const;
@@ -95,15 +95,15 @@ public:
     QueryPool() noexcept = default;
     static QueryPool create(const Device& device, const QueryPoolCreateInfo& info);
 
-    VkQueryPool vk() const noexcept;
-    std::uint32_t query_count() const noexcept;
+    VkQueryPool vk() const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t query_count() const VKRC_UNCHECKED_NOEXCEPT;
     // Reset queries before use with CommandBuffer::reset_query_pool.
     // vkGetQueryPoolResults as 64-bit values into out (one per query, or
     // stride_words per query). VK_NOT_READY when flags lack WAIT and some are not ready.
     VkResult results(std::uint32_t first_query, std::span<std::uint64_t> out,
                      VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
     // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
-    double timestamp_period_ns() const noexcept;
+    double timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -174,13 +174,37 @@ public:
 
 }  // namespace detail
 
-inline VkFence Fence::vk() const noexcept { return state_->fence; }
-inline const Device& Fence::device() const noexcept { return state_->device; }
-inline VkSemaphore Semaphore::vk() const noexcept { return state_->semaphore; }
-inline SemaphoreType Semaphore::type() const noexcept { return state_->type; }
-inline const Device& Semaphore::device() const noexcept { return state_->device; }
-inline VkEvent Event::vk() const noexcept { return state_->event; }
-inline VkQueryPool QueryPool::vk() const noexcept { return state_->pool; }
-inline std::uint32_t QueryPool::query_count() const noexcept { return state_->count; }
+inline VkFence Fence::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Fence::vk");
+    return state_->fence;
+}
+inline const Device& Fence::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Fence::device");
+    return state_->device;
+}
+inline VkSemaphore Semaphore::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::vk");
+    return state_->semaphore;
+}
+inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::type");
+    return state_->type;
+}
+inline const Device& Semaphore::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::device");
+    return state_->device;
+}
+inline VkEvent Event::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Event::vk");
+    return state_->event;
+}
+inline VkQueryPool QueryPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::vk");
+    return state_->pool;
+}
+inline std::uint32_t QueryPool::query_count() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::query_count");
+    return state_->count;
+}
 
 VKRC_END_NAMESPACE
