@@ -24,7 +24,10 @@ void OpenCommandBuffers::remove(DeviceState& device, RecordingWindow& window) no
 }
 
 void OpenCommandBuffers::close_pool(DeviceState& device, const void* pool) noexcept {
-    {
+    // A frame loop resets a pool whose ONE_TIME_SUBMIT primaries its submit
+    // closed: nothing to scan, no lock (the pool is externally synchronised,
+    // so none of its windows opens meanwhile).
+    if (open_.load() != 0) {
         LockGuard lock(mutex_);
         for (RecordingWindow* w : windows_) {
             if (w->pool == pool && w->end.exchange(0) != 0) open_.fetch_sub(1);
