@@ -47,7 +47,8 @@ void AllocationState::on_last_release() noexcept {
                               }
                               delete self;
                           },
-                          0, this});
+                          0, this},
+                         serial());
 }
 
 [[noreturn]] void throw_not_host_visible(const char* who) {

@@ -14,7 +14,7 @@ void throw_too_many_color_attachments(std::size_t count) {
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
-    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool);
+    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool, serial());
 }
 
 void CommandPoolState::free_completed() {
@@ -29,8 +29,12 @@ void CommandPoolState::free_completed() {
 CommandBufferState::~CommandBufferState() {
     if (cmd == VK_NULL_HANDLE) return;
     auto& p = *pool.state();
+    auto& device = *p.device.state();
+    // Closed first: it holds nothing once gone, but a primary it was
+    // executed in may still hold it.
+    device.commands.remove(device, window);
     LockGuard lock(p.mutex);
-    p.pending.push(*p.device.state(), cmd);
+    p.pending.push(device, cmd, serial());
 }
 
 }  // namespace detail
@@ -49,11 +53,13 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
 }
 
 CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::allocate");
     auto& p = *state_;
     detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
     s->fn = &p.device.fn();
     s->pool = *this;
     s->level = level;
+    s->window.pool = &p;
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = p.pool;
     ai.level = level;
@@ -61,17 +67,29 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     LockGuard lock(p.mutex);
     p.free_completed();
     check(p.device.fn().vkAllocateCommandBuffers(p.device.vk(), &ai, &s->cmd), "vkAllocateCommandBuffers");
+    try {
+        p.device.state()->commands.add(s->window);
+    } catch (...) {
+        p.device.fn().vkFreeCommandBuffers(p.device.vk(), p.pool, 1, &s->cmd);
+        s->cmd = VK_NULL_HANDLE;
+        throw;
+    }
     return CommandBuffer(std::move(s));
 }
 
 void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::reset_commands");
     auto& p = *state_;
-    LockGuard lock(p.mutex);
-    p.free_completed();
-    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+    {
+        LockGuard lock(p.mutex);
+        p.free_completed();
+        check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+    }
+    p.device.state()->commands.close_pool(*p.device.state(), &p);
 }
 
 std::size_t CommandPool::pending_free_count() const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::pending_free_count");
     LockGuard lock(state_->mutex);
     return state_->pending.size();
 }
@@ -82,6 +100,10 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
     LockGuard lock(p.mutex);
     p.free_completed();
     check(s.fn->vkBeginCommandBuffer(s.cmd, &info), "vkBeginCommandBuffer");
+    // Only a primary's submit closes it: a ONE_TIME secondary stays open until reset, re-begin or free.
+    const bool one_time =
+        s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && (info.flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0;
+    p.device.state()->commands.begin(s.window, one_time);
 }
 }  // namespace
 
@@ -89,6 +111,7 @@ CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noex
     : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
 
 void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin");
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
         throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
     }
@@ -99,6 +122,7 @@ void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
                                     VkCommandBufferUsageFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_secondary");
     if (state_->level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
         throw UsageError("vkrc::CommandBuffer::begin_secondary: the command buffer is primary");
     }
@@ -126,13 +150,31 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
 }
 
 void CommandBuffer::end() const {
-    LockGuard lock(state_->pool.state()->mutex);
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
+    auto& p = *state_->pool.state();
+    LockGuard lock(p.mutex);
     check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
+    p.device.state()->commands.end(state_->window);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
-    LockGuard lock(state_->pool.state()->mutex);
-    check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_commands");
+    auto& p = *state_->pool.state();
+    {
+        LockGuard lock(p.mutex);
+        check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
+    }
+    p.device.state()->commands.close(*p.device.state(), state_->window);
 }
+
+namespace detail {
+void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept {
+    for (const CommandBuffer& c : command_buffers) {
+        auto& s = *c.state();
+        if (s.window.one_time)
+            s.pool.state()->device.state()->commands.close(*s.pool.state()->device.state(), s.window);
+    }
+}
+}  // namespace detail
 
 VKRC_END_NAMESPACE

@@ -10,19 +10,19 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 DescriptorSetLayoutState::~DescriptorSetLayoutState() {
-    defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout);
+    defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout, serial());
 }
 
 DescriptorPoolState::~DescriptorPoolState() {
     // Destroying the pool frees every set still in it, pending ones included.
-    defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool);
+    defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool, serial());
 }
 
 DescriptorSetState::~DescriptorSetState() {
     auto& p = *pool.state();
     if (!p.can_free_sets || set == VK_NULL_HANDLE) return;
     LockGuard lock(p.mutex);
-    if (p.generation == generation) p.pending.push(*p.device.state(), set);
+    if (p.generation == generation) p.pending.push(*p.device.state(), set, serial());
 }
 
 }  // namespace detail

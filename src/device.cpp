@@ -23,7 +23,9 @@ DeviceState::~DeviceState() {
         // its submissions are done.
         for (auto& q : queues) wait_for_submission(q, q.timeline.last_submitted());
     }
+    // Children before what they were made from: held drops are older.
     deferred.run_all(*this);
+    commands.run_all(*this);
     allocators.release_all(*this);
     for (auto& q : queues) {
         if (q.semaphore != VK_NULL_HANDLE) fn.vkDestroySemaphore(device, q.semaphore, nullptr);
@@ -350,7 +352,8 @@ Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership own
     return Device(std::move(state));
 }
 
-bool Device::extension_enabled(const char* name) const noexcept {
+bool Device::extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::extension_enabled");
     return detail::contains(state_->enabled_extensions, name);
 }
 
@@ -378,9 +381,18 @@ void Device::wait_idle() const {
     state_->finish_call(r, "vkDeviceWaitIdle");
 }
 
-void Device::collect_garbage() const noexcept { state_->deferred.collect(*state_); }
-std::size_t Device::deferred_count() const noexcept { return state_->deferred.size(); }
-bool Device::lost() const noexcept { return state_->lost.load(std::memory_order_relaxed); }
+void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::collect_garbage");
+    state_->collect();
+}
+std::size_t Device::deferred_count() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::deferred_count");
+    return state_->deferred.size() + state_->commands.held_count();
+}
+bool Device::lost() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::lost");
+    return state_->lost.load(std::memory_order_relaxed);
+}
 
 namespace {
 

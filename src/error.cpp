@@ -1,6 +1,7 @@
 #include "vkrc/error.hpp"
 
 #include "enum_names.hpp"
+#include "vkrc/handle.hpp"
 
 #include <cstdint>
 #include <cstring>
@@ -66,6 +67,12 @@ std::string enum_text(VkFormat value) { return enum_text_of(value, "VkFormat"); 
 std::string enum_text(VkPhysicalDeviceType value) { return enum_text_of(value, "VkPhysicalDeviceType"); }
 std::string enum_text(VkColorSpaceKHR value) { return enum_text_of(value, "VkColorSpaceKHR"); }
 std::string enum_text(VkImageLayout value) { return enum_text_of(value, "VkImageLayout"); }
+
+void throw_empty_handle(const char* call) {
+    throw UsageError(std::string(call) +
+                     ": the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image "
+                     "has no Allocation)");
+}
 }  // namespace detail
 
 Error::Error(VkResult result, const char* call) : result_(result), call_(call) {

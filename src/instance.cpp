@@ -94,6 +94,7 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     s.global_fn = global;
     s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
     for (const char* e : extensions) s.enabled_extensions.push_back(e);
+    for (const char* l : layers) s.enabled_layers.push_back(l);
     if (messenger) {
         messenger_info.pNext = nullptr;
         check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
@@ -103,7 +104,8 @@ Instance Instance::create(const InstanceCreateInfo& info) {
 }
 
 Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_version,
-                         PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
+                         PFN_vkGetInstanceProcAddr get_instance_proc_addr,
+                         std::span<const char* const> enabled_extensions, std::span<const char* const> enabled_layers) {
     if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Instance::adopt: the VkInstance is VK_NULL_HANDLE");
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
@@ -113,11 +115,19 @@ Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_
     s.api_version = api_version;
     s.global_fn = global;
     s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
+    for (const char* e : enabled_extensions) s.enabled_extensions.push_back(e);
+    for (const char* l : enabled_layers) s.enabled_layers.push_back(l);
     return instance;
 }
 
-bool Instance::extension_enabled(const char* name) const noexcept {
+bool Instance::extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::extension_enabled");
     return detail::contains(state_->enabled_extensions, name);
+}
+
+bool Instance::layer_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::layer_enabled");
+    return detail::contains(state_->enabled_layers, name);
 }
 
 List<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {

@@ -19,7 +19,8 @@ std::string version_string(std::uint32_t v) {
 }
 }  // namespace
 
-bool PhysicalDevice::supports_extension(const char* name) const noexcept {
+bool PhysicalDevice::supports_extension(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::supports_extension");
     return detail::contains(state_->extensions, name);
 }
 

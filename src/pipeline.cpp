@@ -14,19 +14,19 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 PipelineLayoutState::~PipelineLayoutState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout);
+    defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout, serial());
 }
 RenderPassState::~RenderPassState() {
-    defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass);
+    defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass, serial());
 }
 FramebufferState::~FramebufferState() {
-    defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer);
+    defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer, serial());
 }
 PipelineCacheState::~PipelineCacheState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache);
+    defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache, serial());
 }
 PipelineState::~PipelineState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline);
+    defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline, serial());
 }
 }  // namespace detail
 

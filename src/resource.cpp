@@ -16,20 +16,46 @@ namespace detail {
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
     if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer);
+        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer, serial());
+    if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
 ImageState::~ImageState() {
     if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image);
+        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image, serial());
+    if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
+}
+
+void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t serial) noexcept {
+    auto run = [](DeviceState&, std::uint64_t, void* context) noexcept {
+        auto* f = static_cast<Function<void()>*>(context);
+        try {
+            (*f)();
+        } catch (...) {
+            // A destructor path has no one to report to; the callback's failure is its own.
+        }
+        delete f;
+    };
+    Function<void()>* held = nullptr;
+    try {
+        held = new Function<void()>(std::move(cleanup));
+    } catch (...) {
+        // Out of host memory: waiting is the only safe way left to run it now.
+        device.fn.vkDeviceWaitIdle(device.device);
+        try {
+            cleanup();
+        } catch (...) {}
+        return;
+    }
+    device.destroy_after_gpu({run, 0, held}, serial);
 }
 ImageViewState::~ImageViewState() {
-    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view);
+    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view, serial());
 }
 BufferViewState::~BufferViewState() {
-    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view);
+    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
 }
 SamplerState::~SamplerState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler);
+    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler, serial());
 }
 
 }  // namespace detail
@@ -125,11 +151,12 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
 }
 
 Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
-                     Ownership ownership) {
+                     Ownership ownership, Function<void()> cleanup) {
     if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
     if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
     auto state = buffer_state(device, size, usage, ownership);
     state->buffer = buffer;
+    state->cleanup = std::move(cleanup);
     return Buffer(std::move(state));
 }
 
@@ -187,11 +214,13 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
     return Image(std::move(state));
 }
 
-Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership) {
+Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership,
+                   Function<void()> cleanup) {
     if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
     if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
     auto state = image_state(device, info, ownership);
     state->image = image;
+    state->cleanup = std::move(cleanup);
     return Image(std::move(state));
 }
 

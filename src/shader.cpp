@@ -11,7 +11,7 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 ShaderModuleState::~ShaderModuleState() {
-    defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module);
+    defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module, serial());
 }
 }  // namespace detail
 

@@ -93,6 +93,7 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         c += b.command_buffers.size();
     }
     submit_infos(queue, std::span<const VkSubmitInfo2>(infos.data(), batches.size()), fence);
+    for (const auto& batch : batches) detail::close_submitted(batch.command_buffers);
 }
 
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
@@ -107,6 +108,7 @@ void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
     VkCommandBufferSubmitInfo cmds[inline_command_buffers];
     fill_batch(queue, batch, info, waits, signals, cmds);
     submit_infos(queue, std::span<const VkSubmitInfo2>(&info, 1), fence);
+    detail::close_submitted(batch.command_buffers);
 }
 
 VKRC_END_NAMESPACE

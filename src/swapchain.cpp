@@ -103,7 +103,7 @@ SwapchainChainState::~SwapchainChainState() {
     // so no cycle): the surface must outlive the swapchain's destruction.
     SurfaceState* s = surface.state();
     s->add_ref();
-    device.destroy_after_gpu({last ? destroy_last_swapchain : destroy_swapchain, handle_bits(swapchain), s});
+    device.destroy_after_gpu({last ? destroy_last_swapchain : destroy_swapchain, handle_bits(swapchain), s}, serial());
 }
 
 SwapchainState::~SwapchainState() {

@@ -21,29 +21,33 @@ VkResult finish_fence_query(detail::FenceState& s, VkResult r, const char* name)
 }  // namespace
 
 namespace detail {
-void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept {
+void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t serial) noexcept {
     if (fence == VK_NULL_HANDLE) return;
     device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
                                   auto f = handle_from_bits<VkFence>(bits);
                                   d.fn.vkWaitForFences(d.device, 1, &f, VK_TRUE, UINT64_MAX);
                                   d.fn.vkDestroyFence(d.device, f, nullptr);
                               },
-                              handle_bits(fence), nullptr});
+                              handle_bits(fence), nullptr},
+                             serial);
 }
 
 FenceState::~FenceState() {
     if (ownership != Ownership::owned) return;
     if (in_flight) {
-        destroy_submitted_fence(*device.state(), fence);
+        destroy_submitted_fence(*device.state(), fence, serial());
     } else {
-        defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence);
+        defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence, serial());
     }
 }
 SemaphoreState::~SemaphoreState() {
-    if (ownership == Ownership::owned) defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore);
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore, serial());
 }
-EventState::~EventState() { defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event); }
-QueryPoolState::~QueryPoolState() { defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool); }
+EventState::~EventState() { defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event, serial()); }
+QueryPoolState::~QueryPoolState() {
+    defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool, serial());
+}
 }  // namespace detail
 
 Fence Fence::create(const Device& device, bool signaled) {
@@ -217,7 +221,8 @@ VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> 
     return d.state()->finish_call(r, "vkGetQueryPoolResults");
 }
 
-double QueryPool::timestamp_period_ns() const noexcept {
+double QueryPool::timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::timestamp_period_ns");
     return state_->device.physical_device().properties().limits.timestampPeriod;
 }
 

@@ -157,7 +157,10 @@ struct BlockedQueue {
     }
     // The gate may still be waited on: its destruction goes through the same
     // deferral as any vkrc object's.
-    ~BlockedQueue() { vkrc::detail::defer_destroy<&vkrc::DeviceFunctions::vkDestroySemaphore>(*device.state(), gate); }
+    ~BlockedQueue() {
+        vkrc::detail::defer_destroy<&vkrc::DeviceFunctions::vkDestroySemaphore>(*device.state(), gate,
+                                                                                vkrc::detail::current_serial());
+    }
 };
 
 int actions_run = 0;
@@ -166,12 +169,12 @@ void count_action(vkrc::detail::DeviceState&, std::uint64_t handle, void*) noexc
 TEST_F(VulkanTest, DestructionWaitsForSubmittedWork) {
     actions_run = 0;
     auto& state = *device.state();
-    state.destroy_after_gpu({count_action, 1, nullptr});
+    state.destroy_after_gpu({count_action, 1, nullptr}, vkrc::detail::current_serial());
     EXPECT_EQ(actions_run, 1) << "nothing submitted: runs at once";
 
     BlockedQueue blocked(device, queue);
-    state.destroy_after_gpu({count_action, 10, nullptr});
-    state.destroy_after_gpu({count_action, 100, nullptr});
+    state.destroy_after_gpu({count_action, 10, nullptr}, vkrc::detail::current_serial());
+    state.destroy_after_gpu({count_action, 100, nullptr}, vkrc::detail::current_serial());
     EXPECT_EQ(actions_run, 1);
     EXPECT_EQ(device.deferred_count(), 2u);
     device.collect_garbage();
@@ -189,7 +192,7 @@ TEST(DeferredDestruction, DeviceTeardownDrainsPendingWork) {
     {
         Chain c = make_chain(log);
         BlockedQueue blocked(c.device, c.queue);
-        c.device.state()->destroy_after_gpu({count_action, 5, nullptr});
+        c.device.state()->destroy_after_gpu({count_action, 5, nullptr}, vkrc::detail::current_serial());
         EXPECT_EQ(actions_run, 0);
         blocked.open();
         // Every handle goes here, the queue's work possibly still running:
@@ -210,7 +213,7 @@ TEST_F(VulkanTest, SubmitSignalsTheTimelineOnlyWhenAsked) {
     EXPECT_EQ(q.timeline.last_signalled(), signalled) << "nothing dropped: the application's submits only";
 
     // A drop while work may be pending asks the next submit for one signal.
-    device.state()->destroy_after_gpu({count_action, 1, nullptr});
+    device.state()->destroy_after_gpu({count_action, 1, nullptr}, vkrc::detail::current_serial());
     EXPECT_EQ(device.deferred_count(), 1u);
     const std::uint64_t third = queue.submit(batches);
     EXPECT_EQ(q.timeline.last_signalled(), third);
@@ -232,17 +235,17 @@ TEST_F(VulkanTest, WaitsRunDropsThatNoSubmitSignalled) {
     actions_run = 0;
     VkSubmitInfo2 empty{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     queue.submit(std::span(&empty, 1));
-    device.state()->destroy_after_gpu({count_action, 1, nullptr});
+    device.state()->destroy_after_gpu({count_action, 1, nullptr}, vkrc::detail::current_serial());
     device.wait_idle();
     EXPECT_EQ(actions_run, 1) << "Device::wait_idle";
     queue.submit(std::span(&empty, 1));
-    device.state()->destroy_after_gpu({count_action, 10, nullptr});
+    device.state()->destroy_after_gpu({count_action, 10, nullptr}, vkrc::detail::current_serial());
     queue.wait_idle();
     EXPECT_EQ(actions_run, 11) << "Queue::wait_idle";
     // A fence signal covers all earlier work on its queue.
     auto fence = vkrc::Fence::create(device);
     queue.submit(std::span(&empty, 1));
-    device.state()->destroy_after_gpu({count_action, 100, nullptr});
+    device.state()->destroy_after_gpu({count_action, 100, nullptr}, vkrc::detail::current_serial());
     vkrc::submit(queue, vkrc::SubmitBatch{}, fence);
     EXPECT_EQ(fence.wait(), VK_SUCCESS);
     EXPECT_EQ(actions_run, 111) << "Fence::wait";

@@ -41,9 +41,9 @@ public:
     CommandPool() noexcept = default;
     static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
 
-    VkCommandPool vk() const noexcept;
-    const Device& device() const noexcept;
-    std::uint32_t queue_family_index() const noexcept;
+    VkCommandPool vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t queue_family_index() const VKRC_UNCHECKED_NOEXCEPT;
 
     CommandBuffer allocate(VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY) const;
     // vkResetCommandPool: every command buffer of the pool returns to the
@@ -120,10 +120,10 @@ class CommandBuffer : public Handle<detail::CommandBufferState> {
 public:
     CommandBuffer() noexcept = default;
 
-    VkCommandBuffer vk() const noexcept;
-    const DeviceFunctions& fn() const noexcept;
-    const CommandPool& pool() const noexcept;
-    VkCommandBufferLevel level() const noexcept;
+    VkCommandBuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    const CommandPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
+    VkCommandBufferLevel level() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkBeginCommandBuffer for a primary. flags: ONE_TIME_SUBMIT (default) or
     // SIMULTANEOUS_USE, or 0 to resubmit without overlap.
@@ -140,125 +140,135 @@ public:
     // Render passes and dynamic rendering
     void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
                            std::span<const VkClearValue> clear_values,
-                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
-    void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const noexcept;
-    void end_render_pass() const noexcept;
+                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
+    void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
+    void end_render_pass() const VKRC_UNCHECKED_NOEXCEPT;
     // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
     // RenderingInfo::max_color_attachments colour attachments.
     void begin_rendering(const RenderingInfo& info) const;
-    void end_rendering() const noexcept;
+    void end_rendering() const VKRC_UNCHECKED_NOEXCEPT;
 
     // State
-    void bind_pipeline(const Pipeline& pipeline) const noexcept;
-    void bind_vertex_buffer(std::uint32_t binding, const Buffer& buffer, VkDeviceSize offset = 0) const noexcept {
+    void bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_vertex_buffer(std::uint32_t binding, const Buffer& buffer,
+                            VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         bind_vertex_buffer(binding, buffer.vk(), offset);
     }
-    void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer, VkDeviceSize offset = 0) const noexcept;
+    void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
+                            VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                             std::span<const VkDeviceSize> offsets) const noexcept;
+                             std::span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_index_buffer(const Buffer& buffer, VkDeviceSize offset = 0,
-                           VkIndexType type = VK_INDEX_TYPE_UINT32) const noexcept {
+                           VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
         bind_index_buffer(buffer.vk(), offset, type);
     }
     void bind_index_buffer(VkBuffer buffer, VkDeviceSize offset = 0,
-                           VkIndexType type = VK_INDEX_TYPE_UINT32) const noexcept;
+                           VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT;
     // Binds one set at index set_index of the pipeline's layout.
     void bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
-                             std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+                             std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
-                        std::uint32_t size, const void* data) const noexcept;
+                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
     template <class T>
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
-                        std::uint32_t offset = 0) const noexcept {
+                        std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         push_constants(layout, stages, offset, sizeof(T), &value);
     }
-    void set_viewport(const VkViewport& viewport) const noexcept;
-    void set_scissor(const VkRect2D& scissor) const noexcept;
+    void set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT;
     // Viewport (depth 0..1) and scissor covering extent.
-    void set_viewport_and_scissor(VkExtent2D extent) const noexcept;
+    void set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Work
     void draw(std::uint32_t vertex_count, std::uint32_t instance_count = 1, std::uint32_t first_vertex = 0,
-              std::uint32_t first_instance = 0) const noexcept;
+              std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void draw_indexed(std::uint32_t index_count, std::uint32_t instance_count = 1, std::uint32_t first_index = 0,
-                      std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const noexcept;
-    void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const noexcept;
+                      std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT;
+    void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const VKRC_UNCHECKED_NOEXCEPT;
     // Typed overloads read the raw handles; raw ones are the escape hatch.
-    void copy_buffer(const Buffer& src, const Buffer& dst, std::span<const VkBufferCopy> regions) const noexcept {
+    void copy_buffer(const Buffer& src, const Buffer& dst,
+                     std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         copy_buffer(src.vk(), dst.vk(), regions);
     }
     void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
-                              std::span<const VkBufferImageCopy> regions) const noexcept {
+                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         copy_buffer_to_image(src.vk(), dst.vk(), dst_layout, regions);
     }
     void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
-                              std::span<const VkBufferImageCopy> regions) const noexcept {
+                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         copy_image_to_buffer(src.vk(), src_layout, dst.vk(), regions);
     }
-    void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size, std::uint32_t data) const noexcept {
+    void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size,
+                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
         fill_buffer(dst.vk(), offset, size, data);
     }
-    void copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const noexcept;
+    void copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                              std::span<const VkBufferImageCopy> regions) const noexcept;
+                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                              std::span<const VkBufferImageCopy> regions) const noexcept;
+                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    std::span<const VkImageCopy> regions) const noexcept;
-    void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, std::uint32_t data) const noexcept;
+                    std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+    void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
+                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Synchronisation (synchronization2)
-    void pipeline_barrier(const VkDependencyInfo& dependency) const noexcept;
+    void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
     void pipeline_barrier(std::span<const VkMemoryBarrier2> memory, std::span<const VkBufferMemoryBarrier2> buffers,
-                          std::span<const VkImageMemoryBarrier2> images, VkDependencyFlags flags = 0) const noexcept;
-    void set_event(const Event& event, const VkDependencyInfo& dependency) const noexcept;
-    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const noexcept;
+                          std::span<const VkImageMemoryBarrier2> images,
+                          VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
+    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
-    void execute_commands(std::span<const CommandBuffer> secondaries) const noexcept;
+    void execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Queries
-    void reset_query_pool(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count) const noexcept;
-    void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool, std::uint32_t query) const noexcept;
+    void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
+                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT;
+    void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
+                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Transfer commands on whole images and buffers. Layouts are the images'
     // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
     // during the call only. Typed overloads read the raw handles.
     void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    std::span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const noexcept {
+                    std::span<const VkImageBlit> regions,
+                    VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
         blit_image(src.vk(), src_layout, dst.vk(), dst_layout, regions, filter);
     }
     void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    std::span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const noexcept;
+                    std::span<const VkImageBlit> regions,
+                    VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT;
     // src: multisampled; dst: single-sample, same format.
     void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                       std::span<const VkImageResolve> regions) const noexcept {
+                       std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
         resolve_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
     }
     void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                       std::span<const VkImageResolve> regions) const noexcept;
+                       std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    std::span<const VkImageCopy> regions) const noexcept {
+                    std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         copy_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
     }
     // Outside rendering; the image needs TRANSFER_DST usage.
     void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
-                           std::span<const VkImageSubresourceRange> ranges) const noexcept {
+                           std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         clear_color_image(image.vk(), layout, color, ranges);
     }
     void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                           std::span<const VkImageSubresourceRange> ranges) const noexcept;
+                           std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
     void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   std::span<const VkImageSubresourceRange> ranges) const noexcept {
+                                   std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         clear_depth_stencil_image(image.vk(), layout, value, ranges);
     }
     void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   std::span<const VkImageSubresourceRange> ranges) const noexcept;
+                                   std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
     // Inside rendering (a render pass or dynamic rendering).
     void clear_attachments(std::span<const VkClearAttachment> attachments,
-                           std::span<const VkClearRect> rects) const noexcept;
+                           std::span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
     // this call (data need not outlive it). size and offset are multiples of
     // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
@@ -270,105 +280,106 @@ public:
     // Indirect work: parameters read by the GPU from buffer (INDIRECT_BUFFER
     // usage) at execution. stride 0 means tightly packed commands.
     void draw_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                       std::uint32_t stride = 0) const noexcept {
+                       std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         draw_indirect(buffer.vk(), offset, draw_count, stride);
     }
     void draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                       std::uint32_t stride = 0) const noexcept;
+                       std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void draw_indexed_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                               std::uint32_t stride = 0) const noexcept {
+                               std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         draw_indexed_indirect(buffer.vk(), offset, draw_count, stride);
     }
     void draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                               std::uint32_t stride = 0) const noexcept;
-    void dispatch_indirect(const Buffer& buffer, VkDeviceSize offset = 0) const noexcept {
+                               std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
+    void dispatch_indirect(const Buffer& buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         dispatch_indirect(buffer.vk(), offset);
     }
-    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const noexcept;
+    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT;
     // The draw count comes from count_buffer (a uint32 at count_offset),
     // clamped to max_draw_count. Needs the Vulkan 1.2 drawIndirectCount feature.
     void draw_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
                              VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                             std::uint32_t stride = 0) const noexcept {
+                             std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         draw_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
     }
     void draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer, VkDeviceSize count_offset,
-                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const noexcept;
+                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void draw_indexed_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                     std::uint32_t stride = 0) const noexcept {
+                                     std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         draw_indexed_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
     }
     void draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                     std::uint32_t stride = 0) const noexcept;
+                                     std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
-    void begin_query(const QueryPool& pool, std::uint32_t query, VkQueryControlFlags flags = 0) const noexcept;
-    void end_query(const QueryPool& pool, std::uint32_t query) const noexcept;
+    void begin_query(const QueryPool& pool, std::uint32_t query,
+                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
+    void end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
     void copy_query_results(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count,
                             const Buffer& dst, VkDeviceSize offset, VkDeviceSize stride,
-                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const noexcept;
+                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Debug-utils labels around and between commands, shown by debuggers and
     // capture tools. No-ops when the instance has not enabled
     // VK_EXT_debug_utils, so they may stay in release code. name is copied.
-    void begin_label(const char* name, const LabelColor& color = {}) const noexcept;
-    void end_label() const noexcept;
-    void insert_label(const char* name, const LabelColor& color = {}) const noexcept;
+    void begin_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT;
+    void end_label() const VKRC_UNCHECKED_NOEXCEPT;
+    void insert_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Dynamic state (Vulkan 1.0): each needs its VK_DYNAMIC_STATE_* in the
     // bound pipeline's dynamic states.
-    void set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const noexcept;
-    void set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const noexcept;
+    void set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
     // Other widths than 1.0 need the wideLines feature.
-    void set_line_width(float width) const noexcept;
+    void set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT;
     // A clamp other than 0 needs the depthBiasClamp feature.
-    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const noexcept;
-    void set_blend_constants(const float (&constants)[4]) const noexcept;
-    void set_depth_bounds(float min_bounds, float max_bounds) const noexcept;
-    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept;
-    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept;
-    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const noexcept;
+    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Dynamic state (Vulkan 1.3 core, formerly extended dynamic state 1 and 2).
-    void set_cull_mode(VkCullModeFlags mode) const noexcept;
-    void set_front_face(VkFrontFace face) const noexcept;
-    void set_primitive_topology(VkPrimitiveTopology topology) const noexcept;
+    void set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT;
     // The viewport and scissor counts are dynamic too (VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT).
-    void set_viewport_with_count(std::span<const VkViewport> viewports) const noexcept;
-    void set_scissor_with_count(std::span<const VkRect2D> scissors) const noexcept;
+    void set_viewport_with_count(std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_scissor_with_count(std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
     // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
     void bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
                               std::span<const VkDeviceSize> offsets, std::span<const VkDeviceSize> sizes = {},
-                              std::span<const VkDeviceSize> strides = {}) const noexcept;
-    void set_depth_test_enable(bool enable) const noexcept;
-    void set_depth_write_enable(bool enable) const noexcept;
-    void set_depth_compare_op(VkCompareOp op) const noexcept;
+                              std::span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT;
     // Enabling needs the depthBounds feature.
-    void set_depth_bounds_test_enable(bool enable) const noexcept;
-    void set_stencil_test_enable(bool enable) const noexcept;
+    void set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
     void set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op, VkStencilOp depth_fail_op,
-                        VkCompareOp compare_op) const noexcept;
-    void set_rasterizer_discard_enable(bool enable) const noexcept;
-    void set_depth_bias_enable(bool enable) const noexcept;
-    void set_primitive_restart_enable(bool enable) const noexcept;
+                        VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Binding by raw handles or by a PipelineLayout, for pipelines and
     // layouts made by other code (or adopted): the same single calls.
-    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept;
+    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
                               std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept {
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
     }
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
                               std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const noexcept;
+                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
-                        const void* data) const noexcept;
+                        const void* data) const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     friend class CommandPool;
@@ -475,6 +486,10 @@ void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const Mipmap
 
 namespace detail {
 
+// After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
+// (OpenCommandBuffers), whose held drops then wait for that submission.
+void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept;
+
 class CommandPoolState final : public RefCounted {
 public:
     ~CommandPoolState() override;
@@ -497,22 +512,45 @@ public:
     const DeviceFunctions* fn = nullptr;
     CommandPool pool;
     VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    RecordingWindow window;  // registered with the device's OpenCommandBuffers
 };
 
 }  // namespace detail
 
-inline VkCommandPool CommandPool::vk() const noexcept { return state_->pool; }
-inline const Device& CommandPool::device() const noexcept { return state_->device; }
-inline std::uint32_t CommandPool::queue_family_index() const noexcept { return state_->queue_family_index; }
+inline VkCommandPool CommandPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::vk");
+    return state_->pool;
+}
+inline const Device& CommandPool::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::device");
+    return state_->device;
+}
+inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::queue_family_index");
+    return state_->queue_family_index;
+}
 
-inline VkCommandBuffer CommandBuffer::vk() const noexcept { return cmd_; }
-inline const DeviceFunctions& CommandBuffer::fn() const noexcept { return *fn_; }
-inline const CommandPool& CommandBuffer::pool() const noexcept { return state_->pool; }
-inline VkCommandBufferLevel CommandBuffer::level() const noexcept { return state_->level; }
+inline VkCommandBuffer CommandBuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::vk");
+    return cmd_;
+}
+inline const DeviceFunctions& CommandBuffer::fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fn");
+    return *fn_;
+}
+inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pool");
+    return state_->pool;
+}
+inline VkCommandBufferLevel CommandBuffer::level() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::level");
+    return state_->level;
+}
 
 inline void CommandBuffer::begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer,
                                              VkRect2D render_area, std::span<const VkClearValue> clear_values,
-                                             VkSubpassContents contents) const noexcept {
+                                             VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
     VkRenderPassBeginInfo info{};
     info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
     info.renderPass = render_pass.vk();
@@ -522,10 +560,14 @@ inline void CommandBuffer::begin_render_pass(const RenderPass& render_pass, cons
     info.pClearValues = clear_values.data();
     fn_->vkCmdBeginRenderPass(cmd_, &info, contents);
 }
-inline void CommandBuffer::next_subpass(VkSubpassContents contents) const noexcept {
+inline void CommandBuffer::next_subpass(VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::next_subpass");
     fn_->vkCmdNextSubpass(cmd_, contents);
 }
-inline void CommandBuffer::end_render_pass() const noexcept { fn_->vkCmdEndRenderPass(cmd_); }
+inline void CommandBuffer::end_render_pass() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_render_pass");
+    fn_->vkCmdEndRenderPass(cmd_);
+}
 
 namespace detail {
 [[noreturn]] void throw_too_many_color_attachments(std::size_t count);
@@ -533,6 +575,7 @@ namespace detail {
 
 inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
 #if VKRC_RUNTIME_CHECKS
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_rendering");
     if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
         detail::throw_too_many_color_attachments(info.color_attachments.size());
     }
@@ -576,93 +619,119 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
     }
     fn_->vkCmdBeginRendering(cmd_, &r);
 }
-inline void CommandBuffer::end_rendering() const noexcept { fn_->vkCmdEndRendering(cmd_); }
+inline void CommandBuffer::end_rendering() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_rendering");
+    fn_->vkCmdEndRendering(cmd_);
+}
 
-inline void CommandBuffer::bind_pipeline(const Pipeline& pipeline) const noexcept {
+inline void CommandBuffer::bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
     fn_->vkCmdBindPipeline(cmd_, pipeline.bind_point(), pipeline.vk());
 }
 inline void CommandBuffer::bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
-                                              VkDeviceSize offset) const noexcept {
+                                              VkDeviceSize offset) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffer");
     fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, &buffer, &offset);
 }
 inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                                               std::span<const VkDeviceSize> offsets) const noexcept {
+                                               std::span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers");
     fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                 offsets.data());
 }
-inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offset, VkIndexType type) const noexcept {
+inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offset,
+                                             VkIndexType type) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_index_buffer");
     fn_->vkCmdBindIndexBuffer(cmd_, buffer, offset, type);
 }
-inline void CommandBuffer::bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index,
-                                               const DescriptorSet& set,
-                                               std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+inline void CommandBuffer::bind_descriptor_set(
+    const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
+    std::span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_set");
     VkDescriptorSet raw = set.vk();
     fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
                                  static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
 }
-inline void CommandBuffer::bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set,
-                                                std::span<const VkDescriptorSet> sets,
-                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+inline void CommandBuffer::bind_descriptor_sets(
+    const Pipeline& pipeline, std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
+    std::span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
     fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), first_set,
                                  static_cast<std::uint32_t>(sets.size()), sets.data(),
                                  static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
 }
 inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
-                                          std::uint32_t size, const void* data) const noexcept {
+                                          std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
     fn_->vkCmdPushConstants(cmd_, layout.vk(), stages, offset, size, data);
 }
-inline void CommandBuffer::set_viewport(const VkViewport& viewport) const noexcept {
+inline void CommandBuffer::set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
     fn_->vkCmdSetViewport(cmd_, 0, 1, &viewport);
 }
-inline void CommandBuffer::set_scissor(const VkRect2D& scissor) const noexcept {
+inline void CommandBuffer::set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor");
     fn_->vkCmdSetScissor(cmd_, 0, 1, &scissor);
 }
-inline void CommandBuffer::set_viewport_and_scissor(VkExtent2D extent) const noexcept {
+inline void CommandBuffer::set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_and_scissor");
     set_viewport({0.0f, 0.0f, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0f, 1.0f});
     set_scissor({{0, 0}, extent});
 }
 
 inline void CommandBuffer::draw(std::uint32_t vertex_count, std::uint32_t instance_count, std::uint32_t first_vertex,
-                                std::uint32_t first_instance) const noexcept {
+                                std::uint32_t first_instance) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw");
     fn_->vkCmdDraw(cmd_, vertex_count, instance_count, first_vertex, first_instance);
 }
 inline void CommandBuffer::draw_indexed(std::uint32_t index_count, std::uint32_t instance_count,
                                         std::uint32_t first_index, std::int32_t vertex_offset,
-                                        std::uint32_t first_instance) const noexcept {
+                                        std::uint32_t first_instance) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed");
     fn_->vkCmdDrawIndexed(cmd_, index_count, instance_count, first_index, vertex_offset, first_instance);
 }
-inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint32_t z) const noexcept {
+inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint32_t z) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch");
     fn_->vkCmdDispatch(cmd_, x, y, z);
 }
 inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst,
-                                       std::span<const VkBufferCopy> regions) const noexcept {
+                                       std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
     fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                                                std::span<const VkBufferImageCopy> regions) const noexcept {
+                                                std::span<const VkBufferImageCopy> regions) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
     fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                                                std::span<const VkBufferImageCopy> regions) const noexcept {
+                                                std::span<const VkBufferImageCopy> regions) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
     fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      std::span<const VkImageCopy> regions) const noexcept {
+                                      std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
     fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                         regions.data());
 }
 inline void CommandBuffer::fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
-                                       std::uint32_t data) const noexcept {
+                                       std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fill_buffer");
     fn_->vkCmdFillBuffer(cmd_, dst, offset, size, data);
 }
 
-inline void CommandBuffer::pipeline_barrier(const VkDependencyInfo& dependency) const noexcept {
+inline void CommandBuffer::pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
     fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
 }
 inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> memory,
                                             std::span<const VkBufferMemoryBarrier2> buffers,
                                             std::span<const VkImageMemoryBarrier2> images,
-                                            VkDependencyFlags flags) const noexcept {
+                                            VkDependencyFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
     VkDependencyInfo d{};
     d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
     d.dependencyFlags = flags;
@@ -674,14 +743,19 @@ inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> me
     d.pImageMemoryBarriers = images.data();
     fn_->vkCmdPipelineBarrier2(cmd_, &d);
 }
-inline void CommandBuffer::set_event(const Event& event, const VkDependencyInfo& dependency) const noexcept {
+inline void CommandBuffer::set_event(const Event& event,
+                                     const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
     fn_->vkCmdSetEvent2(cmd_, event.vk(), &dependency);
 }
-inline void CommandBuffer::reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const noexcept {
+inline void CommandBuffer::reset_event(const Event& event,
+                                       VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
     fn_->vkCmdResetEvent2(cmd_, event.vk(), stage_mask);
 }
 
-inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secondaries) const noexcept {
+inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
     constexpr std::size_t chunk = 32;
     VkCommandBuffer raw[chunk];
     for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
@@ -692,36 +766,45 @@ inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secon
 }
 
 inline void CommandBuffer::reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
-                                            std::uint32_t query_count) const noexcept {
+                                            std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
     fn_->vkCmdResetQueryPool(cmd_, pool.vk(), first_query, query_count);
 }
 inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
-                                           std::uint32_t query) const noexcept {
+                                           std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
     fn_->vkCmdWriteTimestamp2(cmd_, stage, pool.vk(), query);
 }
 
 inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      std::span<const VkImageBlit> regions, VkFilter filter) const noexcept {
+                                      std::span<const VkImageBlit> regions,
+                                      VkFilter filter) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
     fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                         regions.data(), filter);
 }
 inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                         std::span<const VkImageResolve> regions) const noexcept {
+                                         std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
     fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                            regions.data());
 }
 inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                                             std::span<const VkImageSubresourceRange> ranges) const noexcept {
+                                             std::span<const VkImageSubresourceRange> ranges) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
     fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()), ranges.data());
 }
-inline void CommandBuffer::clear_depth_stencil_image(VkImage image, VkImageLayout layout,
-                                                     const VkClearDepthStencilValue& value,
-                                                     std::span<const VkImageSubresourceRange> ranges) const noexcept {
+inline void CommandBuffer::clear_depth_stencil_image(
+    VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
+    std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
     fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
                                      ranges.data());
 }
 inline void CommandBuffer::clear_attachments(std::span<const VkClearAttachment> attachments,
-                                             std::span<const VkClearRect> rects) const noexcept {
+                                             std::span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_attachments");
     fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
                                static_cast<std::uint32_t>(rects.size()), rects.data());
 }
@@ -732,6 +815,7 @@ namespace detail {
 
 inline void CommandBuffer::update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
 #if VKRC_RUNTIME_CHECKS
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::update_buffer");
     if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
         detail::throw_bad_update_buffer(offset, size);
     }
@@ -740,56 +824,68 @@ inline void CommandBuffer::update_buffer(VkBuffer dst, VkDeviceSize offset, VkDe
 }
 
 inline void CommandBuffer::draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                                         std::uint32_t stride) const noexcept {
+                                         std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect");
     fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
                            stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
 }
 inline void CommandBuffer::draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                                                 std::uint32_t stride) const noexcept {
+                                                 std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect");
     fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
                                   stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
 }
-inline void CommandBuffer::dispatch_indirect(VkBuffer buffer, VkDeviceSize offset) const noexcept {
+inline void CommandBuffer::dispatch_indirect(VkBuffer buffer, VkDeviceSize offset) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch_indirect");
     fn_->vkCmdDispatchIndirect(cmd_, buffer, offset);
 }
 inline void CommandBuffer::draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                                VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                               std::uint32_t stride) const noexcept {
+                                               std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect_count");
     fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
                                 stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
 }
 inline void CommandBuffer::draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                                        VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                                       std::uint32_t stride) const noexcept {
+                                                       std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect_count");
     fn_->vkCmdDrawIndexedIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
                                        stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
 }
 
 inline void CommandBuffer::begin_query(const QueryPool& pool, std::uint32_t query,
-                                       VkQueryControlFlags flags) const noexcept {
+                                       VkQueryControlFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
     fn_->vkCmdBeginQuery(cmd_, pool.vk(), query, flags);
 }
-inline void CommandBuffer::end_query(const QueryPool& pool, std::uint32_t query) const noexcept {
+inline void CommandBuffer::end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
     fn_->vkCmdEndQuery(cmd_, pool.vk(), query);
 }
 inline void CommandBuffer::copy_query_results(const QueryPool& pool, std::uint32_t first_query,
                                               std::uint32_t query_count, const Buffer& dst, VkDeviceSize offset,
-                                              VkDeviceSize stride, VkQueryResultFlags flags) const noexcept {
+                                              VkDeviceSize stride,
+                                              VkQueryResultFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
     fn_->vkCmdCopyQueryPoolResults(cmd_, pool.vk(), first_query, query_count, dst.vk(), offset, stride,
                                    flags | VK_QUERY_RESULT_64_BIT);
 }
 
-inline void CommandBuffer::begin_label(const char* name, const LabelColor& color) const noexcept {
+inline void CommandBuffer::begin_label(const char* name, const LabelColor& color) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_label");
     if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
         const VkDebugUtilsLabelEXT label{
             VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
         f(cmd_, &label);
     }
 }
-inline void CommandBuffer::end_label() const noexcept {
+inline void CommandBuffer::end_label() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_label");
     if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(cmd_);
 }
-inline void CommandBuffer::insert_label(const char* name, const LabelColor& color) const noexcept {
+inline void CommandBuffer::insert_label(const char* name, const LabelColor& color) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::insert_label");
     if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
         const VkDebugUtilsLabelEXT label{
             VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
@@ -797,92 +893,135 @@ inline void CommandBuffer::insert_label(const char* name, const LabelColor& colo
     }
 }
 
-inline void CommandBuffer::set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const noexcept {
+inline void CommandBuffer::set_viewports(std::uint32_t first,
+                                         std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewports");
     fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
-inline void CommandBuffer::set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const noexcept {
+inline void CommandBuffer::set_scissors(std::uint32_t first,
+                                        std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissors");
     fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
-inline void CommandBuffer::set_line_width(float width) const noexcept { fn_->vkCmdSetLineWidth(cmd_, width); }
-inline void CommandBuffer::set_depth_bias(float constant_factor, float clamp, float slope_factor) const noexcept {
+inline void CommandBuffer::set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_line_width");
+    fn_->vkCmdSetLineWidth(cmd_, width);
+}
+inline void CommandBuffer::set_depth_bias(float constant_factor, float clamp,
+                                          float slope_factor) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias");
     fn_->vkCmdSetDepthBias(cmd_, constant_factor, clamp, slope_factor);
 }
-inline void CommandBuffer::set_blend_constants(const float (&constants)[4]) const noexcept {
+inline void CommandBuffer::set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_blend_constants");
     fn_->vkCmdSetBlendConstants(cmd_, constants);
 }
-inline void CommandBuffer::set_depth_bounds(float min_bounds, float max_bounds) const noexcept {
+inline void CommandBuffer::set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds");
     fn_->vkCmdSetDepthBounds(cmd_, min_bounds, max_bounds);
 }
-inline void CommandBuffer::set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
+inline void CommandBuffer::set_stencil_compare_mask(VkStencilFaceFlags faces,
+                                                    std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_compare_mask");
     fn_->vkCmdSetStencilCompareMask(cmd_, faces, mask);
 }
-inline void CommandBuffer::set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const noexcept {
+inline void CommandBuffer::set_stencil_write_mask(VkStencilFaceFlags faces,
+                                                  std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_write_mask");
     fn_->vkCmdSetStencilWriteMask(cmd_, faces, mask);
 }
-inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const noexcept {
+inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces,
+                                                 std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_reference");
     fn_->vkCmdSetStencilReference(cmd_, faces, reference);
 }
 
-inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const noexcept { fn_->vkCmdSetCullMode(cmd_, mode); }
-inline void CommandBuffer::set_front_face(VkFrontFace face) const noexcept { fn_->vkCmdSetFrontFace(cmd_, face); }
-inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const noexcept {
+inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_cull_mode");
+    fn_->vkCmdSetCullMode(cmd_, mode);
+}
+inline void CommandBuffer::set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_front_face");
+    fn_->vkCmdSetFrontFace(cmd_, face);
+}
+inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_topology");
     fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
 }
-inline void CommandBuffer::set_viewport_with_count(std::span<const VkViewport> viewports) const noexcept {
+inline void CommandBuffer::set_viewport_with_count(std::span<const VkViewport> viewports) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_with_count");
     fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
-inline void CommandBuffer::set_scissor_with_count(std::span<const VkRect2D> scissors) const noexcept {
+inline void CommandBuffer::set_scissor_with_count(std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor_with_count");
     fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
 inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
                                                 std::span<const VkDeviceSize> offsets,
                                                 std::span<const VkDeviceSize> sizes,
-                                                std::span<const VkDeviceSize> strides) const noexcept {
+                                                std::span<const VkDeviceSize> strides) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
     fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                  offsets.data(), sizes.empty() ? nullptr : sizes.data(),
                                  strides.empty() ? nullptr : strides.data());
 }
-inline void CommandBuffer::set_depth_test_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_test_enable");
     fn_->vkCmdSetDepthTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
-inline void CommandBuffer::set_depth_write_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_write_enable");
     fn_->vkCmdSetDepthWriteEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
-inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const noexcept {
+inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
     fn_->vkCmdSetDepthCompareOp(cmd_, op);
 }
-inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds_test_enable");
     fn_->vkCmdSetDepthBoundsTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
-inline void CommandBuffer::set_stencil_test_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_test_enable");
     fn_->vkCmdSetStencilTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
-                                          VkStencilOp depth_fail_op, VkCompareOp compare_op) const noexcept {
+                                          VkStencilOp depth_fail_op,
+                                          VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_op");
     fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
 }
-inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_rasterizer_discard_enable");
     fn_->vkCmdSetRasterizerDiscardEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
-inline void CommandBuffer::set_depth_bias_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias_enable");
     fn_->vkCmdSetDepthBiasEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
-inline void CommandBuffer::set_primitive_restart_enable(bool enable) const noexcept {
+inline void CommandBuffer::set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_restart_enable");
     fn_->vkCmdSetPrimitiveRestartEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
 }
 
-inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const noexcept {
+inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point,
+                                         VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
     fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
 }
 inline void CommandBuffer::bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
                                                 std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
-                                                std::span<const std::uint32_t> dynamic_offsets) const noexcept {
+                                                std::span<const std::uint32_t> dynamic_offsets) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
     fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
                                  sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
                                  dynamic_offsets.data());
 }
 inline void CommandBuffer::push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset,
-                                          std::uint32_t size, const void* data) const noexcept {
+                                          std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
     fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
 }
 

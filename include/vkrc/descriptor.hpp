@@ -36,8 +36,8 @@ class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
 public:
     DescriptorSetLayout() noexcept = default;
     static DescriptorSetLayout create(const Device& device, const DescriptorSetLayoutCreateInfo& info);
-    VkDescriptorSetLayout vk() const noexcept;
-    const Device& device() const noexcept;
+    VkDescriptorSetLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -64,8 +64,8 @@ public:
     DescriptorPool() noexcept = default;
     static DescriptorPool create(const Device& device, const DescriptorPoolCreateInfo& info);
 
-    VkDescriptorPool vk() const noexcept;
-    const Device& device() const noexcept;
+    VkDescriptorPool vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     DescriptorSet allocate(const DescriptorSetLayout& layout) const;
     // vkResetDescriptorPool: every set allocated from it becomes invalid (its
     // handle may still be dropped). The caller ensures the GPU no longer uses them.
@@ -81,8 +81,8 @@ private:
 class DescriptorSet : public Handle<detail::DescriptorSetState> {
 public:
     DescriptorSet() noexcept = default;
-    VkDescriptorSet vk() const noexcept;
-    const DescriptorPool& pool() const noexcept;
+    VkDescriptorSet vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const DescriptorPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkUpdateDescriptorSets with one buffer descriptor. The set does not keep
     // what it points to alive: drop it only after the work that uses it is submitted.
@@ -140,11 +140,29 @@ public:
 
 }  // namespace detail
 
-inline VkDescriptorSetLayout DescriptorSetLayout::vk() const noexcept { return state_->layout; }
-inline const Device& DescriptorSetLayout::device() const noexcept { return state_->device; }
-inline VkDescriptorPool DescriptorPool::vk() const noexcept { return state_->pool; }
-inline const Device& DescriptorPool::device() const noexcept { return state_->device; }
-inline VkDescriptorSet DescriptorSet::vk() const noexcept { return state_->set; }
-inline const DescriptorPool& DescriptorSet::pool() const noexcept { return state_->pool; }
+inline VkDescriptorSetLayout DescriptorSetLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSetLayout::vk");
+    return state_->layout;
+}
+inline const Device& DescriptorSetLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSetLayout::device");
+    return state_->device;
+}
+inline VkDescriptorPool DescriptorPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorPool::vk");
+    return state_->pool;
+}
+inline const Device& DescriptorPool::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorPool::device");
+    return state_->device;
+}
+inline VkDescriptorSet DescriptorSet::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::vk");
+    return state_->set;
+}
+inline const DescriptorPool& DescriptorSet::pool() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::pool");
+    return state_->pool;
+}
 
 VKRC_END_NAMESPACE

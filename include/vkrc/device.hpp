@@ -60,11 +60,11 @@ public:
     static Device adopt(const PhysicalDevice& physical_device, VkDevice device, Ownership ownership,
                         std::span<const QueueRequest> queues, std::span<const char* const> enabled_extensions = {});
 
-    VkDevice vk() const noexcept;
-    const DeviceFunctions& fn() const noexcept;
-    const PhysicalDevice& physical_device() const noexcept;
-    const Instance& instance() const noexcept;
-    bool extension_enabled(const char* name) const noexcept;
+    VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    const PhysicalDevice& physical_device() const VKRC_UNCHECKED_NOEXCEPT;
+    const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
+    bool extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
 
     // The index-th queue of a family requested at creation; throws UsageError otherwise.
     Queue queue(std::uint32_t family_index, std::uint32_t index = 0) const;
@@ -75,11 +75,12 @@ public:
     void wait_idle() const;
     // Runs the deferred destructions whose GPU work has completed. vkrc calls
     // this on every submit and wait; applications need not.
-    void collect_garbage() const noexcept;
-    // Number of Vulkan objects and allocations waiting for the GPU.
-    std::size_t deferred_count() const noexcept;
+    void collect_garbage() const VKRC_UNCHECKED_NOEXCEPT;
+    // Number of Vulkan objects and allocations waiting for the GPU, or for an
+    // open command buffer that may refer to them.
+    std::size_t deferred_count() const VKRC_UNCHECKED_NOEXCEPT;
     // True once any call reported VK_ERROR_DEVICE_LOST.
-    bool lost() const noexcept;
+    bool lost() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -256,6 +257,72 @@ private:
     Atomic<std::size_t> count_{0};
 };
 
+// One command buffer's recording window, as the device's OpenCommandBuffers
+// sees it. end is 0 while closed, UINT64_MAX while recording, and after
+// end() the creation counter's value then: the command buffer may refer to
+// objects with a lower serial only.
+struct RecordingWindow {
+    Atomic<std::uint64_t> end{0};
+    const void* pool = nullptr;  // the CommandPoolState, for pool resets
+    bool one_time = false;       // a ONE_TIME_SUBMIT primary: closes when submitted
+    std::size_t index = 0;       // in the registry
+};
+
+// Drops held back while a command buffer that may refer to them is open
+// (recording, or executable and not yet submitted for the last time): a drop
+// of an object is held while some open window's end exceeds its serial, and
+// goes into the deferred queue (so still waits for the GPU) once none does.
+// begin/end/close touch the window and one counter; the lock is taken when
+// something is held, or to register a command buffer at allocate and free.
+class OpenCommandBuffers {
+public:
+    struct Held {
+        DeferredAction action;
+        std::uint64_t serial = 0;
+    };
+    void add(RecordingWindow& window);
+    void remove(DeviceState& device, RecordingWindow& window) noexcept;
+    void begin(RecordingWindow& window, bool one_time) noexcept {
+        window.one_time = one_time;
+        if (window.end.exchange(UINT64_MAX) == 0) open_.fetch_add(1);
+    }
+    void end(RecordingWindow& window) noexcept { window.end.store(current_serial()); }
+    void close(DeviceState& device, RecordingWindow& window) noexcept {
+        const std::uint64_t end = window.end.exchange(0);
+        if (end != 0) open_.fetch_sub(1);
+        // Only closing a window at the last computed limit can uncover a held
+        // drop: a long hold by a reusable command buffer costs other closes nothing.
+        if (held_count_.load() != 0 && end >= covered_.load(__ATOMIC_RELAXED)) release(device);
+    }
+    // Closes every window of a pool (vkResetCommandPool).
+    void close_pool(DeviceState& device, const void* pool) noexcept;
+    // Whether a drop of an object with this serial must wait for a close.
+    bool holds(std::uint64_t serial) noexcept;
+    // Holds action when holds(serial); false (and nothing done) otherwise.
+    bool hold(DeferredAction action, std::uint64_t serial) noexcept;
+    // Objects with a serial at or above this are held by no open window.
+    std::uint64_t limit() noexcept;
+    // Moves the entries no longer held to the deferred queue, in order.
+    void release(DeviceState& device) noexcept;
+    // collect()'s safety net: release when a hold happened since the last release.
+    void release_if_stale(DeviceState& device) noexcept {
+        if (held_count_.load(__ATOMIC_RELAXED) != 0 && stale_.load(__ATOMIC_RELAXED)) release(device);
+    }
+    // Teardown: runs what is still held.
+    void run_all(DeviceState& device) noexcept;
+    std::size_t held_count() const noexcept { return held_count_.load(__ATOMIC_RELAXED); }
+
+private:
+    std::uint64_t limit_locked() const noexcept;
+    mutable Mutex mutex_;
+    List<RecordingWindow*> windows_;  // every allocated command buffer of the device
+    List<Held> held_;
+    Atomic<std::size_t> open_{0};
+    Atomic<std::size_t> held_count_{0};
+    Atomic<bool> stale_{false};
+    Atomic<std::uint64_t> covered_{0};  // limit_locked() at the last hold or release
+};
+
 // Every allocator used with the device, kept until teardown so that deferred
 // frees can still reach it (memory.cpp).
 class AllocatorRegistry {
@@ -277,8 +344,17 @@ class DeviceState final : public RefCounted {
 public:
     ~DeviceState() override;
 
-    // See DeferredDestructor::destroy_after_gpu.
-    void destroy_after_gpu(DeferredAction action) noexcept { deferred.destroy_after_gpu(*this, action); }
+    // See DeferredDestructor::destroy_after_gpu; serial is the dropped
+    // object's, which open command buffers may hold back (OpenCommandBuffers).
+    void destroy_after_gpu(DeferredAction action, std::uint64_t serial) noexcept {
+        if (commands.hold(action, serial)) return;
+        deferred.destroy_after_gpu(*this, action);
+    }
+    // Releases stale holds, then runs the completed deferred actions.
+    void collect() noexcept {
+        commands.release_if_stale(*this);
+        deferred.collect(*this);
+    }
     // Marks the device lost: the GPU will touch nothing any more, so every
     // queued action may run.
     void mark_lost() noexcept { lost.store(true, __ATOMIC_RELAXED); }
@@ -293,7 +369,7 @@ public:
     // lost when r says so, runs the completed deferred actions, then check(r, call).
     VkResult finish_call(VkResult r, const char* call) {
         note_result(r);
-        deferred.collect(*this);
+        collect();
         return check(r, call);
     }
     // Under the queue's lock: when submits since the last timeline signal
@@ -325,6 +401,7 @@ public:
     List<Text> enabled_extensions;
     List<QueueState> queues;  // made once, never grows: Queue handles point into it
     Atomic<bool> lost{false};
+    OpenCommandBuffers commands;
     DeferredDestructor deferred;
     AllocatorRegistry allocators;
 
@@ -344,22 +421,36 @@ VkHandle handle_from_bits(std::uint64_t bits) noexcept {
 }
 
 // Queues vkDestroyX(device, handle, nullptr) to run after the GPU is done.
-// Usage: defer_destroy<&DeviceFunctions::vkDestroyBuffer>(device, buffer);
+// Usage: defer_destroy<&DeviceFunctions::vkDestroyBuffer>(device, buffer, serial());
+// serial: the dropped state's serial().
 template <auto DestroyMember, class VkHandle>
-void defer_destroy(DeviceState& device, VkHandle handle) noexcept {
+void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) noexcept {
     if (handle == VK_NULL_HANDLE) return;
     device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
                                   (d.fn.*DestroyMember)(d.device, handle_from_bits<VkHandle>(bits), nullptr);
                               },
-                              handle_bits(handle), nullptr});
+                              handle_bits(handle), nullptr},
+                             serial);
 }
 
 }  // namespace detail
 
-inline VkDevice Device::vk() const noexcept { return state_->device; }
-inline const DeviceFunctions& Device::fn() const noexcept { return state_->fn; }
-inline const PhysicalDevice& Device::physical_device() const noexcept { return state_->physical_device; }
-inline const Instance& Device::instance() const noexcept { return state_->physical_device.instance(); }
+inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::vk");
+    return state_->device;
+}
+inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::fn");
+    return state_->fn;
+}
+inline const PhysicalDevice& Device::physical_device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::physical_device");
+    return state_->physical_device;
+}
+inline const Instance& Device::instance() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Device::instance");
+    return state_->physical_device.instance();
+}
 
 inline VkQueue Queue::vk() const noexcept { return queue_->queue; }
 inline std::uint32_t Queue::family_index() const noexcept { return queue_->family_index; }

@@ -155,11 +155,17 @@ private:
 
 namespace detail {
 
+// Creation order of every state block, process-wide: a command buffer ended
+// at counter value v may refer to objects whose serial is below v, never to
+// later ones (docs/design.md, "Dropped while recorded").
+inline Atomic<std::uint64_t> creation_counter{1};
+inline std::uint64_t current_serial() noexcept { return creation_counter.load(__ATOMIC_RELAXED); }
+
 // Base of every state block. The count starts at one: the creator owns it.
 template <class Policy>
 class BasicRefCounted {
 public:
-    BasicRefCounted() = default;
+    BasicRefCounted() noexcept : serial_(creation_counter.fetch_add(1, __ATOMIC_RELAXED)) {}
     BasicRefCounted(const BasicRefCounted&) = delete;
     BasicRefCounted& operator=(const BasicRefCounted&) = delete;
 
@@ -171,6 +177,8 @@ public:
         }
     }
     std::uint32_t use_count() const noexcept { return Policy::load(refs_); }
+    // Taken at construction (creation or adoption); see creation_counter.
+    std::uint64_t serial() const noexcept { return serial_; }
 
 protected:
     virtual ~BasicRefCounted() = default;
@@ -180,6 +188,7 @@ protected:
 
 private:
     mutable typename Policy::Count refs_{1};
+    std::uint64_t serial_;
 };
 
 using RefCounted = BasicRefCounted<ThreadPolicy>;
@@ -229,8 +238,29 @@ private:
 
 }  // namespace detail
 
+namespace detail {
+// Throws UsageError: call (e.g. "vkrc::Buffer::vk") was made through an empty handle.
+[[noreturn]] void throw_empty_handle(const char* call);
+}  // namespace detail
+
+// Accessors and recording methods through an empty handle: with
+// VKRC_RUNTIME_CHECKS they throw UsageError naming the type and the call (so
+// they are not noexcept); without, the check compiles away and an empty
+// handle stays a precondition violation (recording stays one call).
+// clang-format off
+#if VKRC_RUNTIME_CHECKS
+#  define VKRC_UNCHECKED_NOEXCEPT
+#  define VKRC_REQUIRE_STATE(call) \
+      if (!this->state_) [[unlikely]] ::vkrc::detail::throw_empty_handle(call)
+#else
+#  define VKRC_UNCHECKED_NOEXCEPT noexcept
+#  define VKRC_REQUIRE_STATE(call) static_cast<void>(0)
+#endif
+// clang-format on
+
 // Base of the user-facing wrappers. An empty handle (default-constructed or
-// moved-from) holds nothing; calling its accessors is a precondition violation.
+// moved-from) holds nothing; calling its accessors is a precondition violation
+// (checked with VKRC_RUNTIME_CHECKS: VKRC_REQUIRE_STATE).
 template <class State>
 class Handle {
 public:

@@ -3,6 +3,8 @@
 
 #include "vkrc/error.hpp"
 #include "vkrc/functions.hpp"
+
+#include <span>
 #include "vkrc/handle.hpp"
 #include "vkrc/detail/function.hpp"
 
@@ -68,14 +70,20 @@ public:
     // does not build and destroy a default create-info (bench/header_cost).
     static Instance create();
     // Wraps an instance made elsewhere. With Ownership::owned vkrc destroys it.
+    // enabled_extensions and enabled_layers: what it was created with, so
+    // that extension_enabled (and Surface::adopt, which needs VK_KHR_surface)
+    // see them.
     static Instance adopt(VkInstance instance, Ownership ownership, std::uint32_t api_version,
-                          PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr);
+                          PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr,
+                          std::span<const char* const> enabled_extensions = {},
+                          std::span<const char* const> enabled_layers = {});
 
-    VkInstance vk() const noexcept;
-    const InstanceFunctions& fn() const noexcept;
-    const GlobalFunctions& global_fn() const noexcept;
-    std::uint32_t api_version() const noexcept;
-    bool extension_enabled(const char* name) const noexcept;
+    VkInstance vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const InstanceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    const GlobalFunctions& global_fn() const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t api_version() const VKRC_UNCHECKED_NOEXCEPT;
+    bool extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
+    bool layer_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
 
     List<PhysicalDevice> physical_devices() const;
 
@@ -135,14 +143,14 @@ public:
     // The reasons this device fails the requirements; empty when it meets them.
     List<Text> unmet_requirements(const DeviceRequirements& requirements) const;
 
-    VkPhysicalDevice vk() const noexcept;
-    const Instance& instance() const noexcept;
-    const InstanceFunctions& fn() const noexcept;
-    const VkPhysicalDeviceProperties& properties() const noexcept;
-    const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept;
-    const List<VkQueueFamilyProperties>& queue_families() const noexcept;
-    const char* name() const noexcept { return properties().deviceName; }
-    bool supports_extension(const char* name) const noexcept;
+    VkPhysicalDevice vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
+    const InstanceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    const VkPhysicalDeviceProperties& properties() const VKRC_UNCHECKED_NOEXCEPT;
+    const VkPhysicalDeviceMemoryProperties& memory_properties() const VKRC_UNCHECKED_NOEXCEPT;
+    const List<VkQueueFamilyProperties>& queue_families() const VKRC_UNCHECKED_NOEXCEPT;
+    const char* name() const VKRC_UNCHECKED_NOEXCEPT { return properties().deviceName; }
+    bool supports_extension(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
     // First family with all the flags (and presentation to surface if given), or -1.
     int find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_surface = VK_NULL_HANDLE) const;
 
@@ -163,6 +171,7 @@ public:
     GlobalFunctions global_fn;
     InstanceFunctions fn;
     List<Text> enabled_extensions;
+    List<Text> enabled_layers;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
     DebugCallback debug_callback;  // the messengers' user data: the state never moves
 };
@@ -179,19 +188,45 @@ public:
 
 }  // namespace detail
 
-inline VkInstance Instance::vk() const noexcept { return state_->instance; }
-inline const InstanceFunctions& Instance::fn() const noexcept { return state_->fn; }
-inline const GlobalFunctions& Instance::global_fn() const noexcept { return state_->global_fn; }
-inline std::uint32_t Instance::api_version() const noexcept { return state_->api_version; }
+inline VkInstance Instance::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::vk");
+    return state_->instance;
+}
+inline const InstanceFunctions& Instance::fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::fn");
+    return state_->fn;
+}
+inline const GlobalFunctions& Instance::global_fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::global_fn");
+    return state_->global_fn;
+}
+inline std::uint32_t Instance::api_version() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Instance::api_version");
+    return state_->api_version;
+}
 
-inline VkPhysicalDevice PhysicalDevice::vk() const noexcept { return state_->physical_device; }
-inline const Instance& PhysicalDevice::instance() const noexcept { return state_->instance; }
-inline const InstanceFunctions& PhysicalDevice::fn() const noexcept { return state_->instance.fn(); }
-inline const VkPhysicalDeviceProperties& PhysicalDevice::properties() const noexcept { return state_->properties; }
-inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties() const noexcept {
+inline VkPhysicalDevice PhysicalDevice::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::vk");
+    return state_->physical_device;
+}
+inline const Instance& PhysicalDevice::instance() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::instance");
+    return state_->instance;
+}
+inline const InstanceFunctions& PhysicalDevice::fn() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::fn");
+    return state_->instance.fn();
+}
+inline const VkPhysicalDeviceProperties& PhysicalDevice::properties() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::properties");
+    return state_->properties;
+}
+inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::memory_properties");
     return state_->memory_properties;
 }
-inline const List<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const noexcept {
+inline const List<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::queue_families");
     return state_->queue_families;
 }
 

@@ -330,16 +330,43 @@ public:
     static Allocation create(const Device& device, const AllocationRequest& request,
                              const SharedAllocator& allocator = {});
 
-    const AllocationInfo& info() const noexcept { return state_->info; }
-    VkDeviceMemory memory() const noexcept { return state_->info.memory; }
-    VkDeviceSize offset() const noexcept { return state_->info.offset; }
-    VkDeviceSize size() const noexcept { return state_->info.size; }
-    std::uint32_t memory_type() const noexcept { return state_->info.memory_type; }
-    bool host_visible() const noexcept { return state_->info.mapped != nullptr; }
-    bool host_coherent() const noexcept { return state_->coherent; }
+    const AllocationInfo& info() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::info");
+        return state_->info;
+    }
+    VkDeviceMemory memory() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::memory");
+        return state_->info.memory;
+    }
+    VkDeviceSize offset() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::offset");
+        return state_->info.offset;
+    }
+    VkDeviceSize size() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::size");
+        return state_->info.size;
+    }
+    std::uint32_t memory_type() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::memory_type");
+        return state_->info.memory_type;
+    }
+    bool host_visible() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::host_visible");
+        return state_->info.mapped != nullptr;
+    }
+    bool host_coherent() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::host_coherent");
+        return state_->coherent;
+    }
     // Host address of the first byte; null when not host-visible.
-    std::byte* mapped() const noexcept { return state_->info.mapped; }
-    DeviceAllocator& allocator() const noexcept { return *state_->allocator; }
+    std::byte* mapped() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::mapped");
+        return state_->info.mapped;
+    }
+    DeviceAllocator& allocator() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::allocator");
+        return *state_->allocator;
+    }
 
     // Copies count elements to offset (bytes) and flushes them on non-coherent
     // memory. Any alignment of offset is fine. Throws UsageError when the
@@ -347,6 +374,7 @@ public:
     // do not fit or count * sizeof(T) overflows.
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
+        VKRC_REQUIRE_STATE("vkrc::Allocation::write");
         auto& s = *state_;
         if (!s.info.mapped) [[unlikely]]
             detail::throw_not_host_visible("vkrc::Allocation::write");
@@ -365,6 +393,7 @@ public:
     template <class T>
     void read(VkDeviceSize offset, T* out, std::size_t count) const {
         static_assert(__is_trivially_copyable(T), "mapped reads copy bytes");  // see write_mapped
+        VKRC_REQUIRE_STATE("vkrc::Allocation::read");
         auto& s = *state_;
         if (!s.info.mapped) [[unlikely]]
             detail::throw_not_host_visible("vkrc::Allocation::read");

@@ -33,8 +33,8 @@ public:
     PipelineLayout() noexcept = default;
     static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
     static PipelineLayout create(const Device& device);  // no sets, no push constants
-    VkPipelineLayout vk() const noexcept;
-    const Device& device() const noexcept;
+    VkPipelineLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -69,8 +69,8 @@ class RenderPass : public Handle<detail::RenderPassState> {
 public:
     RenderPass() noexcept = default;
     static RenderPass create(const Device& device, const RenderPassCreateInfo& info);
-    VkRenderPass vk() const noexcept;
-    const Device& device() const noexcept;
+    VkRenderPass vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t color_attachment_count(std::uint32_t subpass) const;
 
 private:
@@ -99,9 +99,9 @@ class Framebuffer : public Handle<detail::FramebufferState> {
 public:
     Framebuffer() noexcept = default;
     static Framebuffer create(const Device& device, const FramebufferCreateInfo& info);
-    VkFramebuffer vk() const noexcept;
-    VkExtent2D extent() const noexcept;
-    const RenderPass& render_pass() const noexcept;
+    VkFramebuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
+    VkExtent2D extent() const VKRC_UNCHECKED_NOEXCEPT;
+    const RenderPass& render_pass() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -118,8 +118,8 @@ public:
     // on stderr: the cache starts empty and loaded_from_file() is false.
     static PipelineCache load(const Device& device, const char* file);
 
-    VkPipelineCache vk() const noexcept;
-    bool loaded_from_file() const noexcept;
+    VkPipelineCache vk() const VKRC_UNCHECKED_NOEXCEPT;
+    bool loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT;
     // vkGetPipelineCacheData.
     List<std::byte> data() const;
     // Writes data() to file (replacing it); throws std::system_error on I/O failure.
@@ -153,9 +153,9 @@ struct ComputePipelineCreateInfo {
 class Pipeline : public Handle<detail::PipelineState> {
 public:
     Pipeline() noexcept = default;
-    VkPipeline vk() const noexcept;
-    VkPipelineBindPoint bind_point() const noexcept;
-    const PipelineLayout& layout() const noexcept;
+    VkPipeline vk() const VKRC_UNCHECKED_NOEXCEPT;
+    VkPipelineBindPoint bind_point() const VKRC_UNCHECKED_NOEXCEPT;
+    const PipelineLayout& layout() const VKRC_UNCHECKED_NOEXCEPT;
 
 protected:
     using Handle::Handle;
@@ -404,17 +404,53 @@ public:
 
 }  // namespace detail
 
-inline VkPipelineLayout PipelineLayout::vk() const noexcept { return state_->layout; }
-inline const Device& PipelineLayout::device() const noexcept { return state_->device; }
-inline VkRenderPass RenderPass::vk() const noexcept { return state_->render_pass; }
-inline const Device& RenderPass::device() const noexcept { return state_->device; }
-inline VkFramebuffer Framebuffer::vk() const noexcept { return state_->framebuffer; }
-inline VkExtent2D Framebuffer::extent() const noexcept { return state_->extent; }
-inline const RenderPass& Framebuffer::render_pass() const noexcept { return state_->render_pass; }
-inline VkPipelineCache PipelineCache::vk() const noexcept { return state_->cache; }
-inline bool PipelineCache::loaded_from_file() const noexcept { return state_->loaded_from_file; }
-inline VkPipeline Pipeline::vk() const noexcept { return state_->pipeline; }
-inline VkPipelineBindPoint Pipeline::bind_point() const noexcept { return state_->bind_point; }
-inline const PipelineLayout& Pipeline::layout() const noexcept { return state_->layout; }
+inline VkPipelineLayout PipelineLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PipelineLayout::vk");
+    return state_->layout;
+}
+inline const Device& PipelineLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PipelineLayout::device");
+    return state_->device;
+}
+inline VkRenderPass RenderPass::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::RenderPass::vk");
+    return state_->render_pass;
+}
+inline const Device& RenderPass::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::RenderPass::device");
+    return state_->device;
+}
+inline VkFramebuffer Framebuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Framebuffer::vk");
+    return state_->framebuffer;
+}
+inline VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Framebuffer::extent");
+    return state_->extent;
+}
+inline const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Framebuffer::render_pass");
+    return state_->render_pass;
+}
+inline VkPipelineCache PipelineCache::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PipelineCache::vk");
+    return state_->cache;
+}
+inline bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PipelineCache::loaded_from_file");
+    return state_->loaded_from_file;
+}
+inline VkPipeline Pipeline::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Pipeline::vk");
+    return state_->pipeline;
+}
+inline VkPipelineBindPoint Pipeline::bind_point() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Pipeline::bind_point");
+    return state_->bind_point;
+}
+inline const PipelineLayout& Pipeline::layout() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Pipeline::layout");
+    return state_->layout;
+}
 
 VKRC_END_NAMESPACE

@@ -42,16 +42,19 @@ public:
     static Buffer create(const Device& device, const BufferCreateInfo& info);
     // Wraps a buffer made elsewhere, its memory bound by its maker: the
     // result has no Allocation. With Ownership::owned vkrc destroys it.
+    // cleanup, if given, runs once the GPU is done with the buffer (after
+    // its destruction when owned), e.g. to free the memory its maker bound.
     static Buffer adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
-                        Ownership ownership);
+                        Ownership ownership, Function<void()> cleanup = {});
 
-    VkBuffer vk() const noexcept;
-    VkDeviceSize size() const noexcept;
-    VkBufferUsageFlags usage() const noexcept;
-    const Device& device() const noexcept;
+    VkBuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
+    VkDeviceSize size() const VKRC_UNCHECKED_NOEXCEPT;
+    VkBufferUsageFlags usage() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // Mapped access goes through the allocation: buffer.allocation().write(0, span).
-    // Empty for an adopted buffer.
-    const Allocation& allocation() const noexcept;
+    // Empty for an adopted buffer: its accessors then throw UsageError with
+    // VKRC_RUNTIME_CHECKS (a precondition without).
+    const Allocation& allocation() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -99,20 +102,22 @@ public:
     // Wraps an image made elsewhere (a swapchain's, with Ownership::borrowed);
     // info describes it (its memory and allocator fields are ignored). The
     // result has no Allocation. With Ownership::owned vkrc destroys it.
-    static Image adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership);
+    // cleanup: as for Buffer::adopt.
+    static Image adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership,
+                       Function<void()> cleanup = {});
 
-    VkImage vk() const noexcept;
-    VkImageType image_type() const noexcept;
-    VkFormat format() const noexcept;
-    VkExtent3D extent() const noexcept;
+    VkImage vk() const VKRC_UNCHECKED_NOEXCEPT;
+    VkImageType image_type() const VKRC_UNCHECKED_NOEXCEPT;
+    VkFormat format() const VKRC_UNCHECKED_NOEXCEPT;
+    VkExtent3D extent() const VKRC_UNCHECKED_NOEXCEPT;
     // The extent of a mip level (each dimension halved per level, at least 1).
-    VkExtent3D extent(std::uint32_t mip_level) const noexcept;
-    std::uint32_t mip_levels() const noexcept;
-    std::uint32_t array_layers() const noexcept;
-    VkSampleCountFlagBits samples() const noexcept;
-    VkImageUsageFlags usage() const noexcept;
-    const Device& device() const noexcept;
-    const Allocation& allocation() const noexcept;
+    VkExtent3D extent(std::uint32_t mip_level) const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t mip_levels() const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t array_layers() const VKRC_UNCHECKED_NOEXCEPT;
+    VkSampleCountFlagBits samples() const VKRC_UNCHECKED_NOEXCEPT;
+    VkImageUsageFlags usage() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
+    const Allocation& allocation() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -140,10 +145,10 @@ public:
     ImageView() noexcept = default;
     static ImageView create(const Image& image, const ImageViewCreateInfo& info = {});
 
-    VkImageView vk() const noexcept;
-    const Image& image() const noexcept;
-    VkFormat format() const noexcept;
-    const VkImageSubresourceRange& subresource_range() const noexcept;
+    VkImageView vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Image& image() const VKRC_UNCHECKED_NOEXCEPT;
+    VkFormat format() const VKRC_UNCHECKED_NOEXCEPT;
+    const VkImageSubresourceRange& subresource_range() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -169,8 +174,8 @@ public:
     BufferView() noexcept = default;
     static BufferView create(const Buffer& buffer, const BufferViewCreateInfo& info);
 
-    VkBufferView vk() const noexcept;
-    const Buffer& buffer() const noexcept;
+    VkBufferView vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Buffer& buffer() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -204,8 +209,8 @@ public:
     Sampler() noexcept = default;
     static Sampler create(const Device& device, const SamplerCreateInfo& info = {});
 
-    VkSampler vk() const noexcept;
-    const Device& device() const noexcept;
+    VkSampler vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -216,6 +221,9 @@ VkImageAspectFlags format_aspects(VkFormat format) noexcept;
 
 namespace detail {
 
+// Queues cleanup to run once the GPU is done with what was dropped before it.
+void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t serial) noexcept;
+
 class BufferState final : public RefCounted {
 public:
     ~BufferState() override;
@@ -224,7 +232,8 @@ public:
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
     Ownership ownership = Ownership::owned;
-    Allocation allocation;  // released after the buffer's destruction is queued
+    Allocation allocation;       // released after the buffer's destruction is queued
+    Function<void()> cleanup{};  // an adopted buffer's, queued after its destruction
 };
 
 class ImageState final : public RefCounted {
@@ -242,6 +251,7 @@ public:
     VkImageCreateFlags flags = 0;
     Ownership ownership = Ownership::owned;
     Allocation allocation;
+    Function<void()> cleanup{};  // an adopted image's, queued after its destruction
     // What a borrowed image belongs to and keeps alive (a swapchain's images
     // keep their swapchain); released first, after the image's own teardown.
     Ref<RefCounted> owner;
@@ -272,37 +282,107 @@ public:
 
 }  // namespace detail
 
-inline VkBuffer Buffer::vk() const noexcept { return state_->buffer; }
-inline VkDeviceSize Buffer::size() const noexcept { return state_->size; }
-inline VkBufferUsageFlags Buffer::usage() const noexcept { return state_->usage; }
-inline const Device& Buffer::device() const noexcept { return state_->device; }
-inline const Allocation& Buffer::allocation() const noexcept { return state_->allocation; }
+inline VkBuffer Buffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::vk");
+    return state_->buffer;
+}
+inline VkDeviceSize Buffer::size() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::size");
+    return state_->size;
+}
+inline VkBufferUsageFlags Buffer::usage() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::usage");
+    return state_->usage;
+}
+inline const Device& Buffer::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::device");
+    return state_->device;
+}
+inline const Allocation& Buffer::allocation() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::allocation");
+    return state_->allocation;
+}
 
-inline VkImage Image::vk() const noexcept { return state_->image; }
-inline VkImageType Image::image_type() const noexcept { return state_->image_type; }
-inline VkFormat Image::format() const noexcept { return state_->format; }
-inline VkExtent3D Image::extent() const noexcept { return state_->extent; }
-inline VkExtent3D Image::extent(std::uint32_t level) const noexcept {
+inline VkImage Image::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::vk");
+    return state_->image;
+}
+inline VkImageType Image::image_type() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::image_type");
+    return state_->image_type;
+}
+inline VkFormat Image::format() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::format");
+    return state_->format;
+}
+inline VkExtent3D Image::extent() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::extent");
+    return state_->extent;
+}
+inline VkExtent3D Image::extent(std::uint32_t level) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::extent");
     auto e = state_->extent;
     auto half = [level](std::uint32_t v) { return v >> level ? v >> level : 1u; };
     return {half(e.width), half(e.height), half(e.depth)};
 }
-inline std::uint32_t Image::mip_levels() const noexcept { return state_->mip_levels; }
-inline std::uint32_t Image::array_layers() const noexcept { return state_->array_layers; }
-inline VkSampleCountFlagBits Image::samples() const noexcept { return state_->samples; }
-inline VkImageUsageFlags Image::usage() const noexcept { return state_->usage; }
-inline const Device& Image::device() const noexcept { return state_->device; }
-inline const Allocation& Image::allocation() const noexcept { return state_->allocation; }
+inline std::uint32_t Image::mip_levels() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::mip_levels");
+    return state_->mip_levels;
+}
+inline std::uint32_t Image::array_layers() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::array_layers");
+    return state_->array_layers;
+}
+inline VkSampleCountFlagBits Image::samples() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::samples");
+    return state_->samples;
+}
+inline VkImageUsageFlags Image::usage() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::usage");
+    return state_->usage;
+}
+inline const Device& Image::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::device");
+    return state_->device;
+}
+inline const Allocation& Image::allocation() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Image::allocation");
+    return state_->allocation;
+}
 
-inline VkImageView ImageView::vk() const noexcept { return state_->view; }
-inline const Image& ImageView::image() const noexcept { return state_->image; }
-inline VkFormat ImageView::format() const noexcept { return state_->format; }
-inline const VkImageSubresourceRange& ImageView::subresource_range() const noexcept { return state_->range; }
+inline VkImageView ImageView::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ImageView::vk");
+    return state_->view;
+}
+inline const Image& ImageView::image() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ImageView::image");
+    return state_->image;
+}
+inline VkFormat ImageView::format() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ImageView::format");
+    return state_->format;
+}
+inline const VkImageSubresourceRange& ImageView::subresource_range() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ImageView::subresource_range");
+    return state_->range;
+}
 
-inline VkBufferView BufferView::vk() const noexcept { return state_->view; }
-inline const Buffer& BufferView::buffer() const noexcept { return state_->buffer; }
+inline VkBufferView BufferView::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::BufferView::vk");
+    return state_->view;
+}
+inline const Buffer& BufferView::buffer() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::BufferView::buffer");
+    return state_->buffer;
+}
 
-inline VkSampler Sampler::vk() const noexcept { return state_->sampler; }
-inline const Device& Sampler::device() const noexcept { return state_->device; }
+inline VkSampler Sampler::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Sampler::vk");
+    return state_->sampler;
+}
+inline const Device& Sampler::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Sampler::device");
+    return state_->device;
+}
 
 VKRC_END_NAMESPACE

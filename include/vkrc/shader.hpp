@@ -21,8 +21,8 @@ public:
     static ShaderModule create(const Device& device, std::span<const std::byte> spirv);
     static ShaderModule load(const Device& device, const char* spv_file);
 
-    VkShaderModule vk() const noexcept;
-    const Device& device() const noexcept;
+    VkShaderModule vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -37,7 +37,13 @@ public:
 };
 }  // namespace detail
 
-inline VkShaderModule ShaderModule::vk() const noexcept { return state_->module; }
-inline const Device& ShaderModule::device() const noexcept { return state_->device; }
+inline VkShaderModule ShaderModule::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ShaderModule::vk");
+    return state_->module;
+}
+inline const Device& ShaderModule::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::ShaderModule::device");
+    return state_->device;
+}
 
 VKRC_END_NAMESPACE

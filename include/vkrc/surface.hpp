@@ -23,8 +23,8 @@ public:
     // it (vkDestroySurfaceKHR) when the last owner goes.
     static Surface adopt(const Instance& instance, VkSurfaceKHR surface, Ownership ownership);
 
-    VkSurfaceKHR vk() const noexcept;
-    const Instance& instance() const noexcept;
+    VkSurfaceKHR vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
     // vkGetPhysicalDeviceSurfaceCapabilitiesKHR.
     VkSurfaceCapabilitiesKHR capabilities(const PhysicalDevice& physical_device) const;
     // vkGetPhysicalDeviceSurfaceFormatsKHR / PresentModesKHR.
@@ -54,7 +54,13 @@ public:
 
 }  // namespace detail
 
-inline VkSurfaceKHR Surface::vk() const noexcept { return state_->surface; }
-inline const Instance& Surface::instance() const noexcept { return state_->instance; }
+inline VkSurfaceKHR Surface::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Surface::vk");
+    return state_->surface;
+}
+inline const Instance& Surface::instance() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Surface::instance");
+    return state_->instance;
+}
 
 VKRC_END_NAMESPACE

@@ -26,8 +26,8 @@ public:
     static Fence create(const Device& device, bool signaled = false);
     static Fence adopt(const Device& device, VkFence fence, Ownership ownership);
 
-    VkFence vk() const noexcept;
-    const Device& device() const noexcept;
+    VkFence vk() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
     // After VK_SUCCESS for a fence given to vkrc::submit, every object dropped
     // before that submission has been destroyed.
@@ -50,9 +50,9 @@ public:
     static Semaphore create_timeline(const Device& device, std::uint64_t initial_value = 0);
     static Semaphore adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership);
 
-    VkSemaphore vk() const noexcept;
-    SemaphoreType type() const noexcept;
-    const Device& device() const noexcept;
+    VkSemaphore vk() const VKRC_UNCHECKED_NOEXCEPT;
+    SemaphoreType type() const VKRC_UNCHECKED_NOEXCEPT;
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
     // Timeline semaphores only (UsageError otherwise).
     // vkGetSemaphoreCounterValue.
@@ -72,7 +72,7 @@ public:
     // device_only: VK_EVENT_CREATE_DEVICE_ONLY_BIT (no host set/reset/status).
     static Event create(const Device& device, bool device_only = false);
 
-    VkEvent vk() const noexcept;
+    VkEvent vk() const VKRC_UNCHECKED_NOEXCEPT;
     // vkSetEvent / vkResetEvent (reset() drops the handle, as on every handle).
     void set() const;
     void unset() const;
@@ -100,19 +100,19 @@ public:
     QueryPool() noexcept = default;
     static QueryPool create(const Device& device, const QueryPoolCreateInfo& info);
 
-    VkQueryPool vk() const noexcept;
-    std::uint32_t query_count() const noexcept;
+    VkQueryPool vk() const VKRC_UNCHECKED_NOEXCEPT;
+    std::uint32_t query_count() const VKRC_UNCHECKED_NOEXCEPT;
     // Reset queries before use with CommandBuffer::reset_query_pool.
     // vkGetQueryPoolResults as 64-bit values into out (one per query, or
     // stride_words per query). VK_NOT_READY when flags lack WAIT and some are not ready.
     VkResult results(std::uint32_t first_query, std::span<std::uint64_t> out,
                      VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
     // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
-    double timestamp_period_ns() const noexcept;
-    VkQueryType query_type() const noexcept;
+    double timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT;
+    VkQueryType query_type() const VKRC_UNCHECKED_NOEXCEPT;
     // Values per query in results(): one per statistic for a pipeline
     // statistics pool, otherwise 1 (pass it as stride_words).
-    std::uint32_t values_per_query() const noexcept;
+    std::uint32_t values_per_query() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using Handle::Handle;
@@ -155,7 +155,7 @@ public:
 // Queues the destruction of a fence that was submitted and may not have been
 // seen signalled: after the work submitted so far, it waits for the fence
 // (at once in practice; a lost device returns at once too), then destroys it.
-void destroy_submitted_fence(DeviceState& device, VkFence fence) noexcept;
+void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t serial) noexcept;
 
 class SemaphoreState final : public RefCounted {
 public:
@@ -185,15 +185,45 @@ public:
 
 }  // namespace detail
 
-inline VkFence Fence::vk() const noexcept { return state_->fence; }
-inline const Device& Fence::device() const noexcept { return state_->device; }
-inline VkSemaphore Semaphore::vk() const noexcept { return state_->semaphore; }
-inline SemaphoreType Semaphore::type() const noexcept { return state_->type; }
-inline const Device& Semaphore::device() const noexcept { return state_->device; }
-inline VkEvent Event::vk() const noexcept { return state_->event; }
-inline VkQueryPool QueryPool::vk() const noexcept { return state_->pool; }
-inline std::uint32_t QueryPool::query_count() const noexcept { return state_->count; }
-inline VkQueryType QueryPool::query_type() const noexcept { return state_->type; }
-inline std::uint32_t QueryPool::values_per_query() const noexcept { return state_->values_per_query; }
+inline VkFence Fence::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Fence::vk");
+    return state_->fence;
+}
+inline const Device& Fence::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Fence::device");
+    return state_->device;
+}
+inline VkSemaphore Semaphore::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::vk");
+    return state_->semaphore;
+}
+inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::type");
+    return state_->type;
+}
+inline const Device& Semaphore::device() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Semaphore::device");
+    return state_->device;
+}
+inline VkEvent Event::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Event::vk");
+    return state_->event;
+}
+inline VkQueryPool QueryPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::vk");
+    return state_->pool;
+}
+inline std::uint32_t QueryPool::query_count() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::query_count");
+    return state_->count;
+}
+inline VkQueryType QueryPool::query_type() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::query_type");
+    return state_->type;
+}
+inline std::uint32_t QueryPool::values_per_query() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::QueryPool::values_per_query");
+    return state_->values_per_query;
+}
 
 VKRC_END_NAMESPACE

@@ -18,18 +18,23 @@ namespace detail {
 template <class VkHandle>
 class PoolFreeList {
 public:
-    // Caller holds the pool's lock. Never throws: on allocation failure the
-    // handle is left to the pool's destruction, which frees it anyway.
-    void push(DeviceState& device, VkHandle handle) noexcept {
+    // Caller holds the pool's lock. serial: the dying child's. Never throws:
+    // on allocation failure the handle is left to the pool's destruction,
+    // which frees it anyway.
+    void push(DeviceState& device, VkHandle handle, std::uint64_t serial) noexcept {
         try {
-            device.submitted_snapshot(scratch_);
-            if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
-            batches_.back().handles.push_back(handle);
+            // An open command buffer may still refer to it (OpenCommandBuffers).
+            if (device.commands.holds(serial)) {
+                held_.push_back(Held{handle, serial});
+                return;
+            }
+            push_now(device, handle);
         } catch (...) {}
     }
     // Caller holds the pool's lock. Moves the handles whose GPU work has
     // completed into out, in the order they were pushed.
     void take_ready(DeviceState& device, List<VkHandle>& out) {
+        if (!held_.empty()) release_held(device);
         std::size_t ready = 0, handles = 0;
         for (; ready < batches_.size() && device.reached(batches_[ready].wait_values); ++ready) {
             handles += batches_[ready].handles.size();
@@ -39,20 +44,49 @@ public:
         for (std::size_t i = 0; i < ready; ++i) out.append(batches_[i].handles.data(), batches_[i].handles.size());
         batches_.erase_front(ready);
     }
-    bool empty() const noexcept { return batches_.empty(); }
+    bool empty() const noexcept { return batches_.empty() && held_.empty(); }
     std::size_t size() const noexcept {
-        std::size_t n = 0;
+        std::size_t n = held_.size();
         for (auto& b : batches_) n += b.handles.size();
         return n;
     }
-    void clear() noexcept { batches_.clear(); }
+    void clear() noexcept {
+        batches_.clear();
+        held_.clear();
+    }
 
 private:
     struct Batch {
         List<std::uint64_t> wait_values;
         List<VkHandle> handles;
     };
+    struct Held {
+        VkHandle handle;
+        std::uint64_t serial;
+    };
+    void push_now(DeviceState& device, VkHandle handle) {
+        device.submitted_snapshot(scratch_);
+        if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
+        batches_.back().handles.push_back(handle);
+    }
+    // The held handles no open command buffer refers to any more wait for
+    // the work submitted so far, like a fresh drop; the others stay, in order.
+    void release_held(DeviceState& device) {
+        const std::uint64_t limit = device.commands.limit();
+        std::size_t kept = 0;
+        for (std::size_t i = 0; i < held_.size(); ++i) {
+            try {
+                if (held_[i].serial >= limit) {
+                    push_now(device, held_[i].handle);
+                    continue;
+                }
+            } catch (...) {}  // out of host memory: stays held until a later try
+            held_[kept++] = held_[i];
+        }
+        held_.resize(kept);
+    }
     List<Batch> batches_;
+    List<Held> held_;
     List<std::uint64_t> scratch_;
 };
 

@@ -1,0 +1,455 @@
+// Objects dropped while a command buffer that records them is open (recording,
+// or executable and not yet submitted for the last time) stay alive until it
+// is submitted or closed, and then until the GPU is done (issue 13).
+#include "support/vk_test.hpp"
+
+#include "shaders/fill_pattern.comp.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+constexpr VkDeviceSize words = 256;
+constexpr VkDeviceSize bytes = words * sizeof(std::uint32_t);
+
+vkrc::Buffer make_buffer(const vkrc::Device& device, VkBufferUsageFlags usage) {
+    return vkrc::Buffer::create(device, {.size = bytes, .usage = usage});
+}
+
+// Host-visible, survives every drop: where the tests read results.
+vkrc::Buffer make_readback(const vkrc::Device& device) {
+    return vkrc::Buffer::create(
+        device, {.size = bytes, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {vkrc::MemoryUsage::readback}});
+}
+
+void transfer_barrier(const vkrc::CommandBuffer& cmd) {
+    auto b = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                  VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
+    cmd.pipeline_barrier(std::span(&b, 1), {}, {});
+}
+
+// Fills buffer with value and copies it into readback.
+void record_fill_copy(const vkrc::CommandBuffer& cmd, const vkrc::Buffer& buffer, const vkrc::Buffer& readback,
+                      std::uint32_t value) {
+    cmd.fill_buffer(buffer, 0, bytes, value);
+    transfer_barrier(cmd);
+    VkBufferCopy region{0, 0, bytes};
+    cmd.copy_buffer(buffer, readback, std::span(&region, 1));
+}
+
+std::vector<std::uint32_t> read_all(const vkrc::Buffer& readback) {
+    std::vector<std::uint32_t> out(words);
+    readback.allocation().read(0, std::span(out));
+    return out;
+}
+
+bool all_equal(const vkrc::Buffer& readback, std::uint32_t value) {
+    auto v = read_all(readback);
+    return std::all_of(v.begin(), v.end(), [&](std::uint32_t x) { return x == value; });
+}
+
+void clear_readback(const vkrc::Buffer& readback) {
+    std::vector<std::uint32_t> zero(words, 0);
+    readback.allocation().write(0, std::span<const std::uint32_t>(zero));
+}
+
+void submit_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd) {
+    auto fence = vkrc::Fence::create(queue.device());
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+}
+
+// The issue's snippet, with a copy into a buffer that stays alive.
+TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    {
+        auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        cmd.begin();
+        record_fill_copy(cmd, buffer, readback, 7);
+        cmd.end();
+    }                                        // buffer dropped here
+    EXPECT_GE(device.deferred_count(), 1u);  // held, not destroyed
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(all_equal(readback, 7));
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+// Dropped during recording, before end().
+TEST_F(VulkanTest, BufferDroppedWhileRecording) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    cmd.begin();
+    {
+        auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        record_fill_copy(cmd, buffer, readback, 7);
+    }
+    cmd.end();
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(all_equal(readback, 7));
+}
+
+// An image, its view, a sampler, a descriptor set pointing at a storage
+// buffer, the set's layout, the pipeline layout, the pipeline and the
+// buffer itself, all dropped between recording and submission.
+TEST_F(VulkanTest, EveryKindDroppedBetweenRecordAndSubmit) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    {
+        auto storage = make_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        auto image = vkrc::Image::create(
+            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+        auto view = vkrc::ImageView::create(image);
+        auto sampler = vkrc::Sampler::create(device);
+        auto set_layout = vkrc::DescriptorSetLayout::create(
+            device, {.bindings = {{.binding = 0,
+                                   .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                   .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+        auto layout = vkrc::PipelineLayout::create(
+            device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
+        auto descriptors = vkrc::DescriptorPool::create(
+            device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+        auto set = descriptors.allocate(set_layout);
+        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage);
+        auto pipeline =
+            vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        cmd.begin();
+        cmd.bind_pipeline(pipeline);
+        cmd.bind_descriptor_set(pipeline, 0, set);
+        const std::uint32_t params[2] = {static_cast<std::uint32_t>(words), 0};
+        cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(params), params);
+        cmd.dispatch(static_cast<std::uint32_t>(words / 64));
+        transfer_barrier(cmd);
+        VkBufferCopy region{0, 0, bytes};
+        cmd.copy_buffer(storage, readback, std::span(&region, 1));
+        auto to_general = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
+                                              VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
+        cmd.pipeline_barrier({}, {}, std::span(&to_general, 1));
+        cmd.end();
+    }
+    submit_and_wait(queue, cmd);
+    auto v = read_all(readback);
+    for (std::uint32_t i = 0; i < words; ++i) ASSERT_EQ(v[i], i * 2654435761u) << i;
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+// A reusable command buffer keeps what it records alive between its
+// submissions, until it is reset.
+TEST_F(VulkanTest, DroppedBetweenSubmissionsOfAReusableCommandBuffer) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    cmd.begin(0);
+    record_fill_copy(cmd, buffer, readback, 7);
+    cmd.end();
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(all_equal(readback, 7));
+    clear_readback(readback);
+    buffer.reset();
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(all_equal(readback, 7));
+    EXPECT_GE(device.deferred_count(), 1u);  // still held by cmd
+    cmd.reset_commands();
+    device.collect_garbage();
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+// A secondary records the work and is dropped, with the buffer, before the
+// primary that executes it is submitted.
+TEST_F(VulkanTest, DroppedInsideASecondary) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    {
+        auto secondary = pool.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        secondary.begin_secondary();
+        record_fill_copy(secondary, buffer, readback, 7);
+        secondary.end();
+        cmd.begin();
+        cmd.execute_commands(std::span(&secondary, 1));
+        cmd.end();
+    }
+    EXPECT_EQ(pool.pending_free_count(), 1u);  // the secondary, held by cmd
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(all_equal(readback, 7));
+    auto next = pool.allocate();  // frees the secondary
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+}
+
+// Never submitted: dropping the command buffer releases what it held.
+TEST_F(VulkanTest, NeverSubmittedCommandBufferReleasesOnFree) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto cmd = pool.allocate();
+    auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    cmd.begin();
+    record_fill_copy(cmd, buffer, readback, 7);
+    cmd.end();
+    buffer.reset();
+    EXPECT_EQ(device.deferred_count(), 2u);  // the buffer and its memory
+    cmd.reset();
+    EXPECT_EQ(device.deferred_count(), 0u);  // nothing pending on the GPU: destroyed at once
+    // A pool reset closes its command buffers too.
+    auto again = pool.allocate();
+    buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    again.begin();
+    record_fill_copy(again, buffer, readback, 7);
+    again.end();
+    buffer.reset();
+    EXPECT_EQ(device.deferred_count(), 2u);
+    pool.reset_commands();
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+// A reusable command buffer recorded once and submitted every frame holds
+// only objects made before its end(): what is made and dropped each frame
+// goes the normal deferred way.
+TEST_F(VulkanTest, ReusableCommandBufferHoldsABoundedSet) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto source = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    auto cmd = pool.allocate();
+    cmd.begin(0);
+    record_fill_copy(cmd, source, readback, 7);
+    cmd.end();
+    source.reset();  // held for as long as cmd is open
+    auto fence = vkrc::Fence::create(device);
+    std::size_t most = 0;
+    for (int frame = 0; frame < 10000; ++frame) {
+        auto scratch = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        scratch.reset();
+        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+        most = std::max(most, device.deferred_count());
+        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+        fence.unsignal();
+    }
+    EXPECT_LE(most, 6u);
+    EXPECT_TRUE(all_equal(readback, 7));
+}
+
+// An adopted buffer's cleanup runs once the GPU is done with it, even when
+// it is dropped between recording and submission.
+TEST_F(VulkanTest, AdoptedBufferCleanupRunsAfterTheGpu) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto real = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    bool cleaned = false;
+    auto cmd = pool.allocate();
+    {
+        auto adopted = vkrc::Buffer::adopt(device, real.vk(), bytes, real.usage(), vkrc::Ownership::borrowed,
+                                           [&cleaned] { cleaned = true; });
+        EXPECT_FALSE(adopted.allocation());
+        cmd.begin();
+        record_fill_copy(cmd, adopted, readback, 7);
+        cmd.end();
+    }
+    EXPECT_FALSE(cleaned);
+    submit_and_wait(queue, cmd);
+    EXPECT_TRUE(cleaned);
+    EXPECT_TRUE(all_equal(readback, 7));
+}
+
+// An adopted instance knows what it was created with.
+TEST_F(VulkanTest, AdoptedInstanceKnowsItsExtensionsAndLayers) {
+    const char* extensions[] = {VK_EXT_DEBUG_UTILS_EXTENSION_NAME};
+    const char* layers[] = {"VK_LAYER_KHRONOS_validation"};
+    auto adopted = vkrc::Instance::adopt(instance.vk(), vkrc::Ownership::borrowed, instance.api_version(), nullptr,
+                                         extensions, layers);
+    EXPECT_TRUE(adopted.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME));
+    EXPECT_TRUE(adopted.layer_enabled("VK_LAYER_KHRONOS_validation"));
+    EXPECT_FALSE(adopted.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME));
+    EXPECT_TRUE(instance.layer_enabled("VK_LAYER_KHRONOS_validation"));
+}
+
+#if VKRC_RUNTIME_CHECKS
+// Accessors and recording through an empty handle name the type and the call.
+TEST(EmptyHandle, AccessorsAndRecordingThrowUsageError) {
+    auto expect_empty = [](auto call, const char* name) {
+        try {
+            call();
+            ADD_FAILURE() << name << " did not throw";
+        } catch (const vkrc::UsageError& e) {
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
+        }
+    };
+    vkrc::CommandBuffer cmd;
+    vkrc::Buffer buffer;
+    vkrc::Allocation allocation;
+    expect_empty([&] { cmd.draw(3); }, "vkrc::CommandBuffer::draw");
+    expect_empty([&] { cmd.begin(); }, "vkrc::CommandBuffer::begin");
+    expect_empty([&] { (void)cmd.vk(); }, "vkrc::CommandBuffer::vk");
+    expect_empty([&] { (void)buffer.size(); }, "vkrc::Buffer::size");
+    expect_empty([&] { allocation.write_value(0, 1u); }, "vkrc::Allocation::write");
+    expect_empty([&] { (void)vkrc::Device().vk(); }, "vkrc::Device::vk");
+}
+#endif
+
+// ---------------------------------------------------------------- randomized
+
+enum class DropPoint { before_begin, while_recording, after_end, after_submit, after_wait, never };
+constexpr int drop_points = 6;
+
+// One round: a handful of objects, some recorded into one command buffer,
+// each dropped at a random point in a random order; the device's own
+// handles (and, in some rounds, the instance's) too.
+struct Round {
+    std::mt19937& rng;
+    vkrc::Device device;
+    vkrc::Queue queue;
+
+    int pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); }
+
+    void run(bool drop_device_handles) {
+        auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+        auto readback = make_readback(device);
+        struct Item {
+            std::function<void()> drop;
+            DropPoint point;
+        };
+        std::vector<Item> items;
+        std::vector<vkrc::Buffer> buffers;
+        const int count = 1 + pick(4);
+        for (int i = 0; i < count; ++i) {
+            buffers.push_back(make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
+        }
+        auto image = vkrc::Image::create(
+            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+        auto view = vkrc::ImageView::create(image);
+        auto sampler = vkrc::Sampler::create(device);
+        auto secondary = pool.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        const bool use_secondary = pick(2) == 0;
+        auto point = [&] { return static_cast<DropPoint>(pick(drop_points)); };
+        for (auto& b : buffers) items.push_back({[&b] { b.reset(); }, point()});
+        items.push_back({[&] { image.reset(); }, point()});
+        items.push_back({[&] { view.reset(); }, point()});
+        items.push_back({[&] { sampler.reset(); }, point()});
+        items.push_back({[&] { secondary.reset(); }, use_secondary ? point() : DropPoint::before_begin});
+        items.push_back({[&] { pool.reset(); }, point()});
+        if (drop_device_handles) {
+            items.push_back({[&] { device.reset(); }, point()});
+            items.push_back({[&] { queue = {}; }, static_cast<DropPoint>(2 + pick(drop_points - 2))});
+        }
+        std::shuffle(items.begin(), items.end(), rng);
+        auto drop_at = [&](DropPoint p) {
+            for (auto& item : items) {
+                if (item.point == p) item.drop();
+            }
+        };
+        // What is dropped before begin is not recorded: only the living buffers are.
+        auto cmd = pool.allocate();
+        drop_at(DropPoint::before_begin);
+        const bool secondary_records = use_secondary && secondary;
+        auto recorder = secondary_records ? secondary : cmd;
+        if (secondary_records) recorder.begin_secondary();
+        cmd.begin(pick(2) ? VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT : 0);
+        std::uint32_t value = 0;
+        for (std::size_t i = 0; i < buffers.size(); ++i) {
+            if (!buffers[i]) continue;
+            value = static_cast<std::uint32_t>(pick(1000) + 1);
+            record_fill_copy(recorder, buffers[i], readback, value);
+            transfer_barrier(recorder);
+            if (pick(3) == 0) {
+                buffers[i].reset();  // dropped right after recording
+            }
+        }
+        drop_at(DropPoint::while_recording);
+        if (secondary_records) {
+            recorder.end();
+            cmd.execute_commands(std::span(&recorder, 1));
+        }
+        cmd.end();
+        recorder = {};
+        drop_at(DropPoint::after_end);
+        auto fence = vkrc::Fence::create(cmd.pool().device());
+        auto q = queue ? queue : cmd.pool().device().default_queue();
+        vkrc::submit(q, {.command_buffers = std::span(&cmd, 1)}, fence);
+        drop_at(DropPoint::after_submit);
+        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+        drop_at(DropPoint::after_wait);
+        if (value != 0) ASSERT_TRUE(all_equal(readback, value));
+    }
+};
+
+TEST_F(VulkanTest, RandomDropPointsAndOrders) {
+    const unsigned seed = std::random_device{}();
+    std::printf("RandomDropPointsAndOrders seed: %u\n", seed);
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    std::mt19937 rng(seed);
+    int rounds_run = 0;
+    for (int round = 0; round < 500; ++round) {
+        if (round % 50 == 49) {
+            // Everything, instance and device included, dropped in random order.
+            auto inst = vkrc::Instance::create(vkrc_test::validated_instance_info(log));
+            auto dev = vkrc::Device::create(vkrc::PhysicalDevice::select(inst, vkrc_test::test_device_requirements()));
+            Round r{rng, dev, dev.default_queue()};
+            dev.reset();
+            if (r.pick(2)) inst.reset();
+            r.run(true);
+            if (HasFatalFailure()) return;
+            continue;
+        }
+        Round r{rng, device, queue};
+        r.run(r.pick(2) == 0);
+        if (HasFatalFailure()) return;
+        ++rounds_run;
+    }
+    std::printf("rounds %d\n", rounds_run);
+    device.wait_idle();
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+
+#if VKRC_IS_MULTI_THREAD
+// Eight threads record into their own pools and drop what they recorded at
+// random points, on a shared device and queue.
+TEST_F(VulkanTest, EightThreadsRecordAndDrop) {
+    const unsigned seed = std::random_device{}();
+    std::printf("EightThreadsRecordAndDrop seed: %u\n", seed);
+    std::vector<std::thread> threads;
+    std::atomic<int> failures{0};
+    for (unsigned t = 0; t < 8; ++t) {
+        threads.emplace_back([&, t] {
+            std::mt19937 rng(seed + t);
+            auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+            auto readback = make_readback(device);
+            auto fence = vkrc::Fence::create(device);
+            for (int i = 0; i < 40; ++i) {
+                auto buffer = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+                auto cmd = pool.allocate();
+                const int drop = static_cast<int>(rng() % 3);
+                cmd.begin();
+                record_fill_copy(cmd, buffer, readback, i + 1);
+                if (drop == 0) buffer.reset();
+                cmd.end();
+                if (drop == 1) buffer.reset();
+                vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+                if (drop == 2) cmd.reset();
+                buffer.reset();
+                if (fence.wait() != VK_SUCCESS || !all_equal(readback, i + 1)) failures.fetch_add(1);
+                fence.unsignal();
+            }
+        });
+    }
+    for (auto& t : threads) t.join();
+    EXPECT_EQ(failures.load(), 0);
+    device.wait_idle();
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+#endif
+
+}  // namespace
