@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The teapot runs behind docs/benchmarks.md, on whatever device this machine
-# has: 25 and 2 500 teapots, headless, --runs 3 fresh processes each. Writes
+# has: 25 and 2 500 teapots, headless, --runs 3 fresh processes each (RUNS
+# overrides: more processes narrow the intervals, which include their spread). Writes
 # one CSV per configuration into OUT, each headed by '# key: value' lines
 # (device, driver, date, command, git revision) that scripts/gen_bench_docs.py
 # reads; copy them into docs/results/ and run the generator.
@@ -37,9 +38,9 @@ run() {  # run FILE-SUFFIX teapot-args...
   local suffix=$1
   shift
   local csv="$out/tmp-$suffix.csv" log="$out/tmp-$suffix.log"
-  local command="bench/teapot --runs 3 $*"
+  local command="bench/teapot --runs ${RUNS:-3} $*"
   echo "== $command" >&2
-  "$teapot" --runs 3 "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
+  "$teapot" --runs "${RUNS:-3}" "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
   local device
   device=$(awk -F': ' '/^device: / {print $2; exit}' "$log")
   local prefix=$name

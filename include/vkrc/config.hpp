@@ -32,11 +32,18 @@
 #ifndef VKRC_CONFIG_HPP
 #define VKRC_CONFIG_HPP
 
+// VKRC_POLICY_NAMESPACE may be set to another name (e.g. -DVKRC_POLICY_NAMESPACE=
+// st_checked) to link a second copy of vkrc, built with other options, into
+// the same program; the library and its users must agree on it.
 #if VKRC_DETAIL_POLICY_SEEN == 2
-#  define VKRC_POLICY_NAMESPACE mt
+#  ifndef VKRC_POLICY_NAMESPACE
+#    define VKRC_POLICY_NAMESPACE mt
+#  endif
 #  define VKRC_IS_MULTI_THREAD 1
 #else
-#  define VKRC_POLICY_NAMESPACE st
+#  ifndef VKRC_POLICY_NAMESPACE
+#    define VKRC_POLICY_NAMESPACE st
+#  endif
 #  define VKRC_IS_MULTI_THREAD 0
 #endif
 
