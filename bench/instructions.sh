@@ -35,13 +35,15 @@ trap 'rm -rf "$dumps"' EXIT
   exit 1
 }
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+# shellcheck source=bench/run_header.sh
+source "$source_dir/bench/run_header.sh"
 device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
 {
   echo "# device: ${device:-${DEVICE:-unknown}}"
   echo "# driver: $(dpkg-query -W -f='mesa-vulkan-drivers ${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
   echo "# date: $(date -u +%Y-%m-%dT%H:%MZ)"
   echo "# command: bench/instructions.sh TEAPOT CSV $*"
-  echo "# git: $(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+  echo "# git: $(bench_revision "$(dirname "$teapot")/..")"
   echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$(dirname "$teapot")/../CMakeCache.txt" | cut -d= -f2 || true)"
 } >"$dumps/header"
 python3 - "$dumps" "$csv" <<'PY'
