@@ -131,9 +131,9 @@ void begin_batch(detail::UploaderState& s) {
         s.open = s.recorded.back().cmd;
     }
     s.open.begin(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
-    const VkMemoryBarrier2 b = memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                                              VK_PIPELINE_STAGE_2_COPY_BIT,
-                                              VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    const VkMemoryBarrier2 b =
+        memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
     s.open.pipeline_barrier({&b, 1}, {}, {});
     s.batch = detail::Ref<detail::BatchValue>(new detail::BatchValue);
 }

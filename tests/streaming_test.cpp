@@ -37,9 +37,9 @@ protected:
     }
 
     vkrc::Buffer device_buffer(VkDeviceSize size, VkBufferUsageFlags usage = 0) {
-        return vkrc::Buffer::create(device, {.size = size,
-                                             .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                                      VK_BUFFER_USAGE_TRANSFER_SRC_BIT | usage});
+        return vkrc::Buffer::create(
+            device,
+            {.size = size, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | usage});
     }
 
     vkrc::Queue transfer, compute;
@@ -123,9 +123,8 @@ TEST_F(StreamingTest, UploaderThousandRandomUploadsInFlightWithRendering) {
     std::vector<std::byte> expected = random_bytes(rng, total);
     auto dst = device_buffer(total);
     auto result = device_buffer(total);
-    auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
-                                              .extent = {32, 32, 1},
-                                              .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    auto image = vkrc::Image::create(
+        device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {32, 32, 1}, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     auto uploader = vkrc::Uploader::create({.queue = transfer, .staging_size = 256 << 10});
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
@@ -225,8 +224,9 @@ TEST_F(StreamingTest, UploaderEveryMipUploadedAsynchronouslyIsSampledTexelByTexe
     auto layout = vkrc::PipelineLayout::create(
         device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 16}}});
     auto descriptors = vkrc::DescriptorPool::create(
-        device, {.max_sets = 1,
-                 .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+        device,
+        {.max_sets = 1,
+         .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
     auto set = descriptors.allocate(set_layout);
     set.write_image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                     sampler);
@@ -263,11 +263,11 @@ TEST_F(StreamingTest, UploaderBlockCompressedImageByBlockSize) {
     if ((props.optimalTilingFeatures & needed) != needed) {
         GTEST_SKIP() << "the device has no BC1 (textureCompressionBC) transfer support";
     }
-    auto image = vkrc::Image::create(
-        device, {.format = VK_FORMAT_BC1_RGBA_UNORM_BLOCK,
-                 .extent = {16, 8, 1},
-                 .mip_levels = 5,
-                 .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_BC1_RGBA_UNORM_BLOCK,
+                                     .extent = {16, 8, 1},
+                                     .mip_levels = 5,
+                                     .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
     // 4x2 + 2x1 + 1 + 1 + 1 blocks of 8 bytes.
     ASSERT_EQ(vkrc::image_data_size(image), (8u + 2 + 1 + 1 + 1) * 8);
     std::mt19937 rng(1);
@@ -371,14 +371,12 @@ TEST(UploaderDeviceLoss, DeviceLossDuringAnUpload) {
     EXPECT_TRUE(device.lost());
     try {
         first.wait_on_host();  // returns or reports the loss; never hangs
-    } catch (const vkrc::DeviceLostError&) {
-    }
+    } catch (const vkrc::DeviceLostError&) {}
     // The ring keeps working as far as the host goes: space is reclaimed without waiting.
     for (int i = 0; i < 8; ++i) {
         try {
             uploader.upload_buffer(buffer, 0, data);
-        } catch (const vkrc::DeviceLostError&) {
-        }
+        } catch (const vkrc::DeviceLostError&) {}
     }
     uploader = {};
     buffer = {};
@@ -397,8 +395,10 @@ TEST_F(StreamingTest, RingWrapsWhileOlderFramesAreStillOnTheGpu) {
     vkrc_test::Watchdog watchdog("frame ring");
     constexpr std::uint32_t frames = 3;
     constexpr VkDeviceSize slice = 256;
-    auto ring = vkrc::FrameRing::create(
-        {.queue = queue, .frame_size = 4 * slice, .frames_in_flight = frames, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+    auto ring = vkrc::FrameRing::create({.queue = queue,
+                                         .frame_size = 4 * slice,
+                                         .frames_in_flight = frames,
+                                         .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
     auto result = device_buffer(slice * 8);
     auto gate = vkrc::Semaphore::create_timeline(device);
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
@@ -461,8 +461,7 @@ TEST_F(StreamingTest, RingDynamicUniformDescriptor) {
         a.view.write_value(0, draw);
         const VkDescriptorSet raw = set.vk();
         const std::uint32_t offset = a.dynamic_offset();
-        cmd.fn().vkCmdBindDescriptorSets(cmd.vk(), VK_PIPELINE_BIND_POINT_COMPUTE, layout.vk(), 0, 1, &raw, 1,
-                                         &offset);
+        cmd.fn().vkCmdBindDescriptorSets(cmd.vk(), VK_PIPELINE_BIND_POINT_COMPUTE, layout.vk(), 0, 1, &raw, 1, &offset);
     }
     cmd.end();
     vkrc::submit(queue, {.command_buffers = {&cmd, 1}});
@@ -475,10 +474,10 @@ TEST_F(StreamingTest, RingDynamicUniformDescriptor) {
 // The buffer, dropped while both are pending, waits for both queues.
 TEST_F(StreamingTest, AsyncComputeBesideGraphicsWithTimelineWaits) {
     constexpr std::uint32_t count = 4096;
-    auto set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
     auto layout = vkrc::PipelineLayout::create(
         device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
     auto pipeline =
