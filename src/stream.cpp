@@ -15,7 +15,10 @@ SemaphoreSubmit Ticket::wait(VkPipelineStageFlags2 stages) const {
     SemaphoreSubmit s;
     s.semaphore = queue.timeline_semaphore();
     s.value = value;
-    s.stage_mask = stages;
+    // The acquire barriers (destination: all commands) come after the wait
+    // only when the wait covers their stages.
+    const bool acquires = !buffer_acquires.empty() || !image_acquires.empty();
+    s.stage_mask = acquires ? VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT : stages;
     return s;
 }
 

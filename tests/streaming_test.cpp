@@ -109,30 +109,34 @@ TEST_F(VulkanTest, StreamingQueuesExplicitRequestsGetRoles) {
     queue = device.default_queue();
 }
 
-// Uploads of random sizes into one destination, batches submitted without a
-// wait, each consumed by a graphics submission (clear of an image: the
-// rendering stand-in, and a copy of the batch's bytes into a result) that
-// waits on the batch's ticket; a 256 KiB ring wraps and waits many times.
+// Uploads of random sizes, batches of ten submitted without a wait, each
+// batch into a destination of its own (so that each is one ownership
+// transfer when the families differ) and consumed by a graphics submission
+// (a clear of an image: the rendering stand-in, and a copy of the batch's
+// bytes into a result) that waits on the batch's ticket; a 256 KiB ring
+// wraps and waits for its oldest batch many times.
 TEST_F(StreamingTest, UploaderThousandRandomUploadsInFlightWithRendering) {
     vkrc_test::Watchdog watchdog("1000 uploads");
     std::mt19937 rng(15);
-    constexpr int uploads = 1000;
+    constexpr int uploads = 1000, per_batch = 10;
     std::vector<std::size_t> sizes(uploads);
     VkDeviceSize total = 0;
     for (auto& s : sizes) total += s = 4 * (1 + rng() % 8192);  // 4 B to 32 KiB
     std::vector<std::byte> expected = random_bytes(rng, total);
-    auto dst = device_buffer(total);
     auto result = device_buffer(total);
     auto image = vkrc::Image::create(
         device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {32, 32, 1}, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     auto uploader = vkrc::Uploader::create({.queue = transfer, .staging_size = 256 << 10});
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VkDeviceSize offset = 0, batch_start = 0;
-    for (int i = 0; i < uploads; ++i) {
-        uploader.upload_buffer(dst, offset, std::span(expected).subspan(offset, sizes[i]));
-        offset += sizes[i];
-        if (i % 10 != 9) continue;
+    VkDeviceSize offset = 0;
+    for (int batch = 0; batch < uploads / per_batch; ++batch) {
+        const VkDeviceSize batch_start = offset;
+        for (int i = batch * per_batch; i < (batch + 1) * per_batch; ++i) offset += sizes[i];
+        auto dst = device_buffer(offset - batch_start);
+        for (VkDeviceSize at = batch_start, i = batch * per_batch; at < offset; at += sizes[i++]) {
+            uploader.upload_buffer(dst, at - batch_start, std::span(expected).subspan(at, sizes[i]));
+        }
         const vkrc::Ticket ticket = uploader.submit();
         auto cmd = pool.allocate();
         cmd.begin();
@@ -142,15 +146,14 @@ TEST_F(StreamingTest, UploaderThousandRandomUploadsInFlightWithRendering) {
                                           VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
         cmd.pipeline_barrier({}, {}, {&to_dst, 1});
         layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-        const VkClearColorValue color{{float(i % 7) / 7.0f, 0.0f, 0.0f, 1.0f}};
+        const VkClearColorValue color{{float(batch % 7) / 7.0f, 0.0f, 0.0f, 1.0f}};
         const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
         cmd.fn().vkCmdClearColorImage(cmd.vk(), image.vk(), layout, &color, 1, &range);
-        const VkBufferCopy region{batch_start, batch_start, offset - batch_start};
+        const VkBufferCopy region{0, batch_start, offset - batch_start};
         cmd.copy_buffer(dst, result, {&region, 1});
         cmd.end();
         const vkrc::SemaphoreSubmit wait = ticket.wait(VK_PIPELINE_STAGE_2_COPY_BIT);
         vkrc::submit(queue, {.waits = {&wait, 1}, .command_buffers = {&cmd, 1}});
-        batch_start = offset;
     }
     queue.wait_idle();
     const auto got = vkrc::download_buffer(queue, result, 0, total);

@@ -141,8 +141,11 @@ private:
         fn_->vkCmdPipelineBarrier2(cmd, &dep);
     }
 
-    // Ring space: regions in flight are (begin, end, value), oldest first.
+    // Ring space: regions in flight are (begin, end, value), oldest first;
+    // completed ones are dropped first, so an idle ring starts again at 0
+    // (its pages stay warm).
     VkDeviceSize reserve(VkDeviceSize size) {
+        retire();
         for (;;) {
             VkDeviceSize at = 0;
             if (!regions_.empty()) {

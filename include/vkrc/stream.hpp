@@ -30,7 +30,8 @@ struct Ticket {
     List<VkImageMemoryBarrier2> image_acquires{};
 
     explicit operator bool() const noexcept { return static_cast<bool>(queue); }
-    // For SubmitBatch::waits: the consumer's stages wait for the copies.
+    // For SubmitBatch::waits: the consumer's stages wait for the copies
+    // (all commands when the ticket carries acquires, which must follow the wait).
     SemaphoreSubmit wait(VkPipelineStageFlags2 stages = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT) const;
     // Records the acquire barriers into cmd (of the consumer's family) when
     // there are any; before the commands that use the data, in a submission
