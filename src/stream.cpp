@@ -123,10 +123,16 @@ const char* const create_who = "vkrc::Uploader::create";
 // The batch's first command: earlier work on the queue finishes writing and
 // reading what the copies touch (one barrier per batch, not per copy).
 void begin_batch(detail::UploaderState& s) {
-    for (auto& r : s.recorded) {
-        if (r.value <= s.queue.state()->timeline.completed()) {
-            s.open = r.cmd;
-            break;
+    // A command buffer whose batch completed: by the cached value, else by
+    // the semaphore's (so that a stream that never fills the ring, and so
+    // never reads the semaphore there, still reuses them).
+    for (int pass = 0; pass < 2 && !s.open && !s.recorded.empty(); ++pass) {
+        const std::uint64_t completed = pass == 0 ? s.queue.state()->timeline.completed() : refresh_completed(s.queue);
+        for (auto& r : s.recorded) {
+            if (r.value <= completed) {
+                s.open = r.cmd;
+                break;
+            }
         }
     }
     if (!s.open) {
