@@ -330,7 +330,69 @@ def readme_row():
             f"{'all images byte-identical to raw-direct' if images else 'IMAGES DIFFER'} |"]
 
 
+UPLOAD_RAW_GOAL = 0.95  # vkrc-stream vs raw-stream throughput (issue 15)
+UPLOAD_BLOCKING_GOAL = 5.0  # vkrc-stream vs vkrc-blocking throughput, 4 KiB uploads
+
+
+def upload_stats(rows, upload, variant, column):
+    """Median and range over every block of every process."""
+    values = sorted(float(x[column]) for x in rows if x["upload"] == upload and x["variant"] == variant)
+    n = len(values)
+    median = values[n // 2] if n % 2 else (values[n // 2 - 1] + values[n // 2]) / 2
+    return median, values[0], values[-1], n
+
+
+def upload_ratio(rows, upload, a, b):
+    # Per (process, block) ratio of throughputs: the variants of a block run back to back.
+    get = {(x["process"], x["block"], x["variant"]): float(x["gb_per_s"]) for x in rows if x["upload"] == upload}
+    ratios = sorted(get[(p, k, a)] / get[(p, k, b)] for (p, k, v) in get if v == a and (p, k, b) in get)
+    n = len(ratios)
+    return (ratios[n // 2] if n % 2 else (ratios[n // 2 - 1] + ratios[n // 2]) / 2), ratios[0], ratios[-1]
+
+
+def upload_section(pattern, pending):
+    found = sorted(results(pattern, "gb_per_s"), key=lambda r: r["path"])
+    if not found:
+        return [pending]
+    out = []
+    for r in found:
+        rows = r["rows"]
+        uploads = []
+        for x in rows:
+            if x["upload"] not in uploads:
+                uploads.append(x["upload"])
+        out += [run_line(r), "", f"    {r['meta'].get('command', '?')}", "",
+                "| upload | variant | uploads per block | GB/s median [min, max] | CPU us per upload median [min, max] "
+                "| blocks |",
+                "|---|---|---:|---:|---:|---:|"]
+        for u in uploads:
+            for v in ("vkrc-stream", "raw-stream", "vkrc-blocking"):
+                g = upload_stats(rows, u, v, "gb_per_s")
+                c = upload_stats(rows, u, v, "cpu_us_per_upload")
+                per_block = next(x["uploads"] for x in rows if x["upload"] == u and x["variant"] == v)
+                out.append(f"| {u} | {v} | {per_block} | {g[0]:.3f} [{g[1]:.3f}, {g[2]:.3f}] | "
+                           f"{c[0]:.1f} [{c[1]:.1f}, {c[2]:.1f}] | {g[3]} |")
+        out += ["", "| upload | vkrc-stream / raw-stream GB/s, median [min, max] of the blocks | "
+                "vkrc-stream / vkrc-blocking |", "|---|---:|---:|"]
+        for u in uploads:
+            raw = upload_ratio(rows, u, "vkrc-stream", "raw-stream")
+            blocking = upload_ratio(rows, u, "vkrc-stream", "vkrc-blocking")
+            out.append(f"| {u} | {raw[0]:.3f} [{raw[1]:.3f}, {raw[2]:.3f}] | "
+                       f"{blocking[0]:.2f} [{blocking[1]:.2f}, {blocking[2]:.2f}] |")
+        raw_all = [upload_ratio(rows, u, "vkrc-stream", "raw-stream")[0] for u in uploads]
+        small = upload_ratio(rows, uploads[0], "vkrc-stream", "vkrc-blocking")[0]
+        out += ["", f"Goals: vkrc-stream at least {UPLOAD_RAW_GOAL}x raw-stream's throughput (median ratios "
+                f"{', '.join(f'{v:.3f}' for v in raw_all)}: **{'met' if min(raw_all) >= UPLOAD_RAW_GOAL else 'not met'}**"
+                f"); at least {UPLOAD_BLOCKING_GOAL:.0f}x vkrc-blocking for {uploads[0]} ({small:.2f}x: "
+                f"**{'met' if small >= UPLOAD_BLOCKING_GOAL else 'not met'}**).", ""]
+    return out[:-1]
+
+
 BLOCKS = {
+    "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
+    "upload-h200": lambda: upload_section(
+        "H200", "**Pending:** no H200 upload run is committed yet. `bench/upload_run.sh BUILD_DIR OUT NAME` on the "
+        "H200 machine writes the CSV; committed under docs/results/, it appears here."),
     "teapot-lavapipe": lambda: section("llvmpipe", "No lavapipe results in docs/results/ yet."),
     "teapot-h200": lambda: section(
         "H200", "**The H200 figures are pending re-measurement.** The earlier tables were measured with the "

@@ -11,6 +11,20 @@
 
 VKRC_BEGIN_NAMESPACE
 
+int find_dedicated_queue_family(const PhysicalDevice& physical, QueueRole role) {
+    if (!physical) throw UsageError("vkrc::find_dedicated_queue_family: the PhysicalDevice handle is empty");
+    constexpr VkQueueFlags graphics = VK_QUEUE_GRAPHICS_BIT, compute = VK_QUEUE_COMPUTE_BIT;
+    const auto& families = physical.queue_families();
+    for (std::uint32_t i = 0; i < families.size(); ++i) {
+        const VkQueueFlags f = families[i].queueFlags;
+        const bool match = role == QueueRole::graphics  ? (f & (graphics | compute)) == (graphics | compute)
+                           : role == QueueRole::compute ? (f & compute) && !(f & graphics)
+                                                        : (f & VK_QUEUE_TRANSFER_BIT) && !(f & (graphics | compute));
+        if (match) return static_cast<int>(i);
+    }
+    return -1;
+}
+
 namespace detail {
 
 DeviceState::~DeviceState() {
@@ -252,6 +266,68 @@ void drop_unless_debug_utils(const PhysicalDevice& physical, DeviceFunctions& fn
     fn.vkCmdInsertDebugUtilsLabelEXT = nullptr;
 }
 
+bool family_has(const PhysicalDevice& physical, std::uint32_t family, VkQueueFlags flags) {
+    return (physical.queue_families()[family].queueFlags & flags) == flags;
+}
+
+// Graphics and compute queues can also run transfers (the spec's rule).
+bool family_can_do(const PhysicalDevice& physical, std::uint32_t family, QueueRole role) {
+    switch (role) {
+        case QueueRole::graphics: return family_has(physical, family, VK_QUEUE_GRAPHICS_BIT);
+        case QueueRole::compute: return family_has(physical, family, VK_QUEUE_COMPUTE_BIT);
+        case QueueRole::transfer:
+            return (physical.queue_families()[family].queueFlags &
+                    (VK_QUEUE_TRANSFER_BIT | VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT)) != 0;
+    }
+    return false;
+}
+
+// The first queue of the dedicated family, else the first other than those
+// in taken that can do the role's work, else taken[0] (the graphics queue).
+std::size_t pick_role_queue(const detail::DeviceState& s, QueueRole role, std::span<const std::size_t> taken) {
+    const int dedicated = find_dedicated_queue_family(s.physical_device, role);
+    for (std::size_t i = 0; i < s.queues.size(); ++i) {
+        if (static_cast<int>(s.queues[i].family_index) == dedicated) return i;
+    }
+    for (std::size_t i = 0; i < s.queues.size(); ++i) {
+        if (std::find(taken.begin(), taken.end(), i) != taken.end()) continue;
+        if (family_can_do(s.physical_device, s.queues[i].family_index, role)) return i;
+    }
+    return taken[0];
+}
+
+void assign_roles(detail::DeviceState& s) {
+    if (s.queues.empty()) return;
+    auto& graphics = s.role_queues[static_cast<int>(QueueRole::graphics)];
+    for (graphics = 0; graphics < s.queues.size(); ++graphics) {
+        if (family_can_do(s.physical_device, s.queues[graphics].family_index, QueueRole::graphics)) break;
+    }
+    if (graphics == s.queues.size()) graphics = 0;
+    auto& transfer = s.role_queues[static_cast<int>(QueueRole::transfer)];
+    const std::size_t after_graphics[] = {graphics};
+    transfer = pick_role_queue(s, QueueRole::transfer, after_graphics);
+    const std::size_t after_transfer[] = {graphics, transfer};
+    s.role_queues[static_cast<int>(QueueRole::compute)] = pick_role_queue(s, QueueRole::compute, after_transfer);
+}
+
+// The default request, and those of the roles asked for: a dedicated family
+// when there is one, else another queue of the graphics family if it has room.
+void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& info,
+                       std::vector<QueueRequest>& requests) {
+    const int graphics = find_dedicated_queue_family(physical, QueueRole::graphics);
+    if (graphics < 0) throw UsageError("vkrc::Device::create: no queue family with graphics and compute");
+    requests.push_back(QueueRequest{static_cast<std::uint32_t>(graphics)});
+    for (QueueRole role : {QueueRole::transfer, QueueRole::compute}) {
+        if (!(role == QueueRole::transfer ? info.transfer_queue : info.compute_queue)) continue;
+        const int family = find_dedicated_queue_family(physical, role);
+        if (family >= 0) {
+            requests.push_back(QueueRequest{static_cast<std::uint32_t>(family)});
+        } else if (requests[0].queue_priorities.size() < physical.queue_families()[graphics].queueCount) {
+            requests[0].queue_priorities.push_back(1.0f);
+        }
+    }
+}
+
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership,
                  std::span<const QueueRequest> queues, std::span<const char* const> extensions,
                  detail::Ref<detail::DeviceState>& state) {
@@ -264,6 +340,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
     drop_unless_debug_utils(physical, s.fn);
     for (const char* e : extensions) s.enabled_extensions.push_back(e);
     init_queues(s, queues);
+    assign_roles(s);
 }
 
 }  // namespace
@@ -273,11 +350,7 @@ Device Device::create(const PhysicalDevice& physical) { return create(physical, 
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");
     std::vector<QueueRequest> requests(info.queue_requests.begin(), info.queue_requests.end());
-    if (requests.empty()) {
-        int family = physical.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
-        if (family < 0) throw UsageError("vkrc::Device::create: no queue family with graphics and compute");
-        requests.push_back(QueueRequest{static_cast<std::uint32_t>(family)});
-    }
+    if (requests.empty()) add_role_requests(physical, info, requests);
     std::vector<VkDeviceQueueCreateInfo> queue_infos;
     for (const auto& r : requests) {
         if (r.queue_family_index >= physical.queue_families().size()) {
@@ -370,6 +443,19 @@ Queue Device::default_queue() const {
     return Queue(*this, &state_->queues.front());
 }
 
+QueueAssignment Device::queue_for(QueueRole role) const {
+    VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
+    if (state_->queues.empty()) throw UsageError("vkrc::Device::queue_for: the device has no queues");
+    const std::size_t index = state_->role_queues[static_cast<int>(role)];
+    const std::size_t graphics = state_->role_queues[static_cast<int>(QueueRole::graphics)];
+    QueueAssignment a;
+    a.queue = Queue(*this, &state_->queues[index]);
+    a.dedicated_family =
+        static_cast<int>(state_->queues[index].family_index) == find_dedicated_queue_family(physical_device(), role);
+    a.shares_graphics_queue = role != QueueRole::graphics && index == graphics;
+    return a;
+}
+
 void Device::wait_idle() const {
     // Everything submitted before the wait is complete after it.
     std::vector<std::uint64_t> submitted;
@@ -454,6 +540,20 @@ std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fenc
         } else {
             r = submit_signalling(d, q, submits, fence, number);
         }
+    }
+    d.finish_call(r, "vkQueueSubmit2");
+    return number;
+}
+
+std::uint64_t detail::submit_signalled(const Queue& queue, std::span<const VkSubmitInfo2> submits) {
+    auto& q = *queue.state();
+    auto& d = *queue.device().state();
+    VkResult r;
+    std::uint64_t number;
+    {
+        LockGuard lock(q.mutex);
+        number = q.timeline.next_number();
+        r = submit_signalling(d, q, submits, VK_NULL_HANDLE, number);
     }
     d.finish_call(r, "vkQueueSubmit2");
     return number;

@@ -1,9 +1,9 @@
 #include "vkrc/upload.hpp"
 
-#include "vkrc/submit.hpp"
-#include "vkrc/sync.hpp"
+#include "vkrc/stream.hpp"
 
 #include "enum_names.hpp"
+#include "staging.hpp"
 
 #include <string>
 #include <type_traits>
@@ -35,62 +35,38 @@ std::uint32_t format_texel_size(VkFormat format) noexcept {
     return 0;
 }
 
-namespace {
-
-// One command buffer from a transient pool, submitted and waited for. The
-// pool, command buffer and fence are vkrc objects, so their destruction is
-// deferred past the submitted work like any other (a failed wait included).
-class OneTimeCommands {
-public:
-    explicit OneTimeCommands(const Queue& queue)
-        : queue_(queue),
-          pool_(CommandPool::create(queue.device(), {VK_COMMAND_POOL_CREATE_TRANSIENT_BIT, queue.family_index()})),
-          cmd_(pool_.allocate()) {
-        cmd_.begin(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
+FormatBlock format_block(VkFormat format) noexcept {
+    const int f = static_cast<int>(format);
+    if (const std::uint32_t texel = format_texel_size(format)) return {texel, 1, 1};
+    // BC1 and BC4 take 8 bytes per 4x4 block, BC2, 3, 5, 6H and 7 take 16.
+    if (f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && f <= VK_FORMAT_BC7_SRGB_BLOCK) {
+        const bool half =
+            f <= VK_FORMAT_BC1_RGBA_SRGB_BLOCK || (f >= VK_FORMAT_BC4_UNORM_BLOCK && f <= VK_FORMAT_BC4_SNORM_BLOCK);
+        return {half ? 8u : 16u, 4, 4};
     }
-
-    VkCommandBuffer cmd() const noexcept { return cmd_.vk(); }
-    const DeviceFunctions& fn() const noexcept { return cmd_.fn(); }
-
-    void submit_and_wait() {
-        cmd_.end();
-        Fence fence = Fence::create(queue_.device());
-        submit(queue_, SubmitBatch{{}, {&cmd_, 1}, {}}, fence);
-        fence.wait();
+    // ETC2 RGB8, RGB8A1 and EAC R11 take 8 bytes per 4x4 block; ETC2 RGBA8 and EAC RG11 take 16.
+    if (f >= VK_FORMAT_ETC2_R8G8B8_UNORM_BLOCK && f <= VK_FORMAT_EAC_R11G11_SNORM_BLOCK) {
+        const bool half = f <= VK_FORMAT_ETC2_R8G8B8A1_SRGB_BLOCK ||
+                          (f >= VK_FORMAT_EAC_R11_UNORM_BLOCK && f <= VK_FORMAT_EAC_R11_SNORM_BLOCK);
+        return {half ? 8u : 16u, 4, 4};
     }
-
-    void image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
-                       VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                       VkAccessFlags2 dst_access, const VkImageSubresourceRange& range) const {
-        VkImageMemoryBarrier2 b = vkrc::image_barrier(image, old_layout, new_layout, src_stage, src_access, dst_stage,
-                                                      dst_access, range.aspectMask);
-        b.subresourceRange = range;
-        cmd_.pipeline_barrier({}, {}, {&b, 1});
+    // ASTC LDR: 16 bytes per block, the extents in enum order (UNORM, SRGB pairs).
+    if (f >= VK_FORMAT_ASTC_4x4_UNORM_BLOCK && f <= VK_FORMAT_ASTC_12x12_SRGB_BLOCK) {
+        static constexpr std::uint8_t extents[14][2] = {{4, 4},  {5, 4},   {5, 5},   {6, 5},  {6, 6},
+                                                        {8, 5},  {8, 6},   {8, 8},   {10, 5}, {10, 6},
+                                                        {10, 8}, {10, 10}, {12, 10}, {12, 12}};
+        const auto& e = extents[(f - VK_FORMAT_ASTC_4x4_UNORM_BLOCK) / 2];
+        return {16, e[0], e[1]};
     }
-    void memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                        VkAccessFlags2 dst_access) const {
-        const VkMemoryBarrier2 b = vkrc::memory_barrier(src_stage, src_access, dst_stage, dst_access);
-        cmd_.pipeline_barrier({&b, 1}, {}, {});
-    }
-
-private:
-    Queue queue_;
-    CommandPool pool_;
-    CommandBuffer cmd_;
-};
-
-Buffer staging_buffer(const Device& device, VkDeviceSize size, MemoryUsage usage) {
-    BufferCreateInfo info;
-    info.size = size;
-    info.usage = usage == MemoryUsage::upload ? VK_BUFFER_USAGE_TRANSFER_SRC_BIT : VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    info.memory.usage = usage;
-    return Buffer::create(device, info);
+    return {};
 }
 
-// The checks every transfer starts with: the buffer or image exists, belongs
-// to the queue's device and has the transfer usage (usage_name) it needs.
+namespace detail {
+
+namespace {
+
 template <class Resource>
-void check_transfer(const Queue& queue, const Resource& resource, std::uint32_t usage, const char* usage_name,
+void check_resource(const Queue& queue, const Resource& resource, std::uint32_t usage, const char* usage_name,
                     const char* who) {
     constexpr bool buffer = std::is_same_v<Resource, Buffer>;
     if (!resource) throw UsageError(std::string(who) + (buffer ? ": the Buffer is empty" : ": the Image is empty"));
@@ -103,16 +79,6 @@ void check_transfer(const Queue& queue, const Resource& resource, std::uint32_t 
     }
 }
 
-std::uint32_t checked_texel_size(const Image& image, const char* who) {
-    const std::uint32_t texel = format_texel_size(image.format());
-    if (texel == 0) {
-        throw UsageError(std::string(who) + ": format " + detail::enum_text(image.format()) +
-                         " is not an uncompressed colour format");
-    }
-    if (image.samples() != VK_SAMPLE_COUNT_1_BIT) throw UsageError(std::string(who) + ": the image is multisampled");
-    return texel;
-}
-
 // a * b, or UsageError naming who when it does not fit in 64 bits.
 VkDeviceSize checked_mul(VkDeviceSize a, VkDeviceSize b, const char* who) {
     VkDeviceSize r;
@@ -122,79 +88,44 @@ VkDeviceSize checked_mul(VkDeviceSize a, VkDeviceSize b, const char* who) {
     return r;
 }
 
-VkDeviceSize level_size(const Image& image, std::uint32_t level, std::uint32_t texel, const char* who) {
-    const VkExtent3D e = image.extent(level);
-    return checked_mul(checked_mul(checked_mul(e.width, e.height, who), e.depth, who), texel, who);
-}
-
 }  // namespace
 
-void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) {
-    constexpr const char* who = "vkrc::upload_buffer";
-    check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "VK_BUFFER_USAGE_TRANSFER_DST_BIT", who);
-    if (offset > buffer.size() || data.size() > buffer.size() - offset) {
-        throw UsageError(std::string(who) + ": " + std::to_string(data.size()) + " bytes at offset " +
-                         std::to_string(offset) + " do not fit in the " + std::to_string(buffer.size()) +
-                         "-byte buffer");
-    }
-    if (data.empty()) return;
-    Buffer staging = staging_buffer(buffer.device(), data.size(), MemoryUsage::upload);
-    staging.allocation().write(0, data);
-    OneTimeCommands commands(queue);
-    // Earlier submissions' reads and writes of the buffer end before the copy
-    // writes it (as in upload_image).
-    commands.memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    VkBufferCopy region{0, offset, data.size()};
-    commands.fn().vkCmdCopyBuffer(commands.cmd(), staging.vk(), buffer.vk(), 1, &region);
-    // Later submissions see the copy (their commands are in the second scope).
-    commands.memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                            VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    commands.submit_and_wait();
+void check_transfer(const Queue& queue, const Buffer& buffer, VkBufferUsageFlags usage, const char* usage_name,
+                    const char* who) {
+    check_resource(queue, buffer, usage, usage_name, who);
+}
+void check_transfer(const Queue& queue, const Image& image, VkImageUsageFlags usage, const char* usage_name,
+                    const char* who) {
+    check_resource(queue, image, usage, usage_name, who);
 }
 
-List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) {
-    constexpr const char* who = "vkrc::download_buffer";
-    check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "VK_BUFFER_USAGE_TRANSFER_SRC_BIT", who);
+void check_buffer_range(const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size, const char* who) {
     if (offset > buffer.size() || size > buffer.size() - offset) {
         throw UsageError(std::string(who) + ": " + std::to_string(size) + " bytes at offset " + std::to_string(offset) +
-                         " are not all in the " + std::to_string(buffer.size()) + "-byte buffer");
+                         " do not fit in the " + std::to_string(buffer.size()) + "-byte buffer");
     }
-    std::vector<std::byte> out(size);
-    if (size == 0) return out;
-    Buffer readback = staging_buffer(buffer.device(), size, MemoryUsage::readback);
-    OneTimeCommands commands(queue);
-    // Earlier submissions' writes to the buffer are made visible to the copy.
-    commands.memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-    VkBufferCopy region{offset, 0, size};
-    commands.fn().vkCmdCopyBuffer(commands.cmd(), buffer.vk(), readback.vk(), 1, &region);
-    commands.memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                            VK_ACCESS_2_HOST_READ_BIT);
-    commands.submit_and_wait();
-    readback.allocation().read(0, std::span<std::byte>(out));
-    return out;
 }
 
-VkDeviceSize image_data_size(const Image& image) {
-    const std::uint32_t texel = checked_texel_size(image, "vkrc::image_data_size");
-    VkDeviceSize total = 0;
-    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
-        const VkDeviceSize level_bytes = checked_mul(level_size(image, level, texel, "vkrc::image_data_size"),
-                                                     image.array_layers(), "vkrc::image_data_size");
-        if (total + level_bytes < total)
-            throw UsageError("vkrc::image_data_size: the image's size in bytes overflows 64 bits");
-        total += level_bytes;
+FormatBlock checked_block(const Image& image, const char* who) {
+    const FormatBlock block = format_block(image.format());
+    if (block.bytes == 0) {
+        throw UsageError(std::string(who) + ": format " + detail::enum_text(image.format()) +
+                         " is neither an uncompressed colour format nor block-compressed");
     }
-    return total;
+    if (image.samples() != VK_SAMPLE_COUNT_1_BIT) throw UsageError(std::string(who) + ": the image is multisampled");
+    return block;
 }
 
-void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
-                  const ImageUploadInfo& info) {
-    constexpr const char* who = "vkrc::upload_image";
-    check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_DST_BIT, "VK_IMAGE_USAGE_TRANSFER_DST_BIT", who);
-    const std::uint32_t texel = checked_texel_size(image, who);
+VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlock& block, const char* who) {
+    const VkExtent3D e = image.extent(level);
+    const VkDeviceSize columns = (VkDeviceSize(e.width) + block.width - 1) / block.width;
+    const VkDeviceSize rows = (VkDeviceSize(e.height) + block.height - 1) / block.height;
+    return checked_mul(checked_mul(checked_mul(columns, rows, who), e.depth, who), block.bytes, who);
+}
+
+void check_image_upload(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info,
+                        const char* who) {
+    checked_block(image, who);
     const VkDeviceSize expected = image_data_size(image);
     if (data.size() != expected) {
         throw UsageError(std::string(who) + ": " + std::to_string(data.size()) +
@@ -203,67 +134,82 @@ void upload_image(const Queue& queue, const Image& image, std::span<const std::b
     if (info.new_layout == VK_IMAGE_LAYOUT_UNDEFINED || info.new_layout == VK_IMAGE_LAYOUT_PREINITIALIZED) {
         throw UsageError(std::string(who) + ": new_layout must be a layout an image can be transitioned to");
     }
-    Buffer staging = staging_buffer(image.device(), expected, MemoryUsage::upload);
-    staging.allocation().write(0, data);
-
-    std::vector<VkBufferImageCopy> regions;
-    regions.reserve(image.mip_levels());
-    VkDeviceSize offset = 0;
-    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
-        VkBufferImageCopy r{};
-        r.bufferOffset = offset;
-        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, image.array_layers()};
-        r.imageExtent = image.extent(level);
-        regions.push_back(r);
-        offset += level_size(image, level, texel, who) * image.array_layers();
-    }
-    const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, image.mip_levels(), 0, image.array_layers()};
-    OneTimeCommands commands(queue);
-    // From whatever earlier work did with the image to the copy.
-    commands.image_barrier(image.vk(), info.old_layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, all);
-    commands.fn().vkCmdCopyBufferToImage(commands.cmd(), staging.vk(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                         static_cast<std::uint32_t>(regions.size()), regions.data());
-    // From the copy to whatever later work does with the image.
-    commands.image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, info.new_layout,
-                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                           VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, all);
-    commands.submit_and_wait();
 }
 
-List<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout, std::uint32_t mip_level,
-                               std::uint32_t array_layer) {
-    constexpr const char* who = "vkrc::download_image";
-    check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "VK_IMAGE_USAGE_TRANSFER_SRC_BIT", who);
+void check_image_download(const Image& image, VkImageLayout layout, std::uint32_t mip_level, std::uint32_t array_layer,
+                          const char* who) {
     if (mip_level >= image.mip_levels() || array_layer >= image.array_layers()) {
         throw UsageError(std::string(who) + ": level " + std::to_string(mip_level) + " layer " +
                          std::to_string(array_layer) + " is not in the image");
     }
     if (layout == VK_IMAGE_LAYOUT_UNDEFINED) throw UsageError(std::string(who) + ": the image's layout is UNDEFINED");
-    const std::uint32_t texel = checked_texel_size(image, who);
-    const VkDeviceSize size = level_size(image, mip_level, texel, who);
-    Buffer readback = staging_buffer(image.device(), size, MemoryUsage::readback);
-    const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, mip_level, 1, array_layer, 1};
-    OneTimeCommands commands(queue);
-    commands.image_barrier(image.vk(), layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, range);
-    VkBufferImageCopy region{};
-    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip_level, array_layer, 1};
-    region.imageExtent = image.extent(mip_level);
-    commands.fn().vkCmdCopyImageToBuffer(commands.cmd(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                         readback.vk(), 1, &region);
-    commands.image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout, VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                           VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, range);
-    commands.memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                            VK_ACCESS_2_HOST_READ_BIT);
-    commands.submit_and_wait();
-    std::vector<std::byte> out(size);
-    readback.allocation().read(0, std::span<std::byte>(out));
-    return out;
+    checked_block(image, who);
+}
+
+}  // namespace detail
+
+VkDeviceSize image_data_size(const Image& image) {
+    constexpr const char* who = "vkrc::image_data_size";
+    const FormatBlock block = detail::checked_block(image, who);
+    VkDeviceSize total = 0;
+    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
+        VkDeviceSize level_bytes;
+        if (__builtin_mul_overflow(detail::level_size(image, level, block, who), image.array_layers(), &level_bytes) ||
+            total + level_bytes < total)
+            throw UsageError("vkrc::image_data_size: the image's size in bytes overflows 64 bits");
+        total += level_bytes;
+    }
+    return total;
+}
+
+// The blocking path: an Uploader of the queue's own family, sized for the
+// one transfer, and a wait for its ticket.
+namespace {
+Uploader one_time_uploader(const Queue& queue, VkDeviceSize size) {
+    return Uploader::create({.queue = queue, .consumer_family = queue.family_index(), .staging_size = size});
+}
+}  // namespace
+
+void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) {
+    constexpr const char* who = "vkrc::upload_buffer";
+    detail::check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "VK_BUFFER_USAGE_TRANSFER_DST_BIT", who);
+    detail::check_buffer_range(buffer, offset, data.size(), who);
+    if (data.empty()) return;
+    Uploader uploader = one_time_uploader(queue, data.size());
+    uploader.upload_buffer(buffer, offset, data);
+    uploader.submit().wait_on_host();
+}
+
+List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) {
+    constexpr const char* who = "vkrc::download_buffer";
+    detail::check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "VK_BUFFER_USAGE_TRANSFER_SRC_BIT", who);
+    detail::check_buffer_range(buffer, offset, size, who);
+    if (size == 0) return {};
+    Uploader uploader = one_time_uploader(queue, 1);
+    Download download = uploader.download_buffer(buffer, offset, size);
+    uploader.submit();
+    return download.read();
+}
+
+void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
+                  const ImageUploadInfo& info) {
+    constexpr const char* who = "vkrc::upload_image";
+    detail::check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_DST_BIT, "VK_IMAGE_USAGE_TRANSFER_DST_BIT", who);
+    detail::check_image_upload(image, data, info, who);
+    Uploader uploader = one_time_uploader(queue, data.size());
+    uploader.upload_image(image, data, info);
+    uploader.submit().wait_on_host();
+}
+
+List<std::byte> download_image(const Queue& queue, const Image& image, VkImageLayout layout, std::uint32_t mip_level,
+                               std::uint32_t array_layer) {
+    constexpr const char* who = "vkrc::download_image";
+    detail::check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "VK_IMAGE_USAGE_TRANSFER_SRC_BIT", who);
+    detail::check_image_download(image, layout, mip_level, array_layer, who);
+    Uploader uploader = one_time_uploader(queue, 1);
+    Download download = uploader.download_image(image, layout, mip_level, array_layer);
+    uploader.submit();
+    return download.read();
 }
 
 VKRC_END_NAMESPACE

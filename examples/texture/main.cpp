@@ -30,15 +30,19 @@ std::array<std::uint8_t, 4> texel(std::uint32_t level, std::uint32_t x, std::uin
 }
 
 int run(bool validation) {
-    // 1. Instance, device, queue.
+    // 1. Instance, device, a graphics queue and, where the device has one,
+    //    a transfer queue of its own (else transfers share the graphics queue).
     auto instance = vkrc::Instance::create({.application_name = "vkrc texture", .validation = validation});
-    auto device = vkrc::Device::create(vkrc::PhysicalDevice::select(instance));
-    auto queue = device.default_queue();
+    auto device = vkrc::Device::create(vkrc::PhysicalDevice::select(instance), {.transfer_queue = true});
+    auto queue = device.queue_for(vkrc::QueueRole::graphics).queue;
+    auto transfer = device.queue_for(vkrc::QueueRole::transfer).queue;
     std::printf("device: %s\n", device.physical_device().name());
 
-    // 2. The texture, and every mip level generated on the CPU: upload_image
-    //    takes the levels one after the other, tightly packed, and leaves the
-    //    image in SHADER_READ_ONLY_OPTIMAL.
+    // 2. The texture, and every mip level generated on the CPU, streamed on
+    //    the transfer queue: the Uploader takes the levels one after the
+    //    other, tightly packed, and leaves the image in
+    //    SHADER_READ_ONLY_OPTIMAL. Nothing waits here; the draw's submit
+    //    waits on the ticket (step 6).
     auto texture = vkrc::Image::create(device, {.format = format,
                                                 .extent = {size, size, 1},
                                                 .mip_levels = levels,
@@ -51,7 +55,9 @@ int run(bool validation) {
             for (std::uint32_t x = 0; x < extent.width; ++x)
                 for (auto c : texel(level, x, y)) texels.push_back(std::byte{c});
     }
-    vkrc::upload_image(queue, texture, texels);
+    auto uploader = vkrc::Uploader::create({.queue = transfer});
+    uploader.upload_image(texture, texels);
+    const vkrc::Ticket uploaded = uploader.submit();
 
     // 3. A view of all levels, a sampler that picks the nearest texel of one
     //    level, and a descriptor set binding the two for the fragment shader.
@@ -97,6 +103,7 @@ int run(bool validation) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = pool.allocate();
     cmd.begin();
+    uploaded.record_acquire(cmd);  // the ownership acquire when the families differ
     auto to_attachment = vkrc::image_barrier(
         target.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -120,7 +127,8 @@ int run(bool validation) {
     cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
     cmd.end();
     auto done = vkrc::Fence::create(device);
-    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, done);
+    const vkrc::SemaphoreSubmit wait = uploaded.wait(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
+    vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, done);
     if (done.wait() != VK_SUCCESS) return 1;
 
     // 7. Read the target back and check every pixel: pixel x of a square

@@ -23,6 +23,17 @@ struct QueueRequest {
     List<float> queue_priorities = {1.0f};
 };
 
+// What a queue is for. Every device has a queue for each role: one it was
+// given, or the graphics queue when it has none of its own (see
+// DeviceCreateInfo::transfer_queue and Device::queue_for).
+enum class QueueRole : std::uint8_t { graphics, transfer, compute };
+
+// The family the queues of role would best come from, as vk-bootstrap looks
+// for it: transfer, a family with transfer and neither graphics nor compute;
+// compute, a family with compute and no graphics; graphics, the first family
+// with graphics and compute. -1 when the device has no such family.
+int find_dedicated_queue_family(const PhysicalDevice& physical_device, QueueRole role);
+
 // Mirrors VkDeviceCreateInfo. vkrc always turns on timelineSemaphore,
 // synchronization2, dynamicRendering and maintenance4 (it is built on them, and
 // SPIR-V compiled for Vulkan 1.3 needs maintenance4); set any other
@@ -30,8 +41,18 @@ struct QueueRequest {
 // Every member is optional and read during create() (lists and extension names
 // are copied): nothing need outlive the call.
 struct DeviceCreateInfo {
-    // Empty: one queue from the first family with graphics and compute.
+    // Empty: one queue from the first family with graphics and compute, plus
+    // the transfer and compute queues asked for below.
     List<QueueRequest> queue_requests{};
+    // With queue_requests empty: also a queue for transfers (streaming) and
+    // one for async compute, each from its dedicated family when the device
+    // has one, else another queue of the graphics family when it has room,
+    // else none (the role then shares the graphics queue). Device::queue_for
+    // reports what each role got. With queue_requests set, the roles are
+    // given to the requested queues (see queue_for) and these are ignored.
+    // Default false.
+    bool transfer_queue = false;
+    bool compute_queue = false;
     // Default none (vkrc adds VK_EXT_memory_budget, see below).
     List<const char*> enabled_extension_names{};
     // Default none (besides the four above).
@@ -46,6 +67,7 @@ struct DeviceCreateInfo {
 };
 
 class Queue;
+struct QueueAssignment;
 
 // A logical device; keeps its PhysicalDevice (and so its Instance) alive.
 class Device : public Handle<detail::DeviceState> {
@@ -70,6 +92,13 @@ public:
     Queue queue(std::uint32_t family_index, std::uint32_t index = 0) const;
     // The first queue created (the default request's queue).
     Queue default_queue() const;
+    // The queue that does role's work, and whether it is a queue of its own.
+    // graphics: the first queue whose family has graphics (else the first
+    // queue); transfer and compute: a queue of the role's dedicated family
+    // (find_dedicated_queue_family), else another queue than graphics' that
+    // can do the work (compute: also another than transfer's), else the
+    // graphics queue.
+    QueueAssignment queue_for(QueueRole role) const;
 
     // vkDeviceWaitIdle, then runs every deferred destruction.
     void wait_idle() const;
@@ -141,6 +170,16 @@ private:
     Queue(Device device, detail::QueueState* queue) noexcept : device_(std::move(device)), queue_(queue) {}
     Device device_;
     detail::QueueState* queue_ = nullptr;  // owned by the device
+};
+
+// What Device::queue_for found for a role.
+struct QueueAssignment {
+    Queue queue;
+    // The queue's family has only the role's kind of work (find_dedicated_queue_family).
+    bool dedicated_family = false;
+    // The role has no queue of its own: its work goes to the graphics queue
+    // (always false for graphics itself).
+    bool shares_graphics_queue = false;
 };
 
 namespace detail {
@@ -399,7 +438,8 @@ public:
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     List<Text> enabled_extensions;
-    List<QueueState> queues;  // made once, never grows: Queue handles point into it
+    List<QueueState> queues;                 // made once, never grows: Queue handles point into it
+    std::size_t role_queues[3] = {0, 0, 0};  // by QueueRole: an index into queues
     Atomic<bool> lost{false};
     OpenCommandBuffers commands;
     DeferredDestructor deferred;
@@ -409,6 +449,11 @@ private:
     // Reads one queue's timeline into its completed cache; false on failure.
     bool refresh(QueueState& queue) noexcept;
 };
+
+// Queue::submit that always signals the queue's timeline with the
+// submission's number, which it returns: a value to wait on at once, for
+// tickets (stream.cpp). Throws DeviceLostError on device loss.
+std::uint64_t submit_signalled(const Queue& queue, std::span<const VkSubmitInfo2> submits);
 
 // Converts any Vulkan handle to the word stored in a DeferredAction.
 template <class VkHandle>

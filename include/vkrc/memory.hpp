@@ -312,6 +312,18 @@ public:
         write(offset, &value, 1);
     }
     VkDeviceSize size() const noexcept { return size_; }
+    // The bytes [offset, offset + size) as a view of their own (a ring's
+    // slice): writes to it take offsets from its start. UsageError (with
+    // VKRC_RUNTIME_CHECKS) when the range is not inside this view.
+    WriteOnlyView slice(VkDeviceSize offset, VkDeviceSize size) const {
+#if VKRC_RUNTIME_CHECKS
+        detail::check_mapped_range("vkrc::WriteOnlyView::slice", offset, size, 1, size_);
+#endif
+        WriteOnlyView v;
+        v.mapped_ = mapped_ + offset;
+        v.size_ = size;
+        return v;
+    }
 
 private:
     friend class Allocation;

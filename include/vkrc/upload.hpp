@@ -1,7 +1,8 @@
 // Staging transfers: uploads into buffers and images (every mip level and
 // array layer, with the layout transitions) and downloads for reading back.
-// Each call records one command buffer from a transient pool, submits it on
-// the queue and waits for it: for loading and for tests, not per frame.
+// Each call is an Uploader's (vkrc/stream.hpp) upload or download on the
+// queue followed by a wait for its ticket: the simple path, for loading and
+// for tests, not per frame.
 #pragma once
 
 #include "vkrc/resource.hpp"
@@ -13,6 +14,16 @@ VKRC_BEGIN_NAMESPACE
 // Bytes per texel of an uncompressed colour format; 0 for formats the
 // staging functions do not handle (compressed, depth/stencil, planar).
 std::uint32_t format_texel_size(VkFormat format) noexcept;
+
+// The unit a format's data is copied in: a texel (1 x 1) of an uncompressed
+// colour format, or a block of a block-compressed one (BC, ETC2/EAC, ASTC
+// LDR). bytes is 0 for formats the staging functions do not handle.
+struct FormatBlock {
+    std::uint32_t bytes = 0;
+    std::uint32_t width = 1;
+    std::uint32_t height = 1;
+};
+FormatBlock format_block(VkFormat format) noexcept;
 
 // Copies data to buffer at offset through a staging buffer. The buffer needs
 // VK_BUFFER_USAGE_TRANSFER_DST_BIT. The copy waits for earlier submissions on
@@ -31,7 +42,7 @@ struct ImageUploadInfo {
 };
 
 // Bytes upload_image expects: every mip level of every array layer, tightly
-// packed, level by level and within a level layer by layer (level 0 layer 0,
+// packed (block-compressed levels in whole blocks, rounded up), level by level and within a level layer by layer (level 0 layer 0,
 // level 0 layer 1, ..., level 1 layer 0, ...).
 VkDeviceSize image_data_size(const Image& image);
 

@@ -17,4 +17,5 @@
 #include "vkrc/surface.hpp"
 #include "vkrc/swapchain.hpp"
 #include "vkrc/sync.hpp"
+#include "vkrc/stream.hpp"
 #include "vkrc/upload.hpp"

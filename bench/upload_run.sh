@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The upload run behind docs/benchmarks.md, on whatever device this machine
+# has: PROCESSES runs of bench/upload (default 3), each with its blocks, so
+# that the intervals include run-to-run spread. Writes one CSV into OUT,
+# headed by '# key: value' lines (device, driver, date, command, git
+# revision, host) that scripts/gen_bench_docs.py reads, with a process
+# column; copy it into docs/results/ and run the generator. No network.
+#
+#   bench/upload_run.sh BUILD_DIR OUT [NAME] [PROCESSES] [UPLOAD ARGS...]
+#
+# BUILD_DIR: a Release build with the bench (BUILD_DIR/bench/upload), e.g.
+#   cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_TESTS=OFF -DVKRC_BUILD_EXAMPLES=OFF
+#   cmake --build build-release -j --target upload
+# NAME: the result's file prefix (default: the date and a device slug).
+# UPLOAD ARGS: passed on (default --blocks 3 --reps 1000; lavapipe: --reps 250).
+set -euo pipefail
+if [ $# -lt 2 ]; then
+  echo "usage: bench/upload_run.sh BUILD_DIR OUT [NAME] [PROCESSES] [UPLOAD ARGS...]" >&2
+  exit 2
+fi
+build=$1
+out=$2
+name=${3:-}
+processes=${4:-3}
+shift $(($# < 4 ? $# : 4))
+args=("$@")
+[ ${#args[@]} -gt 0 ] || args=(--blocks 3 --reps 1000)
+upload="$build/bench/upload"
+[ -x "$upload" ] || { echo "upload_run.sh: no $upload (build the upload target first)" >&2; exit 1; }
+mkdir -p "$out"
+export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+revision=$(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)
+if git -C "$source_dir" status --porcelain 2>/dev/null | grep -q .; then revision="$revision (with local changes)"; fi
+driver=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverInfo/ {print $2; exit}' || true)
+driver_name=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverName/ {print $2; exit}' || true)
+[ -n "$driver_name" ] || driver_name="mesa-vulkan-drivers $(dpkg-query -W -f="\${Version}" mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+
+body="$out/tmp-upload-body.csv"
+: >"$body"
+device=""
+for p in $(seq 1 "$processes"); do
+  echo "== bench/upload ${args[*]} --csv FILE (process $p of $processes)" >&2
+  "$upload" "${args[@]}" --csv "$out/tmp-upload.csv" | tee "$out/tmp-upload.log"
+  [ -n "$device" ] || device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$out/tmp-upload.log" | head -1)
+  [ -s "$body" ] || head -1 "$out/tmp-upload.csv" | sed 's/^/process,/' >"$body"
+  tail -n +2 "$out/tmp-upload.csv" | sed "s/^/$p,/" >>"$body"
+done
+prefix=$name
+[ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+{
+  echo "# device: $device"
+  echo "# driver: ${driver_name:-unknown}${driver:+ $driver}"
+  echo "# date: $date_utc"
+  echo "# command: bench/upload ${args[*]} --csv FILE, $processes processes (Release build)"
+  echo "# git: $revision"
+  echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  cat "$body"
+} >"$out/$prefix-upload.csv"
+rm -f "$body" "$out/tmp-upload.csv" "$out/tmp-upload.log"
+echo "wrote $out/$prefix-upload.csv" >&2

@@ -1,0 +1,520 @@
+#include "vkrc/stream.hpp"
+
+#include "staging.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+// ---------------------------------------------------------------- Ticket
+
+SemaphoreSubmit Ticket::wait(VkPipelineStageFlags2 stages) const {
+    if (!queue) throw UsageError("vkrc::Ticket::wait: the ticket is empty");
+    SemaphoreSubmit s;
+    s.semaphore = queue.timeline_semaphore();
+    s.value = value;
+    // The acquire barriers (destination: all commands) come after the wait
+    // only when the wait covers their stages.
+    const bool acquires = !buffer_acquires.empty() || !image_acquires.empty();
+    s.stage_mask = acquires ? VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT : stages;
+    return s;
+}
+
+void Ticket::record_acquire(const CommandBuffer& cmd) const {
+    if (buffer_acquires.empty() && image_acquires.empty()) return;
+    cmd.pipeline_barrier({}, {buffer_acquires.data(), buffer_acquires.size()},
+                         {image_acquires.data(), image_acquires.size()});
+}
+
+namespace {
+// Reads queue's timeline into its completed cache and returns it.
+std::uint64_t refresh_completed(const Queue& queue) {
+    auto& d = *queue.device().state();
+    auto& q = *queue.state();
+    std::uint64_t value = 0;
+    d.check_result(d.fn.vkGetSemaphoreCounterValue(d.device, q.semaphore, &value), "vkGetSemaphoreCounterValue");
+    q.timeline.note_completed(value);
+    return q.timeline.completed();
+}
+
+void await(const Queue& queue, std::uint64_t value) {
+    auto& d = *queue.device().state();
+    d.await_submission(*queue.state(), value);
+    d.collect();
+}
+}  // namespace
+
+bool Ticket::done() const {
+    if (!queue || queue.state()->timeline.completed() >= value) return true;
+    return refresh_completed(queue) >= value || queue.device().lost();
+}
+
+void Ticket::wait_on_host() const {
+    if (queue) await(queue, value);
+}
+
+// ---------------------------------------------------------------- Download
+
+Ticket Download::ticket() const {
+    if (!batch_ || batch_->value.load() == 0) return {};
+    return Ticket{queue_, batch_->value.load(), {}, {}};
+}
+
+List<std::byte> Download::read() const {
+    const Ticket t = ticket();
+    if (!t) throw UsageError("vkrc::Download::read: the download is empty or its batch was not submitted");
+    t.wait_on_host();
+    List<std::byte> out(size_);
+    readback_.allocation().read(0, std::span<std::byte>(out.data(), out.size()));
+    return out;
+}
+
+// ---------------------------------------------------------------- StagingRing
+
+namespace detail {
+
+bool StagingRing::try_allocate(VkDeviceSize size, VkDeviceSize alignment, VkDeviceSize& offset) {
+    if (size > capacity_) return false;
+    VkDeviceSize place = 0;
+    if (!regions_.empty()) {
+        const VkDeviceSize head = regions_.back().end, tail = regions_.front().begin;
+        const VkDeviceSize aligned = (head + alignment - 1) / alignment * alignment;
+        if (head > tail && aligned + size <= capacity_) {
+            place = aligned;
+        } else if (head > tail && size <= tail) {
+            place = 0;  // wraps; the bytes after head stay unused this round
+        } else if (head < tail && aligned + size <= tail) {
+            place = aligned;
+        } else {
+            return false;
+        }
+    }
+    if (!regions_.empty() && regions_.back().value == 0 && regions_.back().end <= place) {
+        regions_.back().end = place + size;  // the open batch grows
+    } else {
+        regions_.push_back(Region{place, place + size, 0});
+    }
+    offset = place;
+    return true;
+}
+
+void StagingRing::tag_open(std::uint64_t value) noexcept {
+    for (std::size_t i = regions_.size(); i-- > 0 && regions_[i].value == 0;) regions_[i].value = value;
+}
+
+void StagingRing::retire(std::uint64_t completed) noexcept {
+    std::size_t n = 0;
+    while (n < regions_.size() && regions_[n].value != 0 && regions_[n].value <= completed) ++n;
+    regions_.erase_front(n);
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------- Uploader
+
+namespace {
+
+constexpr VkAccessFlags2 memory_rw = VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+
+const char* const create_who = "vkrc::Uploader::create";
+
+// The batch's first command: earlier work on the queue finishes writing and
+// reading what the copies touch (one barrier per batch, not per copy).
+void begin_batch(detail::UploaderState& s) {
+    // A command buffer whose batch completed: by the cached value, else by
+    // the semaphore's (so that a stream that never fills the ring, and so
+    // never reads the semaphore there, still reuses them).
+    for (int pass = 0; pass < 2 && !s.open && !s.recorded.empty(); ++pass) {
+        const std::uint64_t completed = pass == 0 ? s.queue.state()->timeline.completed() : refresh_completed(s.queue);
+        for (auto& r : s.recorded) {
+            if (r.value <= completed) {
+                s.open = r.cmd;
+                break;
+            }
+        }
+    }
+    if (!s.open) {
+        s.recorded.push_back({s.pool.allocate(), UINT64_MAX});
+        s.open = s.recorded.back().cmd;
+    }
+    s.open.begin(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
+    const VkMemoryBarrier2 b =
+        memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                       VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    s.open.pipeline_barrier({&b, 1}, {}, {});
+    s.batch = detail::Ref<detail::BatchValue>(new detail::BatchValue);
+}
+
+// The barriers after the copies recorded so far: ownership releases, or,
+// within the family, the copies made visible to later work and the images
+// moved to their new layouts. Recorded at the batch's end, and before a
+// download, which may read what an upload of the batch wrote.
+void record_ends(detail::UploaderState& s) {
+    VkMemoryBarrier2 visible = memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw);
+    const bool same_family = s.consumer_family == s.queue.family_index();
+    s.open.pipeline_barrier({&visible, same_family ? 1u : 0u}, {s.buffer_releases.data(), s.buffer_releases.size()},
+                            {s.image_ends.data(), s.image_ends.size()});
+    s.buffer_releases.clear();
+    s.image_ends.clear();
+}
+
+void end_batch(detail::UploaderState& s) {
+    record_ends(s);
+    if (s.host_reads) {
+        const VkMemoryBarrier2 b = memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        s.open.pipeline_barrier({&b, 1}, {}, {});
+    }
+    s.open.end();
+}
+
+// Submits the open batch; under the Uploader's lock.
+Ticket submit_batch(detail::UploaderState& s, std::span<const SemaphoreSubmit> waits) {
+    end_batch(s);
+    List<VkSemaphoreSubmitInfo> wait_infos;
+    for (const auto& w : waits) {
+        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        i.semaphore = w.semaphore;
+        i.value = w.value;
+        i.stageMask = w.stage_mask;
+        wait_infos.push_back(i);
+    }
+    VkCommandBufferSubmitInfo cmd{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cmd.commandBuffer = s.open.vk();
+    VkSubmitInfo2 info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(wait_infos.size());
+    info.pWaitSemaphoreInfos = wait_infos.data();
+    info.commandBufferInfoCount = 1;
+    info.pCommandBufferInfos = &cmd;
+    CommandBuffer open = std::move(s.open);
+    s.open = {};
+    s.host_reads = false;
+    std::uint64_t value;
+    try {
+        value = detail::submit_signalled(s.queue, {&info, 1});
+    } catch (...) {
+        // Nothing of the batch runs (or the device is lost): its ring space
+        // is free once the work before it is.
+        s.ring.tag_open(s.queue.state()->timeline.last_submitted());
+        s.pending = {};
+        throw;
+    }
+    detail::close_submitted({&open, 1});
+    for (auto& r : s.recorded) {
+        if (r.cmd == open) r.value = value;
+    }
+    s.ring.tag_open(value);
+    s.batch->value.store(value);
+    Ticket ticket = std::move(s.pending);
+    ticket.queue = s.queue;
+    ticket.value = value;
+    s.pending = {};
+    s.last = Ticket{s.queue, value, {}, {}};  // its acquires are recorded once, from the returned ticket
+    return ticket;
+}
+
+// Ring space for size bytes, waiting for the oldest batch while there is
+// none (after submitting the open batch when it is the one in the way).
+VkDeviceSize reserve(detail::UploaderState& s, VkDeviceSize size, VkDeviceSize alignment, const char* who) {
+    if (size > s.staging.size()) {
+        throw UsageError(std::string(who) + ": " + std::to_string(size) + " bytes do not fit in the " +
+                         std::to_string(s.staging.size()) + "-byte staging ring");
+    }
+    s.ring.retire(s.queue.state()->timeline.completed());
+    VkDeviceSize offset = 0;
+    while (!s.ring.try_allocate(size, alignment, offset)) {
+        s.ring.retire(refresh_completed(s.queue));
+        if (s.ring.try_allocate(size, alignment, offset)) break;
+        if (s.ring.oldest() == 0) {
+            // The batch's acquires go with the next ticket, which covers it.
+            Ticket carried = submit_batch(s, {});
+            s.pending.buffer_acquires = std::move(carried.buffer_acquires);
+            s.pending.image_acquires = std::move(carried.image_acquires);
+        }
+        await(s.queue, s.ring.oldest());
+        s.ring.retire(s.queue.device().lost() ? UINT64_MAX - 1 : s.queue.state()->timeline.completed());
+    }
+    return offset;
+}
+
+void open_batch(detail::UploaderState& s) {
+    if (!s.open) begin_batch(s);
+}
+
+}  // namespace
+
+Uploader Uploader::create(const UploaderCreateInfo& info) {
+    if (!info.queue) throw UsageError(std::string(create_who) + ": the Queue is empty");
+    if (info.staging_size == 0) throw UsageError(std::string(create_who) + ": staging_size is 0");
+    const Device& device = info.queue.device();
+    detail::Ref<detail::UploaderState> state(new detail::UploaderState);
+    auto& s = *state;
+    s.queue = info.queue;
+    s.consumer_family = info.consumer_family != VK_QUEUE_FAMILY_IGNORED
+                            ? info.consumer_family
+                            : device.queue_for(QueueRole::graphics).queue.family_index();
+    if (s.consumer_family >= device.physical_device().queue_families().size()) {
+        throw UsageError(std::string(create_who) + ": consumer_family " + std::to_string(s.consumer_family) +
+                         " does not exist");
+    }
+    BufferCreateInfo staging;
+    staging.size = info.staging_size;
+    staging.usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+    staging.memory.usage = MemoryUsage::upload;
+    staging.memory.required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;  // written through a WriteOnlyView
+    s.staging = Buffer::create(device, staging);
+    s.staging_view = s.staging.allocation().write_only();
+    s.ring = detail::StagingRing(info.staging_size);
+    s.pool = CommandPool::create(device, {VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, s.queue.family_index()});
+    return Uploader(std::move(state));
+}
+
+const Queue& Uploader::queue() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Uploader::queue");
+    return state_->queue;
+}
+
+VkDeviceSize Uploader::staging_size() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Uploader::staging_size");
+    return state_->staging.size();
+}
+
+void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) const {
+    constexpr const char* who = "vkrc::Uploader::upload_buffer";
+    VKRC_REQUIRE_STATE(who);
+    auto& s = *state_;
+    detail::check_transfer(s.queue, buffer, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "VK_BUFFER_USAGE_TRANSFER_DST_BIT", who);
+    detail::check_buffer_range(buffer, offset, data.size(), who);
+    if (data.empty()) return;
+    LockGuard lock(s.mutex);
+    const VkDeviceSize at = reserve(s, data.size(), 4, who);
+    s.staging_view.write(at, data);
+    open_batch(s);
+    const VkBufferCopy region{at, offset, data.size()};
+    s.open.copy_buffer(s.staging.vk(), buffer.vk(), {&region, 1});
+    const std::uint32_t family = s.queue.family_index();
+    if (s.consumer_family == family) return;
+    s.buffer_releases.push_back(buffer_ownership_release(buffer.vk(), family, s.consumer_family,
+                                                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                         offset, data.size()));
+    s.pending.buffer_acquires.push_back(buffer_ownership_acquire(
+        buffer.vk(), family, s.consumer_family, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw, offset, data.size()));
+}
+
+namespace {
+
+// One region per mip level (every layer), from offset on in the staging ring.
+List<VkBufferImageCopy> level_regions(const Image& image, VkDeviceSize offset, const FormatBlock& block,
+                                      const char* who) {
+    List<VkBufferImageCopy> regions;
+    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
+        VkBufferImageCopy r{};
+        r.bufferOffset = offset;
+        r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, image.array_layers()};
+        r.imageExtent = image.extent(level);
+        regions.push_back(r);
+        offset += detail::level_size(image, level, block, who) * image.array_layers();
+    }
+    return regions;
+}
+
+}  // namespace
+
+void Uploader::upload_image(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info) const {
+    constexpr const char* who = "vkrc::Uploader::upload_image";
+    VKRC_REQUIRE_STATE(who);
+    auto& s = *state_;
+    detail::check_transfer(s.queue, image, VK_IMAGE_USAGE_TRANSFER_DST_BIT, "VK_IMAGE_USAGE_TRANSFER_DST_BIT", who);
+    detail::check_image_upload(image, data, info, who);
+    const FormatBlock block = detail::checked_block(image, who);
+    LockGuard lock(s.mutex);
+    // Buffer offsets of image copies are multiples of the block (and of 4).
+    const VkDeviceSize at = reserve(s, data.size(), std::lcm<VkDeviceSize>(block.bytes, 16), who);
+    s.staging_view.write(at, data);
+    open_batch(s);
+    const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, image.mip_levels(), 0, image.array_layers()};
+    const auto to_copy = image_barrier(image.vk(), all, info.old_layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    s.open.pipeline_barrier({}, {}, {&to_copy, 1});
+    const auto regions = level_regions(image, at, block, who);
+    s.open.copy_buffer_to_image(s.staging.vk(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                {regions.data(), regions.size()});
+    const std::uint32_t family = s.queue.family_index();
+    if (s.consumer_family == family) {
+        s.image_ends.push_back(image_barrier(image.vk(), all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, info.new_layout,
+                                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                             VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
+        return;
+    }
+    s.image_ends.push_back(image_ownership_release(image.vk(), all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                                   info.new_layout, family, s.consumer_family,
+                                                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
+    s.pending.image_acquires.push_back(image_ownership_acquire(image.vk(), all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                                               info.new_layout, family, s.consumer_family,
+                                                               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
+}
+
+namespace {
+
+// A readback buffer of size bytes for a download recorded in the open batch.
+Buffer readback_buffer(detail::UploaderState& s, VkDeviceSize size) {
+    BufferCreateInfo info;
+    info.size = size;
+    info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    info.memory.usage = MemoryUsage::readback;
+    Buffer readback = Buffer::create(s.queue.device(), info);
+    open_batch(s);
+    record_ends(s);
+    s.host_reads = true;
+    return readback;
+}
+
+}  // namespace
+
+Download Uploader::download_buffer(const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) const {
+    constexpr const char* who = "vkrc::Uploader::download_buffer";
+    VKRC_REQUIRE_STATE(who);
+    auto& s = *state_;
+    detail::check_transfer(s.queue, buffer, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, "VK_BUFFER_USAGE_TRANSFER_SRC_BIT", who);
+    detail::check_buffer_range(buffer, offset, size, who);
+    if (size == 0) throw UsageError(std::string(who) + ": size is 0");
+    LockGuard lock(s.mutex);
+    Download d;
+    d.readback_ = readback_buffer(s, size);
+    const VkBufferCopy region{offset, 0, size};
+    s.open.copy_buffer(buffer.vk(), d.readback_.vk(), {&region, 1});
+    d.queue_ = s.queue;
+    d.batch_ = s.batch;
+    d.size_ = size;
+    return d;
+}
+
+Download Uploader::download_image(const Image& image, VkImageLayout layout, std::uint32_t mip_level,
+                                  std::uint32_t array_layer) const {
+    constexpr const char* who = "vkrc::Uploader::download_image";
+    VKRC_REQUIRE_STATE(who);
+    auto& s = *state_;
+    detail::check_transfer(s.queue, image, VK_IMAGE_USAGE_TRANSFER_SRC_BIT, "VK_IMAGE_USAGE_TRANSFER_SRC_BIT", who);
+    detail::check_image_download(image, layout, mip_level, array_layer, who);
+    const VkDeviceSize size = detail::level_size(image, mip_level, detail::checked_block(image, who), who);
+    LockGuard lock(s.mutex);
+    Download d;
+    d.readback_ = readback_buffer(s, size);
+    const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, mip_level, 1, array_layer, 1};
+    const auto to_copy = image_barrier(image.vk(), range, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    s.open.pipeline_barrier({}, {}, {&to_copy, 1});
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, mip_level, array_layer, 1};
+    region.imageExtent = image.extent(mip_level);
+    s.open.copy_image_to_buffer(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, d.readback_.vk(), {&region, 1});
+    s.image_ends.push_back(image_barrier(image.vk(), range, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
+                                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+                                         VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
+    d.queue_ = s.queue;
+    d.batch_ = s.batch;
+    d.size_ = size;
+    return d;
+}
+
+Ticket Uploader::submit(std::span<const SemaphoreSubmit> waits) const {
+    VKRC_REQUIRE_STATE("vkrc::Uploader::submit");
+    auto& s = *state_;
+    LockGuard lock(s.mutex);
+    if (!s.open) return s.last;
+    return submit_batch(s, waits);
+}
+
+// ---------------------------------------------------------------- FrameRing
+
+FrameRing FrameRing::create(const FrameRingCreateInfo& info) {
+    constexpr const char* who = "vkrc::FrameRing::create";
+    if (!info.queue) throw UsageError(std::string(who) + ": the Queue is empty");
+    if (info.frame_size == 0 || info.frames_in_flight == 0) {
+        throw UsageError(std::string(who) + ": frame_size and frames_in_flight must not be 0");
+    }
+    const Device& device = info.queue.device();
+    const auto& limits = device.physical_device().properties().limits;
+    detail::Ref<detail::FrameRingState> state(new detail::FrameRingState);
+    auto& s = *state;
+    s.queue = info.queue;
+    s.min_alignment = std::lcm(limits.minUniformBufferOffsetAlignment, limits.minStorageBufferOffsetAlignment);
+    // Blocks start at multiples of the alignment, so slices' offsets are too.
+    s.frame_size = (info.frame_size + s.min_alignment - 1) / s.min_alignment * s.min_alignment;
+    BufferCreateInfo buffer;
+    buffer.size = s.frame_size * info.frames_in_flight;
+    buffer.usage = info.usage;
+    buffer.memory.usage = MemoryUsage::upload;
+    buffer.memory.required_flags = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;  // written through WriteOnlyViews
+    s.buffer = Buffer::create(device, buffer);
+    s.view = s.buffer.allocation().write_only();
+    s.frame_values = List<std::uint64_t>(info.frames_in_flight);
+    s.index = info.frames_in_flight - 1;  // the first begin_frame takes block 0
+    return FrameRing(std::move(state));
+}
+
+const Buffer& FrameRing::buffer() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::FrameRing::buffer");
+    return state_->buffer;
+}
+
+VkDeviceSize FrameRing::frame_size() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::FrameRing::frame_size");
+    return state_->frame_size;
+}
+
+std::uint32_t FrameRing::frame_index() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::FrameRing::frame_index");
+    return state_->index;
+}
+
+void FrameRing::begin_frame() const {
+    VKRC_REQUIRE_STATE("vkrc::FrameRing::begin_frame");
+    auto& s = *state_;
+    if (s.open) throw UsageError("vkrc::FrameRing::begin_frame: the frame before was not ended (end_frame)");
+    s.index = (s.index + 1) % static_cast<std::uint32_t>(s.frame_values.size());
+    const std::uint64_t value = s.frame_values[s.index];
+    if (value != 0 && s.queue.state()->timeline.completed() < value) await(s.queue, value);
+    s.head = 0;
+    s.open = true;
+}
+
+void FrameRing::end_frame() const {
+    VKRC_REQUIRE_STATE("vkrc::FrameRing::end_frame");
+    auto& s = *state_;
+    if (!s.open) throw UsageError("vkrc::FrameRing::end_frame: no frame was begun (begin_frame)");
+    s.frame_values[s.index] = s.queue.state()->timeline.covering_value();
+    s.open = false;
+}
+
+FrameAllocation FrameRing::allocate(VkDeviceSize size, VkDeviceSize alignment) const {
+    constexpr const char* who = "vkrc::FrameRing::allocate";
+    VKRC_REQUIRE_STATE(who);
+    auto& s = *state_;
+    if (!s.open) throw UsageError(std::string(who) + ": outside begin_frame / end_frame");
+    if (alignment == 0) alignment = s.min_alignment;
+    const VkDeviceSize at = (s.head + alignment - 1) / alignment * alignment;
+    if (at > s.frame_size || size > s.frame_size - at) {
+        throw UsageError(std::string(who) + ": " + std::to_string(size) + " bytes do not fit in the frame's block (" +
+                         std::to_string(s.frame_size - std::min(at, s.frame_size)) + " of " +
+                         std::to_string(s.frame_size) + " bytes left)");
+    }
+    s.head = at + size;
+    const VkDeviceSize offset = VkDeviceSize(s.index) * s.frame_size + at;
+    return {s.buffer.vk(), offset, s.view.slice(offset, size)};
+}
+
+void write_dynamic_buffer(const DescriptorSet& set, std::uint32_t binding, const FrameRing& ring, VkDeviceSize range,
+                          bool storage) {
+    if (!ring) throw UsageError("vkrc::write_dynamic_buffer: the FrameRing is empty");
+    const VkDescriptorType type =
+        storage ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC;
+    set.write_buffer(binding, type, ring.buffer(), 0, range);
+}
+
+VKRC_END_NAMESPACE
