@@ -30,11 +30,10 @@ upload="$build/bench/upload"
 mkdir -p "$out"
 export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
-revision=$(git -C "$source_dir" rev-parse --short HEAD 2>/dev/null || echo unknown)
-if git -C "$source_dir" status --porcelain 2>/dev/null | grep -q .; then revision="$revision (with local changes)"; fi
-driver=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverInfo/ {print $2; exit}' || true)
-driver_name=$(vulkaninfo --summary 2>/dev/null | awk -F'= ' '/driverName/ {print $2; exit}' || true)
-[ -n "$driver_name" ] || driver_name="mesa-vulkan-drivers $(dpkg-query -W -f="\${Version}" mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+# shellcheck source=bench/run_header.sh
+source "$source_dir/bench/run_header.sh"
+revision=$(bench_revision "$build")
+driver=$(bench_driver)
 date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
 
 body="$out/tmp-upload-body.csv"
@@ -51,7 +50,7 @@ prefix=$name
 [ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
 {
   echo "# device: $device"
-  echo "# driver: ${driver_name:-unknown}${driver:+ $driver}"
+  echo "# driver: $driver"
   echo "# date: $date_utc"
   echo "# command: bench/upload ${args[*]} --csv FILE, $processes processes (Release build)"
   echo "# git: $revision"
