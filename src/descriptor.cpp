@@ -32,14 +32,34 @@ DescriptorSetState::~DescriptorSetState() {
 
 namespace {
 
-// The cheap checks of a layout's binding flags that give a clearer message
-// than the validation layer (VUID-VkDescriptorSetLayoutCreateInfo-flags-03000,
+// Immutable samplers: one per descriptor of a sampler binding, of the
+// layout's device (VUID-VkDescriptorSetLayoutBinding-descriptorType-00282).
+void check_immutable_samplers(const Device& device, const DescriptorSetLayoutBinding& b) {
+    if (b.immutable_samplers.empty()) return;
+    const std::string where = "vkrc::DescriptorSetLayout::create: binding " + std::to_string(b.binding);
+    if (b.descriptor_type != VK_DESCRIPTOR_TYPE_SAMPLER &&
+        b.descriptor_type != VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER)
+        throw UsageError(where + " has immutable samplers but type " + detail::enum_text(b.descriptor_type));
+    if (b.immutable_samplers.size() != b.descriptor_count) {
+        throw UsageError(where + " has " + std::to_string(b.immutable_samplers.size()) + " immutable samplers for " +
+                         std::to_string(b.descriptor_count) + " descriptors");
+    }
+    for (const auto& sampler : b.immutable_samplers) {
+        if (!sampler || !(sampler.device() == device))
+            throw UsageError(where + ": an immutable sampler is empty or belongs to another device");
+    }
+}
+
+// The cheap checks of a layout's bindings that give a clearer message than
+// the validation layer: immutable samplers, and binding flags
+// (VUID-VkDescriptorSetLayoutCreateInfo-flags-03000,
 // VUID-VkDescriptorSetLayoutBindingFlagsCreateInfo-pBindingFlags-03004).
-void check_binding_flags(const DescriptorSetLayoutCreateInfo& info) {
+void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
     constexpr const char* who = "vkrc::DescriptorSetLayout::create";
     std::uint32_t highest = 0;
     for (const auto& b : info.bindings) highest = std::max(highest, b.binding);
     for (const auto& b : info.bindings) {
+        check_immutable_samplers(device, b);
         if ((b.binding_flags & VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT) &&
             !(info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT)) {
             throw UsageError(std::string(who) + ": binding " + std::to_string(b.binding) +
@@ -64,15 +84,23 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
             "vkrc::DescriptorSetLayout::create: PUSH_DESCRIPTOR_BIT_KHR needs VK_KHR_push_descriptor enabled on the "
             "device");
     }
-    check_binding_flags(info);
+    check_bindings(device, info);
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     std::vector<VkDescriptorSetLayoutBinding> bindings;
     std::vector<VkDescriptorBindingFlags> flags;
+    // Every binding's immutable samplers, one after another; reserved whole
+    // so that the pointers into it stay valid.
+    std::size_t sampler_count = 0;
+    for (const auto& b : info.bindings) sampler_count += b.immutable_samplers.size();
+    std::vector<VkSampler> samplers;
+    samplers.reserve(sampler_count);
     bindings.reserve(info.bindings.size());
     flags.reserve(info.bindings.size());
     bool any_flags = false;
     for (const auto& b : info.bindings) {
-        bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, nullptr});
+        const VkSampler* immutable = b.immutable_samplers.empty() ? nullptr : samplers.data() + samplers.size();
+        for (const auto& sampler : b.immutable_samplers) samplers.push_back(sampler.vk());
+        bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, immutable});
         flags.push_back(b.binding_flags);
         any_flags = any_flags || b.binding_flags != 0;
         if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {

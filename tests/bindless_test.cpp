@@ -43,34 +43,33 @@ vkrc::Device bindless_device(const vkrc::PhysicalDevice& physical) {
 // Output buffer, sampler, and a large bindless array of sampled images last.
 vkrc::DescriptorSetLayout bindless_layout(const vkrc::Device& device) {
     return vkrc::DescriptorSetLayout::create(
-        device, {.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT,
-                 .bindings = {{.binding = 0,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
-                              {.binding = 1,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
-                              {.binding = 2,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
-                               .descriptor_count = max_textures,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT,
-                               .binding_flags = bindless_flags}}});
+        device,
+        {.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT,
+         .bindings = {
+             {.binding = 0,
+              .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+              .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+             {.binding = 1, .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLER, .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+             {.binding = 2,
+              .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+              .descriptor_count = max_textures,
+              .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT,
+              .binding_flags = bindless_flags}}});
 }
 
 vkrc::DescriptorPool bindless_pool(const vkrc::Device& device) {
-    return vkrc::DescriptorPool::create(
-        device, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT |
-                          VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT,
-                 .max_sets = 1,
-                 .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-                                {VK_DESCRIPTOR_TYPE_SAMPLER, 1},
-                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 64}}});
+    return vkrc::DescriptorPool::create(device, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT |
+                                                          VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT,
+                                                 .max_sets = 1,
+                                                 .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+                                                                {VK_DESCRIPTOR_TYPE_SAMPLER, 1},
+                                                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 64}}});
 }
 
 // A 1x1 R32_UINT texture holding value, cleared and made shader-readable by cmd.
 vkrc::Image uint_texture(const vkrc::Device& device, const vkrc::CommandBuffer& cmd, std::uint32_t value) {
-    auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R32_UINT,
-                                              .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    auto image = vkrc::Image::create(
+        device, {.format = VK_FORMAT_R32_UINT, .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     auto to_dst = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                       VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_CLEAR_BIT,
                                       VK_ACCESS_2_TRANSFER_WRITE_BIT);
@@ -79,10 +78,10 @@ vkrc::Image uint_texture(const vkrc::Device& device, const vkrc::CommandBuffer& 
     color.uint32[0] = value;
     const VkImageSubresourceRange whole{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
     cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&whole, 1));
-    auto to_read = vkrc::image_barrier(
-        image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-        VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    auto to_read =
+        vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
     cmd.pipeline_barrier({}, {}, std::span(&to_read, 1));
     return image;
 }
@@ -147,9 +146,10 @@ TEST_F(VulkanTest, BindlessMisuseIsAUsageError) {
         << "UPDATE_AFTER_BIND without UPDATE_AFTER_BIND_POOL";
     auto variable_first = textures;
     variable_first.binding_flags = VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT;
-    EXPECT_THROW(vkrc::DescriptorSetLayout::create(
-                     device, {.bindings = {variable_first, {.binding = 3, .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}}),
-                 vkrc::UsageError)
+    EXPECT_THROW(
+        vkrc::DescriptorSetLayout::create(
+            device, {.bindings = {variable_first, {.binding = 3, .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}}),
+        vkrc::UsageError)
         << "VARIABLE_DESCRIPTOR_COUNT on a binding below the highest";
 
     auto set_layout = bindless_layout(device);

@@ -24,14 +24,12 @@ void run_through_addresses(const vkrc::Device& device, const vkrc::Queue& queue,
                            const vkrc::SharedAllocator& allocator) {
     constexpr std::uint32_t count = 100;
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    auto src = vkrc::Buffer::create(device, {.size = count * 4,
-                                             .usage = usage,
-                                             .memory = {.usage = vkrc::MemoryUsage::upload},
-                                             .allocator = allocator});
-    auto dst = vkrc::Buffer::create(device, {.size = count * 4,
-                                             .usage = usage,
-                                             .memory = {.usage = vkrc::MemoryUsage::readback},
-                                             .allocator = allocator});
+    auto src = vkrc::Buffer::create(
+        device,
+        {.size = count * 4, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::upload}, .allocator = allocator});
+    auto dst = vkrc::Buffer::create(
+        device,
+        {.size = count * 4, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::readback}, .allocator = allocator});
     ASSERT_NE(src.device_address(), 0u);
     ASSERT_NE(dst.device_address(), 0u);
     std::vector<std::uint32_t> values(count);
@@ -44,7 +42,8 @@ void run_through_addresses(const vkrc::Device& device, const vkrc::Queue& queue,
         vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::device_address_comp));
     vkrc_test::OneShotCommands s(queue);
     s.cmd.bind_pipeline(pipeline);
-    s.cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, Params{src.device_address(), dst.device_address(), count, 0});
+    s.cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT,
+                         Params{src.device_address(), dst.device_address(), count, 0});
     s.cmd.dispatch((count + 63) / 64);
     const auto to_host = vkrc_test::compute_to_host();
     s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
@@ -93,9 +92,9 @@ TEST_F(DeviceAddressTest, DeviceAddressBlocksAreKeptApartByThePoolAllocator) {
 // vkrc binds one allocation to each resource, which sparse resources must
 // not have: they are refused before anything is created.
 TEST_F(VulkanTest, SparseBuffersAndImagesAreRefused) {
-    for (VkBufferCreateFlags flags : {VkBufferCreateFlags(VK_BUFFER_CREATE_SPARSE_BINDING_BIT),
-                                      VkBufferCreateFlags(VK_BUFFER_CREATE_SPARSE_BINDING_BIT |
-                                                          VK_BUFFER_CREATE_SPARSE_RESIDENCY_BIT)}) {
+    for (VkBufferCreateFlags flags :
+         {VkBufferCreateFlags(VK_BUFFER_CREATE_SPARSE_BINDING_BIT),
+          VkBufferCreateFlags(VK_BUFFER_CREATE_SPARSE_BINDING_BIT | VK_BUFFER_CREATE_SPARSE_RESIDENCY_BIT)}) {
         try {
             vkrc::Buffer::create(device, {.flags = flags, .size = 4096, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
             ADD_FAILURE() << "a sparse buffer was created";

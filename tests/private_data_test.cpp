@@ -7,8 +7,7 @@ namespace {
 using vkrc_test::VulkanTest;
 
 TEST_F(VulkanTest, PrivateDataOnSeveralObjectTypes) {
-    if (!vkrc_test::supported_features(physical_device).v13.privateData)
-        GTEST_SKIP() << "the device lacks privateData";
+    if (!vkrc_test::supported_features(physical_device).v13.privateData) GTEST_SKIP() << "the device lacks privateData";
     vkrc::DeviceCreateInfo info;
     info.vulkan13_features.privateData = VK_TRUE;
     device = vkrc::Device::create(physical_device, info);

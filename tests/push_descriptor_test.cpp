@@ -29,10 +29,11 @@ vkrc::Buffer output_buffer(const vkrc::Device& device) {
 }
 
 vkrc::DescriptorSetLayout storage_layout(const vkrc::Device& device, VkDescriptorSetLayoutCreateFlags flags) {
-    return vkrc::DescriptorSetLayout::create(device, {.flags = flags,
-                                                      .bindings = {{.binding = 0,
-                                                                    .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                                                    .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    return vkrc::DescriptorSetLayout::create(device,
+                                             {.flags = flags,
+                                              .bindings = {{.binding = 0,
+                                                            .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                            .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
 }
 
 // fill_pattern.comp with set 0 of set_layout.
@@ -40,9 +41,9 @@ struct FillPipeline {
     vkrc::PipelineLayout layout;
     vkrc::ComputePipeline pipeline;
     explicit FillPipeline(const vkrc::DescriptorSetLayout& set_layout)
-        : layout(vkrc::PipelineLayout::create(set_layout.device(),
-                                              {.set_layouts = {set_layout},
-                                               .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}})),
+        : layout(vkrc::PipelineLayout::create(
+              set_layout.device(),
+              {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}})),
           pipeline(vkrc::ComputePipeline::create(
               layout, vkrc::ShaderModule::create(set_layout.device(), vkrc_shaders::fill_pattern_comp))) {}
     void dispatch(const vkrc::CommandBuffer& cmd, std::uint32_t seed) const {
@@ -59,8 +60,8 @@ protected:
         VulkanTest::SetUp();
         if (!physical_device.supports_extension(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME))
             GTEST_SKIP() << "the device lacks VK_KHR_push_descriptor";
-        device = vkrc::Device::create(physical_device,
-                                      {.enabled_extension_names = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME}});
+        device =
+            vkrc::Device::create(physical_device, {.enabled_extension_names = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME}});
         queue = device.default_queue();
     }
 };

@@ -28,7 +28,7 @@ protected:
                             "and VK_FORMAT_FEATURE_COSITED_CHROMA_SAMPLES_BIT";
         }
         location = (f & VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT) ? VK_CHROMA_LOCATION_MIDPOINT
-                                                                        : VK_CHROMA_LOCATION_COSITED_EVEN;
+                                                                       : VK_CHROMA_LOCATION_COSITED_EVEN;
         vkrc::DeviceCreateInfo info;
         info.vulkan11_features.samplerYcbcrConversion = VK_TRUE;
         device = vkrc::Device::create(physical_device, info);
@@ -51,12 +51,43 @@ TEST_F(YcbcrTest, YcbcrConversionWithSamplerAndImageView) {
                                                   .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
                                                   .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
                                                   .ycbcr_conversion = conversion});
-    auto image = vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto image =
+        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
     auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
     EXPECT_NE(sampler.vk(), VK_NULL_HANDLE);
     EXPECT_NE(view.vk(), VK_NULL_HANDLE);
     EXPECT_EQ(conversion.use_count(), 3u) << "the sampler and the view keep the conversion alive";
     conversion.reset();  // the view and sampler still hold it: no validation error at their destruction
+}
+
+vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcrConversion& conversion) {
+    return vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                          .min_filter = VK_FILTER_NEAREST,
+                                          .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                          .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .ycbcr_conversion = conversion});
+}
+
+// Shaders reach a Y'CbCr sampler only as an immutable sampler of a set layout,
+// which keeps it (and so the conversion) alive.
+TEST_F(YcbcrTest, YcbcrSamplerImmutableInASetLayout) {
+    auto conversion = nv12_conversion(device);
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                               .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT,
+                               .immutable_samplers = {ycbcr_sampler(device, conversion)}}}});
+    EXPECT_EQ(conversion.use_count(), 2u) << "held by the layout's sampler";
+    // A multi-planar format may take several descriptors of the pool (up to one per plane).
+    auto pool = vkrc::DescriptorPool::create(
+        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3}}});
+    auto set = pool.allocate(set_layout);
+    auto image =
+        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+    set.write_image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 TEST_F(YcbcrTest, YcbcrMisuseIsAUsageError) {
@@ -66,6 +97,20 @@ TEST_F(YcbcrTest, YcbcrMisuseIsAUsageError) {
     auto other = vkrc::Device::create(physical_device, info);
     EXPECT_THROW(vkrc::Sampler::create(device, {.ycbcr_conversion = nv12_conversion(other)}), vkrc::UsageError)
         << "a conversion of another device";
+    auto sampler = ycbcr_sampler(device, nv12_conversion(device));
+    EXPECT_THROW(vkrc::DescriptorSetLayout::create(
+                     device, {.bindings = {{.binding = 0,
+                                            .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                            .descriptor_count = 2,
+                                            .immutable_samplers = {sampler}}}}),
+                 vkrc::UsageError)
+        << "one immutable sampler for two descriptors";
+    EXPECT_THROW(
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+                                                                 .immutable_samplers = {sampler}}}}),
+        vkrc::UsageError)
+        << "immutable samplers on a sampled-image binding";
 }
 
 }  // namespace

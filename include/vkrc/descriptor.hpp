@@ -15,9 +15,9 @@ class DescriptorPoolState;
 class DescriptorSetState;
 }  // namespace detail
 
-// Mirrors VkDescriptorSetLayoutBinding (without immutable samplers), plus
-// the binding's entry of VkDescriptorSetLayoutBindingFlagsCreateInfo.
-// Every member is optional (defaults: binding 0, one uniform buffer, all stages, no flags).
+// Mirrors VkDescriptorSetLayoutBinding, plus the binding's entry of
+// VkDescriptorSetLayoutBindingFlagsCreateInfo. Every member is optional
+// (defaults: binding 0, one uniform buffer, all stages, no flags, no immutable samplers).
 struct DescriptorSetLayoutBinding {
     std::uint32_t binding = 0;
     VkDescriptorType descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
@@ -29,6 +29,10 @@ struct DescriptorSetLayoutBinding {
     // VARIABLE_DESCRIPTOR_COUNT (the highest binding only). Each needs its
     // descriptorBinding* feature enabled on the device (vulkan12_features).
     VkDescriptorBindingFlags binding_flags = 0;
+    // For SAMPLER and COMBINED_IMAGE_SAMPLER bindings: empty, or one sampler
+    // per descriptor (descriptor_count of them), fixed in the layout, which
+    // keeps them alive. Samplers with a Y'CbCr conversion must be given here.
+    List<Sampler> immutable_samplers{};
 };
 
 // Mirrors VkDescriptorSetLayoutCreateInfo.
