@@ -23,7 +23,7 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
     try {
         info.memory = detail::allocate_device_memory(
             device, request.requirements.size, type, dedicated_info ? request.dedicated_buffer : VK_NULL_HANDLE,
-            dedicated_info ? request.dedicated_image : VK_NULL_HANDLE, &info.mapped);
+            dedicated_info ? request.dedicated_image : VK_NULL_HANDLE, request.device_address, &info.mapped);
     } catch (...) {
         LockGuard lock(mutex_);
         --memory_objects_;

@@ -1,7 +1,10 @@
 #include "vkrc/descriptor.hpp"
 
+#include "vkrc/descriptor_template.hpp"
+
 #include "enum_names.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -27,18 +30,94 @@ DescriptorSetState::~DescriptorSetState() {
 
 }  // namespace detail
 
+namespace {
+
+// Immutable samplers: one per descriptor of a sampler binding, of the
+// layout's device (VUID-VkDescriptorSetLayoutBinding-descriptorType-00282).
+void check_immutable_samplers(const Device& device, const DescriptorSetLayoutBinding& b) {
+    if (b.immutable_samplers.empty()) return;
+    const std::string where = "vkrc::DescriptorSetLayout::create: binding " + std::to_string(b.binding);
+    if (b.descriptor_type != VK_DESCRIPTOR_TYPE_SAMPLER &&
+        b.descriptor_type != VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER)
+        throw UsageError(where + " has immutable samplers but type " + detail::enum_text(b.descriptor_type));
+    if (b.immutable_samplers.size() != b.descriptor_count) {
+        throw UsageError(where + " has " + std::to_string(b.immutable_samplers.size()) + " immutable samplers for " +
+                         std::to_string(b.descriptor_count) + " descriptors");
+    }
+    for (const auto& sampler : b.immutable_samplers) {
+        if (!sampler || !(sampler.device() == device))
+            throw UsageError(where + ": an immutable sampler is empty or belongs to another device");
+    }
+}
+
+// The cheap checks of a layout's bindings that give a clearer message than
+// the validation layer: immutable samplers, and binding flags
+// (VUID-VkDescriptorSetLayoutCreateInfo-flags-03000,
+// VUID-VkDescriptorSetLayoutBindingFlagsCreateInfo-pBindingFlags-03004).
+void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
+    constexpr const char* who = "vkrc::DescriptorSetLayout::create";
+    std::uint32_t highest = 0;
+    for (const auto& b : info.bindings) highest = std::max(highest, b.binding);
+    for (const auto& b : info.bindings) {
+        check_immutable_samplers(device, b);
+        if ((b.binding_flags & VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT) &&
+            !(info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT)) {
+            throw UsageError(std::string(who) + ": binding " + std::to_string(b.binding) +
+                             " is UPDATE_AFTER_BIND but the layout lacks "
+                             "VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT");
+        }
+        if ((b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) && b.binding != highest) {
+            throw UsageError(std::string(who) + ": binding " + std::to_string(b.binding) +
+                             " has VARIABLE_DESCRIPTOR_COUNT but is not the highest binding (" +
+                             std::to_string(highest) + ")");
+        }
+    }
+}
+
+}  // namespace
+
 DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
     if (!device) throw UsageError("vkrc::DescriptorSetLayout::create: the Device handle is empty");
-    std::vector<VkDescriptorSetLayoutBinding> bindings;
-    bindings.reserve(info.bindings.size());
-    for (const auto& b : info.bindings) {
-        bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, nullptr});
+    if ((info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR) &&
+        !device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)) {
+        throw UsageError(
+            "vkrc::DescriptorSetLayout::create: PUSH_DESCRIPTOR_BIT_KHR needs VK_KHR_push_descriptor enabled on the "
+            "device");
     }
+    check_bindings(device, info);
+    detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
+    std::vector<VkDescriptorSetLayoutBinding> bindings;
+    std::vector<VkDescriptorBindingFlags> flags;
+    // Every binding's immutable samplers, one after another; reserved whole
+    // so that the pointers into it stay valid.
+    std::size_t sampler_count = 0;
+    for (const auto& b : info.bindings) sampler_count += b.immutable_samplers.size();
+    std::vector<VkSampler> samplers;
+    samplers.reserve(sampler_count);
+    bindings.reserve(info.bindings.size());
+    flags.reserve(info.bindings.size());
+    bool any_flags = false;
+    for (const auto& b : info.bindings) {
+        const VkSampler* immutable = b.immutable_samplers.empty() ? nullptr : samplers.data() + samplers.size();
+        for (const auto& sampler : b.immutable_samplers) samplers.push_back(sampler.vk());
+        bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, immutable});
+        flags.push_back(b.binding_flags);
+        any_flags = any_flags || b.binding_flags != 0;
+        if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {
+            s->has_variable_binding = true;
+            s->variable_binding = b.binding;
+        }
+    }
+    VkDescriptorSetLayoutBindingFlagsCreateInfo flags_info{
+        VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO, info.next};
+    flags_info.bindingCount = static_cast<std::uint32_t>(flags.size());
+    flags_info.pBindingFlags = flags.data();
     VkDescriptorSetLayoutCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    // The flags struct only when some binding has flags: older drivers need not know it.
+    ci.pNext = any_flags ? &flags_info : info.next;
     ci.flags = info.flags;
     ci.bindingCount = static_cast<std::uint32_t>(bindings.size());
     ci.pBindings = bindings.data();
-    detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     s->device = device;
     s->bindings = info.bindings;
     check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->layout),
@@ -50,7 +129,7 @@ DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPool
     if (!device) throw UsageError("vkrc::DescriptorPool::create: the Device handle is empty");
     if (info.max_sets == 0) throw UsageError("vkrc::DescriptorPool::create: max_sets is 0");
     if (info.pool_sizes.empty()) throw UsageError("vkrc::DescriptorPool::create: pool_sizes is empty");
-    VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, info.next};
     ci.flags = info.flags;
     ci.maxSets = info.max_sets;
     ci.poolSizeCount = static_cast<std::uint32_t>(info.pool_sizes.size());
@@ -62,18 +141,48 @@ DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPool
     return DescriptorPool(std::move(s));
 }
 
-DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout) const {
+namespace {
+
+// The largest count a set of layout may ask for its variable binding; throws
+// when the layout has none and a count was given.
+void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::uint32_t count) {
+    constexpr const char* who = "vkrc::DescriptorPool::allocate";
+    if (!layout.has_variable_binding) {
+        if (count == 0) return;
+        throw UsageError(std::string(who) + ": variable_descriptor_count is " + std::to_string(count) +
+                         " but the layout has no VARIABLE_DESCRIPTOR_COUNT binding");
+    }
+    for (const auto& b : layout.bindings) {
+        if (b.binding == layout.variable_binding && count > b.descriptor_count) {
+            throw UsageError(std::string(who) + ": variable_descriptor_count " + std::to_string(count) +
+                             " is more than binding " + std::to_string(b.binding) + "'s descriptor_count " +
+                             std::to_string(b.descriptor_count));
+        }
+    }
+}
+
+}  // namespace
+
+DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
+                                       std::uint32_t variable_descriptor_count) const {
     if (!layout) throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout handle is empty");
     if (!(layout.device() == device())) {
         throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout belongs to another device");
     }
+    check_variable_count(*layout.state(), variable_descriptor_count);
     auto& p = *state_;
     auto& d = *p.device.state();
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
     s->pool = *this;
     s->layout = layout;
+    s->variable_count = variable_descriptor_count;
     VkDescriptorSetLayout raw_layout = layout.vk();
+    VkDescriptorSetVariableDescriptorCountAllocateInfo variable{
+        VK_STRUCTURE_TYPE_DESCRIPTOR_SET_VARIABLE_DESCRIPTOR_COUNT_ALLOCATE_INFO};
+    variable.descriptorSetCount = 1;
+    variable.pDescriptorCounts = &variable_descriptor_count;
     VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    if (layout.state()->has_variable_binding) ai.pNext = &variable;
     ai.descriptorPool = p.pool;
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &raw_layout;
@@ -116,22 +225,28 @@ bool is_image_type(VkDescriptorType t) {
 }
 
 // The layout binding a write targets must exist, have the write's type and
-// hold array_element (VUID-VkWriteDescriptorSet-dstBinding-00315,
-// -descriptorType-00319, -dstArrayElement-00321).
+// hold the count elements from array_element on (VUID-VkWriteDescriptorSet-dstBinding-00315,
+// -descriptorType-00319, -dstArrayElement-00321); vkrc does not let a write
+// run on into the next binding. The variable binding holds the set's count.
 void check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                 std::uint32_t array_element, const char* who) {
+                 std::uint32_t array_element, std::size_t count, const char* who) {
     if (!s.layout) return;
-    for (const auto& b : s.layout.state()->bindings) {
+    const auto& layout = *s.layout.state();
+    for (const auto& b : layout.bindings) {
         if (b.binding != binding) continue;
         if (b.descriptor_type != type) {
             throw UsageError(std::string(who) + ": binding " + std::to_string(binding) + " has descriptor type " +
                              detail::enum_text(b.descriptor_type) + " in the set layout, the write has type " +
                              detail::enum_text(type));
         }
-        if (array_element >= b.descriptor_count) {
-            throw UsageError(std::string(who) + ": array element " + std::to_string(array_element) +
-                             " is past binding " + std::to_string(binding) + "'s " +
-                             std::to_string(b.descriptor_count) + " descriptors");
+        const bool variable = layout.has_variable_binding && layout.variable_binding == binding;
+        const std::uint32_t size = variable ? s.variable_count : b.descriptor_count;
+        if (array_element >= size || count > size - array_element) {
+            const std::string elements = count == 1 ? "array element " + std::to_string(array_element) + " is"
+                                                    : "array elements " + std::to_string(array_element) + " to " +
+                                                          std::to_string(array_element + count - 1) + " are";
+            throw UsageError(std::string(who) + ": " + elements + " past binding " + std::to_string(binding) + "'s " +
+                             std::to_string(size) + " descriptors");
         }
         return;
     }
@@ -171,15 +286,15 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, co
 }
 
 namespace {
-// One descriptor, one vkUpdateDescriptorSets; exactly one of the infos is set.
-void update_one(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                std::uint32_t array_element, const VkDescriptorBufferInfo* buffer_info,
-                const VkDescriptorImageInfo* image_info) {
+// One vkUpdateDescriptorSets of count descriptors; exactly one of the infos is set.
+void update(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+            std::uint32_t array_element, std::size_t count, const VkDescriptorBufferInfo* buffer_info,
+            const VkDescriptorImageInfo* image_info) {
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     w.dstSet = s.set;
     w.dstBinding = binding;
     w.dstArrayElement = array_element;
-    w.descriptorCount = 1;
+    w.descriptorCount = static_cast<std::uint32_t>(count);
     w.descriptorType = type;
     w.pBufferInfo = buffer_info;
     w.pImageInfo = image_info;
@@ -188,26 +303,69 @@ void update_one(const detail::DescriptorSetState& s, std::uint32_t binding, VkDe
 }
 }  // namespace
 
+namespace {
+
+void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                        std::span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element, const char* who) {
+    if (!is_buffer_type(type)) {
+        throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) + " is not a buffer type");
+    }
+    check_write(s, binding, type, array_element, infos.size(), who);
+    if (!infos.empty()) update(s, binding, type, array_element, infos.size(), infos.data(), nullptr);
+}
+
+void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                       std::span<const VkDescriptorImageInfo> infos, std::uint32_t array_element, const char* who) {
+    if (!is_image_type(type)) {
+        throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) +
+                         " is not an image or sampler type");
+    }
+    check_write(s, binding, type, array_element, infos.size(), who);
+    if (!infos.empty()) update(s, binding, type, array_element, infos.size(), nullptr, infos.data());
+}
+
+}  // namespace
+
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
-    if (!is_buffer_type(type)) {
-        throw UsageError("vkrc::DescriptorSet::write_buffer: descriptor type " + detail::enum_text(type) +
-                         " is not a buffer type");
-    }
-    check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_buffer");
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffer");
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    update_one(*state_, binding, type, array_element, &info, nullptr);
+    write_buffer_infos(*state_, binding, type, std::span(&info, 1), array_element, "vkrc::DescriptorSet::write_buffer");
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
-    if (!is_image_type(type)) {
-        throw UsageError("vkrc::DescriptorSet::write_image: descriptor type " + detail::enum_text(type) +
-                         " is not an image or sampler type");
-    }
-    check_write(*state_, binding, type, array_element, "vkrc::DescriptorSet::write_image");
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_image");
     const VkDescriptorImageInfo info{sampler, view, layout};
-    update_one(*state_, binding, type, array_element, nullptr, &info);
+    write_image_infos(*state_, binding, type, std::span(&info, 1), array_element, "vkrc::DescriptorSet::write_image");
+}
+
+void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,
+                                  std::span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffers");
+    write_buffer_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_buffers");
+}
+
+void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type,
+                                 std::span<const VkDescriptorImageInfo> infos, std::uint32_t array_element) const {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_images");
+    write_image_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_images");
+}
+
+void DescriptorSet::update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::update_with_template");
+    constexpr const char* who = "vkrc::DescriptorSet::update_with_template";
+    if (!update_template) throw UsageError(std::string(who) + ": the DescriptorUpdateTemplate handle is empty");
+    if (update_template.template_type() != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET) {
+        throw UsageError(std::string(who) + ": the template is for push descriptors");
+    }
+    // VUID-vkUpdateDescriptorSetWithTemplate-descriptorUpdateTemplate-00387 asks
+    // for a compatible layout; vkrc asks for the same one.
+    if (state_->layout && !(update_template.descriptor_set_layout() == state_->layout)) {
+        throw UsageError(std::string(who) + ": the template was made for another descriptor set layout");
+    }
+    const auto& d = state_->pool.device();
+    d.fn().vkUpdateDescriptorSetWithTemplate(d.vk(), state_->set, update_template.vk(), data);
 }
 
 VKRC_END_NAMESPACE

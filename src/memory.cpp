@@ -73,7 +73,8 @@ void check_request(DeviceView device, const AllocationRequest& request, std::uin
 }
 
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,
-                                      VkBuffer dedicated_buffer, VkImage dedicated_image, std::byte** mapped) {
+                                      VkBuffer dedicated_buffer, VkImage dedicated_image, bool device_address,
+                                      std::byte** mapped) {
     VkMemoryAllocateInfo info{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     info.allocationSize = size;
     info.memoryTypeIndex = type;
@@ -82,6 +83,11 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
         dedicated.buffer = dedicated_buffer;
         dedicated.image = dedicated_image;
         info.pNext = &dedicated;
+    }
+    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO, info.pNext};
+    if (device_address) {
+        flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+        info.pNext = &flags;
     }
     VkDeviceMemory memory = VK_NULL_HANDLE;
     check(device.fn().vkAllocateMemory(device.vk(), &info, nullptr, &memory), "vkAllocateMemory");

@@ -12,10 +12,12 @@ namespace detail {
 std::string bytes_text(VkDeviceSize n);
 // Throws UsageError for a zero size, two dedicated resources, or a size larger than the heap.
 void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who);
-// vkAllocateMemory (with VkMemoryDedicatedAllocateInfo when a resource is given),
-// mapped whole when host-visible.
+// vkAllocateMemory (with VkMemoryDedicatedAllocateInfo when a resource is
+// given, VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT when device_address), mapped
+// whole when host-visible.
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,
-                                      VkBuffer dedicated_buffer, VkImage dedicated_image, std::byte** mapped);
+                                      VkBuffer dedicated_buffer, VkImage dedicated_image, bool device_address,
+                                      std::byte** mapped);
 
 // The statistics bookkeeping both allocators do: a VkDeviceMemory of bytes
 // made or freed (a block, or a dedicated allocation), a range of bytes

@@ -58,9 +58,10 @@ inline void size_class(VkDeviceSize size, std::uint32_t& fl, std::uint32_t& sl) 
 }
 
 // The blocks of one memory type (and, with a large bufferImageGranularity, of
-// one tiling class) and its TLSF index.
+// one tiling class), allocated with or without DEVICE_ADDRESS, and its TLSF index.
 struct Pool {
     std::uint32_t memory_type = 0;
+    bool device_address = false;  // blocks allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
     std::vector<Block*> blocks;
     std::uint64_t fl_bitmap = 0;
     std::uint32_t sl_bitmap[fl_count] = {};
@@ -175,8 +176,11 @@ struct PoolAllocator::Impl {
     PoolAllocatorCreateInfo info;
     mutable Mutex mutex;
     detail::DeviceState* device = nullptr;  // the device served; null until first use
-    // Index: memory type * 2 + (optimal-tiling pool when kept apart).
-    std::unique_ptr<Pool> pools[VK_MAX_MEMORY_TYPES * 2];
+    // Index: memory type * 4 + 2 * (device-address blocks) + (optimal-tiling
+    // pool when kept apart). Device-address blocks are kept apart so that
+    // only buffers that ask pay for the flag (drivers may place such memory
+    // differently).
+    std::unique_ptr<Pool> pools[VK_MAX_MEMORY_TYPES * 4];
     NodeStore nodes;
     AllocatorStatistics stats;
     std::uint32_t memory_objects = 0;  // blocks and dedicated allocations
@@ -237,7 +241,7 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
         pool.blocks.reserve(pool.blocks.size() + 1);
         try {
             block->memory = detail::allocate_device_memory(d, size, pool.memory_type, VK_NULL_HANDLE, VK_NULL_HANDLE,
-                                                           &block->mapped);
+                                                           pool.device_address, &block->mapped);
         } catch (const Error& e) {
             // Out of memory for a large block: try one just big enough.
             if (size == at_least ||
@@ -246,7 +250,7 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
             }
             size = at_least;
             block->memory = detail::allocate_device_memory(d, size, pool.memory_type, VK_NULL_HANDLE, VK_NULL_HANDLE,
-                                                           &block->mapped);
+                                                           pool.device_address, &block->mapped);
         }
     } catch (...) {
         nodes.recycle(node);
@@ -314,7 +318,7 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
             throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
         }
         info.memory = detail::allocate_device_memory(d, info.size, type, request.dedicated_buffer,
-                                                     request.dedicated_image, &info.mapped);
+                                                     request.dedicated_image, request.device_address, &info.mapped);
         info.memory_size = info.size;
         info.dedicated = true;
         m.stats.vk_allocate_calls += 1;
@@ -328,10 +332,11 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     const VkDeviceSize size = detail::align_up(request.requirements.size, unit);
     const VkDeviceSize alignment = std::max<VkDeviceSize>(request.requirements.alignment, unit);
     const bool separate = m.granularity > Impl::max_rounded_granularity && !request.linear;
-    auto& slot = m.pools[type * 2 + (separate ? 1 : 0)];
+    auto& slot = m.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
     if (!slot) {
         slot = std::make_unique<Pool>();
         slot->memory_type = type;
+        slot->device_address = request.device_address;
     }
     Pool& pool = *slot;
 

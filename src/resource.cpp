@@ -77,6 +77,26 @@ Allocation allocate_memory(const Device& device, AllocationRequest request, cons
     return Allocation::create(device, request, allocator);
 }
 
+// The address of a bound buffer with SHADER_DEVICE_ADDRESS usage; 0 without.
+VkDeviceAddress query_device_address(const Device& device, VkBuffer buffer, VkBufferUsageFlags usage) {
+    if (!(usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT)) return 0;
+    const VkBufferDeviceAddressInfo query{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO, nullptr, buffer};
+    return device.fn().vkGetBufferDeviceAddress(device.vk(), &query);
+}
+
+// VkSamplerYcbcrConversionInfo for conversion (if any) ahead of next; the
+// conversion must belong to device.
+VkSamplerYcbcrConversionInfo conversion_info(const Device& device, const SamplerYcbcrConversion& conversion,
+                                             const void* next, const char* who) {
+    VkSamplerYcbcrConversionInfo info{VK_STRUCTURE_TYPE_SAMPLER_YCBCR_CONVERSION_INFO, next};
+    if (!conversion) return info;
+    if (!(conversion.device() == device)) {
+        throw UsageError(std::string(who) + ": the SamplerYcbcrConversion belongs to another device");
+    }
+    info.conversion = conversion.vk();
+    return info;
+}
+
 // The state of a buffer, created or adopted (the handle is set by the caller).
 detail::Ref<detail::BufferState> buffer_state(const Device& device, VkDeviceSize size, VkBufferUsageFlags usage,
                                               Ownership ownership) {
@@ -110,7 +130,14 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     if (!device) throw UsageError("vkrc::Buffer::create: the Device handle is empty");
     if (info.size == 0) throw UsageError("vkrc::Buffer::create: size is 0");
     if (info.usage == 0) throw UsageError("vkrc::Buffer::create: usage is 0");
-    if (!(info.flags & VK_BUFFER_CREATE_SPARSE_BINDING_BIT)) {
+    constexpr VkBufferCreateFlags sparse = VK_BUFFER_CREATE_SPARSE_BINDING_BIT | VK_BUFFER_CREATE_SPARSE_RESIDENCY_BIT |
+                                           VK_BUFFER_CREATE_SPARSE_ALIASED_BIT;
+    if (info.flags & sparse) {
+        throw UsageError(
+            "vkrc::Buffer::create: sparse flags are not supported (vkrc binds one allocation to each buffer; create "
+            "a sparse buffer with vkCreateBuffer and bind it with vkQueueBindSparse)");
+    }
+    {
         // A size no heap can hold (a negative number cast to VkDeviceSize, a
         // product that wrapped) fails here with its value, not later with
         // an out-of-memory from the allocator's alignment arithmetic.
@@ -139,6 +166,7 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     request.intent = info.memory;
     request.dedicated_buffer = state->buffer;
     request.linear = true;
+    request.device_address = (info.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
     state->allocation = allocate_memory(device, request, info.allocator, [&](VkMemoryRequirements2& requirements) {
         VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr,
                                               state->buffer};
@@ -147,6 +175,7 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     check(device.fn().vkBindBufferMemory(device.vk(), state->buffer, state->allocation.memory(),
                                          state->allocation.offset()),
           "vkBindBufferMemory");
+    state->device_address = query_device_address(device, state->buffer, info.usage);
     return Buffer(std::move(state));
 }
 
@@ -157,6 +186,7 @@ Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, V
     auto state = buffer_state(device, size, usage, ownership);
     state->buffer = buffer;
     state->cleanup = std::move(cleanup);
+    state->device_address = query_device_address(device, buffer, usage);
     return Buffer(std::move(state));
 }
 
@@ -183,6 +213,13 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
         throw UsageError("vkrc::Image::create: mip_levels and array_layers must be at least 1");
     }
     if (info.usage == 0) throw UsageError("vkrc::Image::create: usage is 0");
+    constexpr VkImageCreateFlags sparse =
+        VK_IMAGE_CREATE_SPARSE_BINDING_BIT | VK_IMAGE_CREATE_SPARSE_RESIDENCY_BIT | VK_IMAGE_CREATE_SPARSE_ALIASED_BIT;
+    if (info.flags & sparse) {
+        throw UsageError(
+            "vkrc::Image::create: sparse flags are not supported (vkrc binds one allocation to each image; create a "
+            "sparse image with vkCreateImage and bind it with vkQueueBindSparse)");
+    }
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, info.next};
     ci.flags = info.flags;
     ci.imageType = info.image_type;
@@ -226,7 +263,9 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
 
 ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info) {
     if (!image) throw UsageError("vkrc::ImageView::create: the Image handle is empty");
-    VkImageViewCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.next};
+    VkSamplerYcbcrConversionInfo conversion =
+        conversion_info(image.device(), info.ycbcr_conversion, info.next, "vkrc::ImageView::create");
+    VkImageViewCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};
     ci.flags = info.flags;
     ci.image = image.vk();
     ci.viewType = info.view_type;
@@ -273,6 +312,7 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     state->image = image;
     state->format = ci.format;
     state->range = ci.subresourceRange;
+    state->ycbcr_conversion = info.ycbcr_conversion;
     return ImageView(std::move(state));
 }
 
@@ -294,7 +334,9 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     if (!device) throw UsageError("vkrc::Sampler::create: the Device handle is empty");
-    VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.next};
+    VkSamplerYcbcrConversionInfo conversion =
+        conversion_info(device, info.ycbcr_conversion, info.next, "vkrc::Sampler::create");
+    VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};
     ci.flags = info.flags;
     ci.magFilter = info.mag_filter;
     ci.minFilter = info.min_filter;
@@ -314,6 +356,7 @@ Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     detail::Ref<detail::SamplerState> state(new detail::SamplerState);
     check(device.fn().vkCreateSampler(device.vk(), &ci, nullptr, &state->sampler), "vkCreateSampler");
     state->device = device;
+    state->ycbcr_conversion = info.ycbcr_conversion;
     return Sampler(std::move(state));
 }
 

@@ -17,6 +17,9 @@ public:
         const auto& req = request.requirements;
         if (req.size == 0 || req.size > arena_size_)
             throw vkrc::UsageError("ArenaAllocator: size 0 or above the arena");
+        // Its arenas are allocated without VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT:
+        // refusing is how an allocator that cannot honour the request says so.
+        if (request.device_address) throw vkrc::UsageError("ArenaAllocator: no device-address memory");
         auto type =
             vkrc::choose_memory_type(device.memory_properties(), req.memoryTypeBits, request.intent, "ArenaAllocator");
         std::lock_guard lock(mutex_);

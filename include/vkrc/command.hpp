@@ -6,6 +6,7 @@
 //     cmd.fn().vkCmdSetLineWidth(cmd.vk(), 2.0f);
 #pragma once
 
+#include "vkrc/descriptor_template.hpp"
 #include "vkrc/pipeline.hpp"
 #include "vkrc/sync.hpp"
 
@@ -171,6 +172,14 @@ public:
                               std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
                         std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
+    // Push descriptors (VK_KHR_push_descriptor, which must be enabled on the
+    // device: the function is called as loaded). Writes set `set` of layout,
+    // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
+    void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
+                             std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
+    // The same through a PUSH_DESCRIPTORS_KHR template, to its pipeline layout and set.
+    void push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
+                                           const void* data) const VKRC_UNCHECKED_NOEXCEPT;
     template <class T>
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
@@ -664,6 +673,19 @@ inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShader
                                           std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
     fn_->vkCmdPushConstants(cmd_, layout.vk(), stages, offset, size, data);
+}
+inline void CommandBuffer::push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout,
+                                               std::uint32_t set, std::span<const VkWriteDescriptorSet> writes) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
+    fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout.vk(), set, static_cast<std::uint32_t>(writes.size()),
+                                   writes.data());
+}
+inline void CommandBuffer::push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
+                                                             const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set_with_template");
+    fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template.vk(), update_template.pipeline_layout().vk(),
+                                               update_template.set(), data);
 }
 inline void CommandBuffer::set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");

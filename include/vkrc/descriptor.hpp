@@ -15,21 +15,35 @@ class DescriptorPoolState;
 class DescriptorSetState;
 }  // namespace detail
 
-// Mirrors VkDescriptorSetLayoutBinding (without immutable samplers).
-// Every member is optional (defaults: binding 0, one uniform buffer, all stages).
+// Mirrors VkDescriptorSetLayoutBinding, plus the binding's entry of
+// VkDescriptorSetLayoutBindingFlagsCreateInfo. Every member is optional
+// (defaults: binding 0, one uniform buffer, all stages, no flags, no immutable samplers).
 struct DescriptorSetLayoutBinding {
     std::uint32_t binding = 0;
     VkDescriptorType descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    // With VARIABLE_DESCRIPTOR_COUNT: the most a set may get (DescriptorPool::allocate picks).
     std::uint32_t descriptor_count = 1;
     VkShaderStageFlags stage_flags = VK_SHADER_STAGE_ALL;
+    // Descriptor indexing: PARTIALLY_BOUND, UPDATE_AFTER_BIND (the layout then
+    // needs UPDATE_AFTER_BIND_POOL), UPDATE_UNUSED_WHILE_PENDING,
+    // VARIABLE_DESCRIPTOR_COUNT (the highest binding only). Each needs its
+    // descriptorBinding* feature enabled on the device (vulkan12_features).
+    VkDescriptorBindingFlags binding_flags = 0;
+    // For SAMPLER and COMBINED_IMAGE_SAMPLER bindings: empty, or one sampler
+    // per descriptor (descriptor_count of them), fixed in the layout, which
+    // keeps them alive. Samplers with a Y'CbCr conversion must be given here.
+    List<Sampler> immutable_samplers{};
 };
 
 // Mirrors VkDescriptorSetLayoutCreateInfo.
 struct DescriptorSetLayoutCreateInfo {
-    // Optional (default none).
+    // Optional (default none). UPDATE_AFTER_BIND_POOL for update-after-bind
+    // bindings; PUSH_DESCRIPTOR_BIT_KHR for CommandBuffer::push_descriptor_set.
     VkDescriptorSetLayoutCreateFlags flags = 0;
     // Optional (empty: an empty layout). Copied: the layout checks writes against it.
     List<DescriptorSetLayoutBinding> bindings{};
+    // Optional pNext chain (vkrc chains the binding flags itself). Read during create().
+    const void* next = nullptr;
 };
 
 class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
@@ -47,15 +61,19 @@ private:
 // a dropped set returns to the pool once the GPU is done with it; without it
 // sets are reclaimed only by reset_sets() or the pool's destruction.
 struct DescriptorPoolCreateInfo {
-    // Optional (default: sets freed one by one, see above).
+    // Optional (default: sets freed one by one, see above). Add
+    // UPDATE_AFTER_BIND_BIT to allocate sets of UPDATE_AFTER_BIND_POOL layouts.
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     // Required, non-zero.
     std::uint32_t max_sets = 0;
     // Required, not empty. Read during create().
     List<VkDescriptorPoolSize> pool_sizes{};
+    // Optional pNext chain. Read during create().
+    const void* next = nullptr;
 };
 
 class DescriptorSet;
+class DescriptorUpdateTemplate;
 
 // Externally synchronised like VkDescriptorPool: allocate() and reset_sets() take
 // the pool's lock under the multi-thread policy.
@@ -66,7 +84,11 @@ public:
 
     VkDescriptorPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
-    DescriptorSet allocate(const DescriptorSetLayout& layout) const;
+    // variable_descriptor_count: for a layout whose last binding has
+    // VARIABLE_DESCRIPTOR_COUNT, how many descriptors the set's binding gets
+    // (at most its descriptor_count; VkDescriptorSetVariableDescriptorCountAllocateInfo).
+    // Must be 0 for other layouts (UsageError otherwise).
+    DescriptorSet allocate(const DescriptorSetLayout& layout, std::uint32_t variable_descriptor_count = 0) const;
     // vkResetDescriptorPool: every set allocated from it becomes invalid (its
     // handle may still be dropped). The caller ensures the GPU no longer uses them.
     void reset_sets() const;
@@ -99,6 +121,19 @@ public:
                      const Sampler& sampler = {}, std::uint32_t array_element = 0) const;
     void write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                      VkSampler sampler = VK_NULL_HANDLE, std::uint32_t array_element = 0) const;
+    // One vkUpdateDescriptorSets writing infos.size() consecutive array
+    // elements of binding from array_element on (bindless tables). Throws
+    // UsageError when the binding does not exist, has another type, or the
+    // elements do not all lie in it (its descriptor_count, or the set's
+    // variable count); the raw handles are not checked further.
+    void write_buffers(std::uint32_t binding, VkDescriptorType type, std::span<const VkDescriptorBufferInfo> infos,
+                       std::uint32_t array_element = 0) const;
+    void write_images(std::uint32_t binding, VkDescriptorType type, std::span<const VkDescriptorImageInfo> infos,
+                      std::uint32_t array_element = 0) const;
+    // vkUpdateDescriptorSetWithTemplate: data is laid out as the template's
+    // entries say (read during the call). The template's type must be
+    // DESCRIPTOR_SET and its layout this set's (UsageError otherwise).
+    void update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const;
 
 private:
     friend class DescriptorPool;
@@ -114,6 +149,9 @@ public:
     VkDescriptorSetLayout layout = VK_NULL_HANDLE;
     // For checking writes against the layout.
     List<DescriptorSetLayoutBinding> bindings;
+    // The binding with VARIABLE_DESCRIPTOR_COUNT, if any.
+    bool has_variable_binding = false;
+    std::uint32_t variable_binding = 0;
 };
 
 class DescriptorPoolState final : public RefCounted {
@@ -136,6 +174,7 @@ public:
     DescriptorSetLayout layout;  // checks writes (the raw layout may go once the set exists)
     VkDescriptorSet set = VK_NULL_HANDLE;
     std::uint64_t generation = 0;
+    std::uint32_t variable_count = 0;  // of the layout's variable binding, if it has one
 };
 
 }  // namespace detail

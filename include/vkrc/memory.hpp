@@ -55,6 +55,11 @@ struct AllocationRequest {
     // Buffers and linear images are "linear"; optimal-tiling images are not
     // (bufferImageGranularity separates the two). Optional (default true).
     bool linear = true;
+    // The memory must be allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
+    // (VkMemoryAllocateFlagsInfo): Buffer::create sets it for buffers with
+    // SHADER_DEVICE_ADDRESS usage, and an allocator must honour it (the
+    // bufferDeviceAddress feature is then enabled). Optional (default false).
+    bool device_address = false;
 };
 
 // A range of device memory as an allocator describes it.

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "vkrc/memory.hpp"
+#include "vkrc/ycbcr.hpp"
 
 #include "vkrc/detail/list.hpp"
 
@@ -17,11 +18,14 @@ class SamplerState;
 
 // Mirrors VkBufferCreateInfo, plus where its memory comes from.
 struct BufferCreateInfo {
-    // Optional (default none).
+    // Optional (default none). Sparse flags are refused (UsageError): vkrc
+    // binds one allocation to every buffer and has no sparse binding.
     VkBufferCreateFlags flags = 0;
     // Required, non-zero.
     VkDeviceSize size = 0;
-    // Required, non-zero.
+    // Required, non-zero. SHADER_DEVICE_ADDRESS_BIT (needs the
+    // bufferDeviceAddress feature) gets memory allocated with
+    // DEVICE_ADDRESS_BIT and a device_address().
     VkBufferUsageFlags usage = 0;
     // Optional (default exclusive).
     VkSharingMode sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
@@ -51,6 +55,9 @@ public:
     VkDeviceSize size() const VKRC_UNCHECKED_NOEXCEPT;
     VkBufferUsageFlags usage() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
+    // The buffer's address for shaders (vkGetBufferDeviceAddress, read once
+    // at creation); 0, never a valid address, without SHADER_DEVICE_ADDRESS usage.
+    VkDeviceAddress device_address() const VKRC_UNCHECKED_NOEXCEPT;
     // Mapped access goes through the allocation: buffer.allocation().write(0, span).
     // Empty for an adopted buffer: its accessors then throw UsageError with
     // VKRC_RUNTIME_CHECKS (a precondition without).
@@ -62,7 +69,7 @@ private:
 
 // Mirrors VkImageCreateInfo, plus where its memory comes from.
 struct ImageCreateInfo {
-    // Optional (default none).
+    // Optional (default none). Sparse flags are refused by create() (UsageError), as for buffers.
     VkImageCreateFlags flags = 0;
     // Optional (default 2D).
     VkImageType image_type = VK_IMAGE_TYPE_2D;
@@ -135,6 +142,9 @@ struct ImageViewCreateInfo {
     VkComponentMapping components{};
     // aspectMask 0: colour, or depth for depth formats (and stencil for depth-stencil ones).
     VkImageSubresourceRange subresource_range{0, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+    // Default none. For views of Y'CbCr formats that a sampler with the same
+    // conversion reads; vkrc chains VkSamplerYcbcrConversionInfo. The view keeps it alive.
+    SamplerYcbcrConversion ycbcr_conversion{};
     // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
@@ -200,6 +210,8 @@ struct SamplerCreateInfo {
     float max_lod = VK_LOD_CLAMP_NONE;
     VkBorderColor border_color = VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK;
     bool unnormalized_coordinates = false;
+    // Default none. vkrc chains VkSamplerYcbcrConversionInfo; the sampler keeps it alive.
+    SamplerYcbcrConversion ycbcr_conversion{};
     // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
@@ -231,6 +243,7 @@ public:
     VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
+    VkDeviceAddress device_address = 0;
     Ownership ownership = Ownership::owned;
     Allocation allocation;       // released after the buffer's destruction is queued
     Function<void()> cleanup{};  // an adopted buffer's, queued after its destruction
@@ -264,6 +277,7 @@ public:
     VkImageView view = VK_NULL_HANDLE;
     VkFormat format = VK_FORMAT_UNDEFINED;
     VkImageSubresourceRange range{};
+    SamplerYcbcrConversion ycbcr_conversion;  // if made with one
 };
 
 class BufferViewState final : public RefCounted {
@@ -278,6 +292,7 @@ public:
     ~SamplerState() override;
     Device device;
     VkSampler sampler = VK_NULL_HANDLE;
+    SamplerYcbcrConversion ycbcr_conversion;  // if made with one
 };
 
 }  // namespace detail
@@ -297,6 +312,10 @@ inline VkBufferUsageFlags Buffer::usage() const VKRC_UNCHECKED_NOEXCEPT {
 inline const Device& Buffer::device() const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::Buffer::device");
     return state_->device;
+}
+inline VkDeviceAddress Buffer::device_address() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::Buffer::device_address");
+    return state_->device_address;
 }
 inline const Allocation& Buffer::allocation() const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::Buffer::allocation");

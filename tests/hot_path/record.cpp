@@ -93,3 +93,9 @@ void hot_bind_sets_by_layout(const Cmd& c, const vkrc::PipelineLayout& l, std::s
 void hot_push_raw(const Cmd& c, VkPipelineLayout l, const float (&m)[4]) {
     c.push_constants(l, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof m, m);
 }
+void hot_push_descriptor_set(const Cmd& c, const vkrc::PipelineLayout& l, std::span<const VkWriteDescriptorSet> w) {
+    c.push_descriptor_set(VK_PIPELINE_BIND_POINT_COMPUTE, l, 0, w);
+}
+void hot_push_descriptor_set_with_template(const Cmd& c, const vkrc::DescriptorUpdateTemplate& t, const void* d) {
+    c.push_descriptor_set_with_template(t, d);
+}

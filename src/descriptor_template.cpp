@@ -1,0 +1,67 @@
+#include "vkrc/descriptor_template.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
+    // A push template may be referred to by an open command buffer: the serial holds the drop.
+    defer_destroy<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>(*device.state(), update_template, serial());
+}
+
+}  // namespace detail
+
+namespace {
+
+void check_template_info(const Device& device, const DescriptorUpdateTemplateCreateInfo& info) {
+    constexpr const char* who = "vkrc::DescriptorUpdateTemplate::create";
+    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    if (info.entries.empty()) throw UsageError(std::string(who) + ": entries is empty");
+    if (!info.descriptor_set_layout) throw UsageError(std::string(who) + ": descriptor_set_layout is empty");
+    if (!(info.descriptor_set_layout.device() == device)) {
+        throw UsageError(std::string(who) + ": descriptor_set_layout belongs to another device");
+    }
+    if (info.template_type != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) return;
+    if (!device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)) {
+        throw UsageError(std::string(who) +
+                         ": a PUSH_DESCRIPTORS_KHR template needs VK_KHR_push_descriptor enabled on the device");
+    }
+    if (!info.pipeline_layout) throw UsageError(std::string(who) + ": a push template needs pipeline_layout");
+    if (!(info.pipeline_layout.device() == device)) {
+        throw UsageError(std::string(who) + ": pipeline_layout belongs to another device");
+    }
+}
+
+}  // namespace
+
+DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
+                                                          const DescriptorUpdateTemplateCreateInfo& info) {
+    check_template_info(device, info);
+    const bool push = info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR;
+    VkDescriptorUpdateTemplateCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_UPDATE_TEMPLATE_CREATE_INFO, info.next};
+    ci.flags = info.flags;
+    ci.descriptorUpdateEntryCount = static_cast<std::uint32_t>(info.entries.size());
+    ci.pDescriptorUpdateEntries = info.entries.data();
+    ci.templateType = info.template_type;
+    ci.descriptorSetLayout = info.descriptor_set_layout.vk();
+    if (push) {
+        ci.pipelineBindPoint = info.pipeline_bind_point;
+        ci.pipelineLayout = info.pipeline_layout.vk();
+        ci.set = info.set;
+    }
+    detail::Ref<detail::DescriptorUpdateTemplateState> s(new detail::DescriptorUpdateTemplateState);
+    s->device = device;
+    s->type = info.template_type;
+    s->set_layout = info.descriptor_set_layout;
+    if (push) {
+        s->pipeline_layout = info.pipeline_layout;
+        s->set = info.set;
+    }
+    check(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &s->update_template),
+          "vkCreateDescriptorUpdateTemplate");
+    return DescriptorUpdateTemplate(std::move(s));
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,36 @@
+#include "vkrc/private_data.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+PrivateDataSlotState::~PrivateDataSlotState() {
+    if (device) defer_destroy<&DeviceFunctions::vkDestroyPrivateDataSlot>(*device.state(), slot, serial());
+}
+
+}  // namespace detail
+
+PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::PrivateDataSlot::create: the Device handle is empty");
+    VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO, info.next, info.flags};
+    detail::Ref<detail::PrivateDataSlotState> state(new detail::PrivateDataSlotState);
+    check(device.fn().vkCreatePrivateDataSlot(device.vk(), &ci, nullptr, &state->slot), "vkCreatePrivateDataSlot");
+    state->device = device;
+    return PrivateDataSlot(std::move(state));
+}
+
+void PrivateDataSlot::set_bits(VkObjectType object_type, std::uint64_t object, std::uint64_t data) const {
+    VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::set");
+    const auto& d = state_->device;
+    check(d.fn().vkSetPrivateData(d.vk(), object_type, object, state_->slot, data), "vkSetPrivateData");
+}
+
+std::uint64_t PrivateDataSlot::get_bits(VkObjectType object_type, std::uint64_t object) const {
+    VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::get");
+    const auto& d = state_->device;
+    std::uint64_t data = 0;
+    d.fn().vkGetPrivateData(d.vk(), object_type, object, state_->slot, &data);
+    return data;
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,36 @@
+#include "vkrc/ycbcr.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
+    if (device) defer_destroy<&DeviceFunctions::vkDestroySamplerYcbcrConversion>(*device.state(), conversion, serial());
+}
+
+}  // namespace detail
+
+SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
+                                                      const SamplerYcbcrConversionCreateInfo& info) {
+    if (!device) throw UsageError("vkrc::SamplerYcbcrConversion::create: the Device handle is empty");
+    if (info.format == VK_FORMAT_UNDEFINED) {
+        throw UsageError("vkrc::SamplerYcbcrConversion::create: format is VK_FORMAT_UNDEFINED");
+    }
+    VkSamplerYcbcrConversionCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_YCBCR_CONVERSION_CREATE_INFO, info.next};
+    ci.format = info.format;
+    ci.ycbcrModel = info.ycbcr_model;
+    ci.ycbcrRange = info.ycbcr_range;
+    ci.components = info.components;
+    ci.xChromaOffset = info.x_chroma_offset;
+    ci.yChromaOffset = info.y_chroma_offset;
+    ci.chromaFilter = info.chroma_filter;
+    ci.forceExplicitReconstruction = info.force_explicit_reconstruction ? VK_TRUE : VK_FALSE;
+    detail::Ref<detail::SamplerYcbcrConversionState> state(new detail::SamplerYcbcrConversionState);
+    check(device.fn().vkCreateSamplerYcbcrConversion(device.vk(), &ci, nullptr, &state->conversion),
+          "vkCreateSamplerYcbcrConversion");
+    state->device = device;
+    state->format = info.format;
+    return SamplerYcbcrConversion(std::move(state));
+}
+
+VKRC_END_NAMESPACE

@@ -1,0 +1,116 @@
+// Sampler Y'CbCr conversions, and the samplers and image views made with one.
+#include "support/features.hpp"
+#include "support/vk_test.hpp"
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+constexpr VkFormat nv12 = VK_FORMAT_G8_B8R8_2PLANE_420_UNORM;
+
+// The fixture's device replaced by one with samplerYcbcrConversion; skips
+// where the device or its NV12 format lacks what a conversion needs.
+class YcbcrTest : public VulkanTest {
+protected:
+    void SetUp() override {
+        VulkanTest::SetUp();
+        if (!vkrc_test::supported_features(physical_device).v11.samplerYcbcrConversion)
+            GTEST_SKIP() << "the device lacks samplerYcbcrConversion";
+        VkFormatProperties props{};
+        physical_device.fn().vkGetPhysicalDeviceFormatProperties(physical_device.vk(), nv12, &props);
+        const VkFormatFeatureFlags f = props.optimalTilingFeatures;
+        if (!(f & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT)) {
+            GTEST_SKIP() << "VK_FORMAT_G8_B8R8_2PLANE_420_UNORM lacks VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT "
+                            "(optimal tiling)";
+        }
+        if (!(f & (VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT | VK_FORMAT_FEATURE_COSITED_CHROMA_SAMPLES_BIT))) {
+            GTEST_SKIP() << "VK_FORMAT_G8_B8R8_2PLANE_420_UNORM lacks VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT "
+                            "and VK_FORMAT_FEATURE_COSITED_CHROMA_SAMPLES_BIT";
+        }
+        location = (f & VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT) ? VK_CHROMA_LOCATION_MIDPOINT
+                                                                       : VK_CHROMA_LOCATION_COSITED_EVEN;
+        vkrc::DeviceCreateInfo info;
+        info.vulkan11_features.samplerYcbcrConversion = VK_TRUE;
+        device = vkrc::Device::create(physical_device, info);
+        queue = device.default_queue();
+    }
+    vkrc::SamplerYcbcrConversion nv12_conversion(const vkrc::Device& on) const {
+        return vkrc::SamplerYcbcrConversion::create(
+            on, {.format = nv12, .x_chroma_offset = location, .y_chroma_offset = location});
+    }
+    VkChromaLocation location = VK_CHROMA_LOCATION_MIDPOINT;
+};
+
+TEST_F(YcbcrTest, YcbcrConversionWithSamplerAndImageView) {
+    auto conversion = nv12_conversion(device);
+    EXPECT_EQ(conversion.format(), nv12);
+    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                                  .min_filter = VK_FILTER_NEAREST,
+                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                                  .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .ycbcr_conversion = conversion});
+    auto image =
+        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+    EXPECT_NE(sampler.vk(), VK_NULL_HANDLE);
+    EXPECT_NE(view.vk(), VK_NULL_HANDLE);
+    EXPECT_EQ(conversion.use_count(), 3u) << "the sampler and the view keep the conversion alive";
+    conversion.reset();  // the view and sampler still hold it: no validation error at their destruction
+}
+
+vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcrConversion& conversion) {
+    return vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                          .min_filter = VK_FILTER_NEAREST,
+                                          .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                          .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .ycbcr_conversion = conversion});
+}
+
+// Shaders reach a Y'CbCr sampler only as an immutable sampler of a set layout,
+// which keeps it (and so the conversion) alive.
+TEST_F(YcbcrTest, YcbcrSamplerImmutableInASetLayout) {
+    auto conversion = nv12_conversion(device);
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                               .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT,
+                               .immutable_samplers = {ycbcr_sampler(device, conversion)}}}});
+    EXPECT_EQ(conversion.use_count(), 2u) << "held by the layout's sampler";
+    // A multi-planar format may take several descriptors of the pool (up to one per plane).
+    auto pool = vkrc::DescriptorPool::create(
+        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3}}});
+    auto set = pool.allocate(set_layout);
+    auto image =
+        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+    set.write_image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+}
+
+TEST_F(YcbcrTest, YcbcrMisuseIsAUsageError) {
+    EXPECT_THROW(vkrc::SamplerYcbcrConversion::create(device, {}), vkrc::UsageError) << "format undefined";
+    vkrc::DeviceCreateInfo info;
+    info.vulkan11_features.samplerYcbcrConversion = VK_TRUE;
+    auto other = vkrc::Device::create(physical_device, info);
+    EXPECT_THROW(vkrc::Sampler::create(device, {.ycbcr_conversion = nv12_conversion(other)}), vkrc::UsageError)
+        << "a conversion of another device";
+    auto sampler = ycbcr_sampler(device, nv12_conversion(device));
+    EXPECT_THROW(vkrc::DescriptorSetLayout::create(
+                     device, {.bindings = {{.binding = 0,
+                                            .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                            .descriptor_count = 2,
+                                            .immutable_samplers = {sampler}}}}),
+                 vkrc::UsageError)
+        << "one immutable sampler for two descriptors";
+    EXPECT_THROW(
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+                                                                 .immutable_samplers = {sampler}}}}),
+        vkrc::UsageError)
+        << "immutable samplers on a sampled-image binding";
+}
+
+}  // namespace
