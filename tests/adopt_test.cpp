@@ -195,6 +195,69 @@ TEST_F(VulkanTest, AdoptedOwnedObjectsAreDestroyedByVkrc) {
     image_view.reset();
 }
 
+// RawInterop: the recording methods that take query pools, events, render
+// passes and framebuffers also take their raw handles.
+TEST_F(VulkanTest, RawInteropQueriesAndEventsByRawHandle) {
+    const auto& fn = device.fn();
+    auto queries = vkrc::QueryPool::create(device, {.query_count = 2});
+    auto event = vkrc::Event::create(device);
+    auto results = vkrc::Buffer::create(
+        device,
+        {.size = 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    const VkQueryPool raw_pool = queries.vk();
+    const VkEvent raw_event = event.vk();
+    const VkBuffer raw_results = results.vk();
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.reset_query_pool(raw_pool, 0, 2);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, raw_pool, 0);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, raw_pool, 1);
+        cmd.copy_query_results(raw_pool, 0, 2, raw_results, 0, 8);
+        auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dependency.memoryBarrierCount = 1;
+        dependency.pMemoryBarriers = &to_host;
+        cmd.set_event(raw_event, dependency);
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    });
+    EXPECT_EQ(fn.vkGetEventStatus(device.vk(), raw_event), VK_EVENT_SET);
+    auto first = results.allocation().read_value<std::uint64_t>(0);
+    auto second = results.allocation().read_value<std::uint64_t>(8);
+    EXPECT_NE(second, 0u);
+    EXPECT_LE(first, second);
+    run(queue,
+        [&](const vkrc::CommandBuffer& cmd) { cmd.reset_event(raw_event, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT); });
+    EXPECT_EQ(fn.vkGetEventStatus(device.vk(), raw_event), VK_EVENT_RESET);
+}
+
+TEST_F(VulkanTest, RawInteropRenderPassByRawHandle) {
+    auto image = vkrc::Image::create(
+        device,
+        {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT});
+    auto view = vkrc::ImageView::create(image);
+    VkAttachmentDescription attachment{0,
+                                       VK_FORMAT_R8G8B8A8_UNORM,
+                                       VK_SAMPLE_COUNT_1_BIT,
+                                       VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                       VK_ATTACHMENT_STORE_OP_STORE,
+                                       VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                       VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                       VK_IMAGE_LAYOUT_UNDEFINED,
+                                       VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    auto pass = vkrc::RenderPass::create(
+        device, {.attachments = {attachment},
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}}});
+    auto framebuffer =
+        vkrc::Framebuffer::create(device, {.render_pass = pass, .attachments = {view}, .width = 4, .height = 4});
+    const VkRenderPass raw_pass = pass.vk();
+    const VkFramebuffer raw_framebuffer = framebuffer.vk();
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        VkClearValue clear{};
+        cmd.begin_render_pass(raw_pass, raw_framebuffer, {{0, 0}, {4, 4}}, std::span(&clear, 1));
+        cmd.end_render_pass();
+    });
+}
+
 TEST_F(VulkanTest, AdoptRejectsNullHandles) {
     EXPECT_THROW(vkrc::Sampler::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
     EXPECT_THROW(vkrc::ShaderModule::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
