@@ -47,7 +47,9 @@ constexpr Command commands[] = {
     std::string providers(c.providers);
     std::replace(providers.begin(), providers.end(), ' ', '|');
     throw UsageError(std::string("vkrc: ") + c.name + " was called but is not loaded: it needs " + providers +
-                     (c.device_table ? " enabled on the device or instance" : " enabled on the instance") +
+                     (c.device_table          ? " enabled on the device or instance"
+                      : c.of_device_extension ? " offered by a driver"
+                                              : " enabled on the instance") +
                      (c.core_name ? std::string(" (or Vulkan with ") + c.core_name + ")" : std::string()));
 }
 

@@ -195,6 +195,28 @@ TEST_F(VulkanTest, AdoptedOwnedObjectsAreDestroyedByVkrc) {
     image_view.reset();
 }
 
+// A pool made elsewhere: vkrc allocates from it and records; borrowed, the
+// maker destroys it (with its command buffers) after the GPU is done.
+TEST_F(VulkanTest, AdoptedCommandPoolAllocatesAndRecords) {
+    VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    info.queueFamilyIndex = queue.family_index();
+    VkCommandPool raw = VK_NULL_HANDLE;
+    ASSERT_EQ(device.fn().vkCreateCommandPool(device.vk(), &info, nullptr, &raw), VK_SUCCESS);
+    for (auto ownership : {vkrc::Ownership::borrowed, vkrc::Ownership::owned}) {
+        auto pool = vkrc::CommandPool::adopt(device, raw, queue.family_index(), ownership);
+        EXPECT_EQ(pool.queue_family_index(), queue.family_index());
+        auto cmd = pool.allocate();
+        cmd.begin();
+        cmd.end();
+        auto fence = vkrc::Fence::create(device);
+        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    }
+    // The owned round destroyed the pool: a second destroy (or a leak) would be reported.
+    EXPECT_THROW(vkrc::CommandPool::adopt(device, VK_NULL_HANDLE, 0, vkrc::Ownership::owned), vkrc::UsageError);
+}
+
 // RawInterop: the recording methods that take query pools, events, render
 // passes and framebuffers also take their raw handles.
 TEST_F(VulkanTest, RawInteropQueriesAndEventsByRawHandle) {

@@ -40,6 +40,12 @@ class CommandPool : public Handle<detail::CommandPoolState> {
 public:
     CommandPool() noexcept = default;
     static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
+    // Wraps a pool made elsewhere from device for queue_family_index. With
+    // Ownership::owned vkrc destroys it once the GPU is done. Borrowed, its
+    // maker destroys it, after the GPU is done with every command buffer vkrc
+    // allocated from it; those dropped last stay allocated until then.
+    static CommandPool adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
+                             Ownership ownership);
 
     VkCommandPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -530,6 +536,7 @@ public:
     Device device;
     VkCommandPool pool = VK_NULL_HANDLE;
     std::uint32_t queue_family_index = 0;
+    Ownership ownership = Ownership::owned;
     mutable Mutex mutex;
     PoolFreeList<VkCommandBuffer> pending;  // under mutex
     List<VkCommandBuffer> scratch;          // under mutex
