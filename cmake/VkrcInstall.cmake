@@ -38,6 +38,8 @@ foreach(policy IN LISTS VKRC_POLICIES)
 endforeach()
 # The whole directory, so headers added later need no change here.
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/include/vkrc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT common)
+# The generated extension function list (vkrc/extension_functions.hpp includes it).
+install(DIRECTORY ${VKRC_GENERATED_DIR}/include/vkrc DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT common)
 
 configure_package_config_file(
   ${CMAKE_CURRENT_LIST_DIR}/vkrcConfig.cmake.in

@@ -14,7 +14,9 @@ void throw_too_many_color_attachments(std::size_t count) {
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
-    defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool, serial());
+    if (ownership == Ownership::owned) {
+        defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool, serial());
+    }
 }
 
 void CommandPoolState::free_completed() {
@@ -49,6 +51,18 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
     s->device = device;
     s->queue_family_index = info.queue_family_index;
     check(device.fn().vkCreateCommandPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateCommandPool");
+    return CommandPool(std::move(s));
+}
+
+CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
+                               Ownership ownership) {
+    if (!device) throw UsageError("vkrc::CommandPool::adopt: the Device handle is empty");
+    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::CommandPool::adopt: the VkCommandPool is VK_NULL_HANDLE");
+    detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);
+    s->device = device;
+    s->pool = pool;
+    s->queue_family_index = queue_family_index;
+    s->ownership = ownership;
     return CommandPool(std::move(s));
 }
 

@@ -2,6 +2,7 @@
 
 #include "text.hpp"
 #include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
+#include "vkrc/extension_functions.hpp"
 
 #include <algorithm>
 #include <atomic>  // std::memory_order for detail::Atomic
@@ -28,6 +29,7 @@ int find_dedicated_queue_family(const PhysicalDevice& physical, QueueRole role) 
 namespace detail {
 
 DeviceState::~DeviceState() {
+    delete ext_fn.load(__ATOMIC_ACQUIRE);
     if (device == VK_NULL_HANDLE) return;
     // Every handle is gone; whatever the GPU still runs must finish before
     // the queued destructions. A lost device returns at once.
@@ -374,6 +376,10 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
         detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    }
+    // The spec requires it enabled wherever it is offered (portability drivers).
+    if (physical.supports_extension("VK_KHR_portability_subset")) {
+        detail::add_unique(extensions, "VK_KHR_portability_subset");
     }
 
     auto f13 = info.vulkan13_features;

@@ -1,5 +1,8 @@
 #include "vkrc/instance.hpp"
 
+#include "vkrc/extension_functions.hpp"
+
+#include "debug_message.hpp"
 #include "text.hpp"
 
 #include <algorithm>
@@ -13,15 +16,32 @@ namespace {
 
 constexpr const char* validation_layer = "VK_LAYER_KHRONOS_validation";
 
+// The 1.0-1.3 features of versions both the device and the instance have.
+void read_features(const InstanceFunctions& f, VkPhysicalDevice raw, std::uint32_t version, DeviceFeatures& out) {
+    if (version < VK_API_VERSION_1_2) {
+        f.vkGetPhysicalDeviceFeatures(raw, &out.core);
+        return;
+    }
+    out.vulkan11.pNext = &out.vulkan12;
+    out.vulkan12.pNext = version >= VK_API_VERSION_1_3 ? &out.vulkan13 : nullptr;
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &out.vulkan11};
+    f.vkGetPhysicalDeviceFeatures2(raw, &features);
+    out.core = features.features;
+    out.vulkan11.pNext = out.vulkan12.pNext = nullptr;
+}
+
+}  // namespace
+
+namespace detail {
 VKAPI_ATTR VkBool32 VKAPI_CALL debug_trampoline(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                 VkDebugUtilsMessageTypeFlagsEXT types,
                                                 const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     const auto& callback = *static_cast<const DebugCallback*>(user);
-    callback(DebugMessage{severity, types, data->pMessageIdName, data->pMessage});
+    callback(DebugMessage{severity, types, data->pMessageIdName, data->pMessage,
+                          std::span(data->pObjects, data->objectCount)});
     return VK_FALSE;  // never abort the call that produced the message
 }
-
-}  // namespace
+}  // namespace detail
 
 void print_debug_message(const DebugMessage& message) {
     const char* level = (message.severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)     ? "error"
@@ -34,6 +54,7 @@ void print_debug_message(const DebugMessage& message) {
 
 namespace detail {
 InstanceState::~InstanceState() {
+    delete ext_fn.load(__ATOMIC_ACQUIRE);
     if (messenger != VK_NULL_HANDLE) fn.vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
     if (ownership == Ownership::owned && instance != VK_NULL_HANDLE) fn.vkDestroyInstance(instance, nullptr);
 }
@@ -50,6 +71,11 @@ Instance Instance::create(const InstanceCreateInfo& info) {
         detail::add_unique(layers, validation_layer);
         detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     }
+    // With it, the loader also lists portability drivers (MoltenVK); those
+    // need VK_KHR_portability_subset, which Device::create enables.
+    const bool portability = detail::contains(available_extensions(info.get_instance_proc_addr),
+                                              VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+    if (portability) detail::add_unique(extensions, VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
     // The state exists before the instance: its callback's address is the
     // messenger's user data from vkCreateInstance to vkDestroyInstance.
     Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
@@ -73,12 +99,13 @@ Instance Instance::create(const InstanceCreateInfo& info) {
     messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
                                  VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                                  VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messenger_info.pfnUserCallback = debug_trampoline;
+    messenger_info.pfnUserCallback = detail::debug_trampoline;
     messenger_info.pUserData = &s.debug_callback;
     messenger_info.pNext = info.next;
 
     VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     ci.pNext = messenger ? &messenger_info : info.next;
+    if (portability) ci.flags |= VK_INSTANCE_CREATE_ENUMERATE_PORTABILITY_BIT_KHR;
     ci.pApplicationInfo = &app;
     ci.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
     ci.ppEnabledLayerNames = layers.data();
@@ -169,12 +196,14 @@ List<PhysicalDevice> Instance::physical_devices() const {
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, nullptr);
         s.queue_families.resize(families);
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, s.queue_families.data());
+        read_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.features);
         auto exts = detail::enumerate<VkExtensionProperties>(
             [&](std::uint32_t* n, VkExtensionProperties* p) {
                 return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
             },
             "vkEnumerateDeviceExtensionProperties");
         for (const auto& e : exts) s.extensions.push_back(e.extensionName);
+        s.default_queue_family = device.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
         devices.push_back(std::move(device));
     }
     return devices;

@@ -13,6 +13,13 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace {
+// Adds "lacks feature <name> (Vulkan 1.x)" for each feature wanted but missing.
+void add_missing_features(const DeviceFeatures& want, const DeviceFeatures& have, std::vector<std::string>& reasons) {
+#define VKRC_FEATURE(group, version, name) \
+  if (want.group.name && !have.group.name) reasons.push_back("lacks feature " #name " (" version ")");
+#include "feature_names.inl"
+}
+
 std::string version_string(std::uint32_t v) {
     return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
            std::to_string(VK_API_VERSION_PATCH(v));
@@ -39,6 +46,23 @@ int PhysicalDevice::find_queue_family(VkQueueFlags flags, VkSurfaceKHR present_s
     return -1;
 }
 
+VkFormatProperties3 PhysicalDevice::format_properties(VkFormat format) const {
+    VkFormatProperties3 props3{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_3};
+    if (std::min(properties().apiVersion, instance().api_version()) >= VK_API_VERSION_1_3) {
+        VkFormatProperties2 props2{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_2, &props3};
+        fn().vkGetPhysicalDeviceFormatProperties2(vk(), format, &props2);
+        props3.pNext = nullptr;
+        return props3;
+    }
+    // The 64-bit flags keep the 32-bit flags' bit values.
+    VkFormatProperties props{};
+    fn().vkGetPhysicalDeviceFormatProperties(vk(), format, &props);
+    props3.linearTilingFeatures = props.linearTilingFeatures;
+    props3.optimalTilingFeatures = props.optimalTilingFeatures;
+    props3.bufferFeatures = props.bufferFeatures;
+    return props3;
+}
+
 List<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) const {
     std::vector<std::string> reasons;
     const auto& props = properties();
@@ -61,16 +85,14 @@ List<Text> PhysicalDevice::unmet_requirements(const DeviceRequirements& req) con
     } else if (req.present_surface != VK_NULL_HANDLE && find_queue_family(req.queue_flags, req.present_surface) < 0) {
         reasons.push_back("no queue family with those flags can present to the surface");
     }
+    // vkrc is built on these three features; Vulkan 1.3 makes only two of them mandatory.
+    auto want = req.required_features;
     if (props.apiVersion >= VK_API_VERSION_1_3) {
-        // vkrc is built on these three features; Vulkan 1.3 makes only two of them mandatory.
-        VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-        VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &f13};
-        VkPhysicalDeviceFeatures2 f{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
-        fn().vkGetPhysicalDeviceFeatures2(vk(), &f);
-        if (!f12.timelineSemaphore) reasons.push_back("lacks feature timelineSemaphore");
-        if (!f13.synchronization2) reasons.push_back("lacks feature synchronization2");
-        if (!f13.dynamicRendering) reasons.push_back("lacks feature dynamicRendering");
+        want.vulkan12.timelineSemaphore = VK_TRUE;
+        want.vulkan13.synchronization2 = VK_TRUE;
+        want.vulkan13.dynamicRendering = VK_TRUE;
     }
+    add_missing_features(want, features(), reasons);
     return std::vector<Text>(reasons.begin(), reasons.end());
 }
 
@@ -97,7 +119,10 @@ PhysicalDevice PhysicalDevice::select(const Instance& instance, const DeviceRequ
             best = device;
         }
     }
-    if (best) return best;
+    if (best) {
+        best.state_->default_queue_family = best.find_queue_family(req.queue_flags, req.present_surface);
+        return best;
+    }
     std::string message = devices.empty() ? "vkrc: no Vulkan physical device found (is a Vulkan driver installed?)"
                                           : "vkrc: no suitable Vulkan physical device";
     for (const auto& r : rejections) message += "\n  rejected " + r;

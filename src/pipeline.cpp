@@ -14,19 +14,24 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 PipelineLayoutState::~PipelineLayoutState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout, serial());
 }
 RenderPassState::~RenderPassState() {
-    defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass, serial());
 }
 FramebufferState::~FramebufferState() {
-    defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer, serial());
 }
 PipelineCacheState::~PipelineCacheState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache, serial());
 }
 PipelineState::~PipelineState() {
-    defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline, serial());
 }
 }  // namespace detail
 
@@ -37,6 +42,62 @@ void require(bool ok, const char* who, const char* problem) {
 }  // namespace
 
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
+
+PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {
+    require(static_cast<bool>(device), "vkrc::PipelineLayout::adopt", "the Device handle is empty");
+    require(layout != VK_NULL_HANDLE, "vkrc::PipelineLayout::adopt", "the VkPipelineLayout is VK_NULL_HANDLE");
+    detail::Ref<detail::PipelineLayoutState> s(new detail::PipelineLayoutState);
+    s->device = device;
+    s->layout = layout;
+    s->ownership = ownership;
+    return PipelineLayout(std::move(s));
+}
+
+RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
+                             std::span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
+    require(static_cast<bool>(device), "vkrc::RenderPass::adopt", "the Device handle is empty");
+    require(render_pass != VK_NULL_HANDLE, "vkrc::RenderPass::adopt", "the VkRenderPass is VK_NULL_HANDLE");
+    detail::Ref<detail::RenderPassState> s(new detail::RenderPassState);
+    s->device = device;
+    s->render_pass = render_pass;
+    s->color_counts = List<std::uint32_t>(color_attachment_counts);
+    s->ownership = ownership;
+    return RenderPass(std::move(s));
+}
+
+Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
+                               Ownership ownership) {
+    require(static_cast<bool>(render_pass), "vkrc::Framebuffer::adopt", "the RenderPass handle is empty");
+    require(framebuffer != VK_NULL_HANDLE, "vkrc::Framebuffer::adopt", "the VkFramebuffer is VK_NULL_HANDLE");
+    detail::Ref<detail::FramebufferState> s(new detail::FramebufferState);
+    s->render_pass = render_pass;
+    s->framebuffer = framebuffer;
+    s->extent = extent;
+    s->ownership = ownership;
+    return Framebuffer(std::move(s));
+}
+
+PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, Ownership ownership) {
+    require(static_cast<bool>(device), "vkrc::PipelineCache::adopt", "the Device handle is empty");
+    require(cache != VK_NULL_HANDLE, "vkrc::PipelineCache::adopt", "the VkPipelineCache is VK_NULL_HANDLE");
+    detail::Ref<detail::PipelineCacheState> s(new detail::PipelineCacheState);
+    s->device = device;
+    s->cache = cache;
+    s->ownership = ownership;
+    return PipelineCache(std::move(s));
+}
+
+Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
+                         Ownership ownership) {
+    require(static_cast<bool>(layout), "vkrc::Pipeline::adopt", "the PipelineLayout handle is empty");
+    require(pipeline != VK_NULL_HANDLE, "vkrc::Pipeline::adopt", "the VkPipeline is VK_NULL_HANDLE");
+    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
+    s->layout = layout;
+    s->pipeline = pipeline;
+    s->bind_point = bind_point;
+    s->ownership = ownership;
+    return Pipeline(std::move(s));
+}
 
 PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
     require(static_cast<bool>(device), "vkrc::PipelineLayout::create", "the Device handle is empty");

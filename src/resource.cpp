@@ -49,13 +49,16 @@ void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t
     device.destroy_after_gpu({run, 0, held}, serial);
 }
 ImageViewState::~ImageViewState() {
-    if (image) defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view, serial());
+    if (image && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view, serial());
 }
 BufferViewState::~BufferViewState() {
-    if (buffer) defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
+    if (buffer && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
 }
 SamplerState::~SamplerState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler, serial());
+    if (device && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler, serial());
 }
 
 }  // namespace detail
@@ -330,6 +333,39 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
     check(device.fn().vkCreateBufferView(device.vk(), &ci, nullptr, &state->view), "vkCreateBufferView");
     state->buffer = buffer;
     return BufferView(std::move(state));
+}
+
+ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
+                           const VkImageSubresourceRange& subresource_range, Ownership ownership) {
+    if (!image) throw UsageError("vkrc::ImageView::adopt: the Image handle is empty");
+    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::ImageView::adopt: the VkImageView is VK_NULL_HANDLE");
+    detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
+    state->image = image;
+    state->view = view;
+    state->format = format;
+    state->range = subresource_range;
+    state->ownership = ownership;
+    return ImageView(std::move(state));
+}
+
+BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
+    if (!buffer) throw UsageError("vkrc::BufferView::adopt: the Buffer handle is empty");
+    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::BufferView::adopt: the VkBufferView is VK_NULL_HANDLE");
+    detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
+    state->buffer = buffer;
+    state->view = view;
+    state->ownership = ownership;
+    return BufferView(std::move(state));
+}
+
+Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
+    if (!device) throw UsageError("vkrc::Sampler::adopt: the Device handle is empty");
+    if (sampler == VK_NULL_HANDLE) throw UsageError("vkrc::Sampler::adopt: the VkSampler is VK_NULL_HANDLE");
+    detail::Ref<detail::SamplerState> state(new detail::SamplerState);
+    state->device = device;
+    state->sampler = sampler;
+    state->ownership = ownership;
+    return Sampler(std::move(state));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {

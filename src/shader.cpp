@@ -11,7 +11,8 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 ShaderModuleState::~ShaderModuleState() {
-    defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module, serial());
 }
 }  // namespace detail
 
@@ -54,6 +55,16 @@ ShaderModule ShaderModule::create(const Device& device, std::span<const std::byt
     if (!spirv.empty()) std::memcpy(words.data(), spirv.data(), spirv.size());
     detail::Ref<detail::ShaderModuleState> s;
     make(device, words.data(), spirv.size(), "vkrc::ShaderModule::create", s);
+    return ShaderModule(std::move(s));
+}
+
+ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
+    if (!device) throw UsageError("vkrc::ShaderModule::adopt: the Device handle is empty");
+    if (module == VK_NULL_HANDLE) throw UsageError("vkrc::ShaderModule::adopt: the VkShaderModule is VK_NULL_HANDLE");
+    detail::Ref<detail::ShaderModuleState> s(new detail::ShaderModuleState);
+    s->device = device;
+    s->module = module;
+    s->ownership = ownership;
     return ShaderModule(std::move(s));
 }
 

@@ -44,9 +44,13 @@ SemaphoreState::~SemaphoreState() {
     if (ownership == Ownership::owned)
         defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore, serial());
 }
-EventState::~EventState() { defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event, serial()); }
+EventState::~EventState() {
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event, serial());
+}
 QueryPoolState::~QueryPoolState() {
-    defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool, serial());
 }
 }  // namespace detail
 
@@ -172,6 +176,16 @@ Event Event::create(const Device& device, bool device_only) {
     return Event(std::move(s));
 }
 
+Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {
+    require_device(device, "vkrc::Event::adopt");
+    if (event == VK_NULL_HANDLE) throw UsageError("vkrc::Event::adopt: the VkEvent is VK_NULL_HANDLE");
+    detail::Ref<detail::EventState> s(new detail::EventState);
+    s->device = device;
+    s->event = event;
+    s->ownership = ownership;
+    return Event(std::move(s));
+}
+
 void Event::set() const {
     const auto& d = state_->device;
     check(d.fn().vkSetEvent(d.vk(), state_->event), "vkSetEvent");
@@ -185,23 +199,41 @@ VkResult Event::status() const {
     return check(d.fn().vkGetEventStatus(d.vk(), state_->event), "vkGetEventStatus");
 }
 
-QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& info) {
-    require_device(device, "vkrc::QueryPool::create");
-    if (info.query_count == 0) throw UsageError("vkrc::QueryPool::create: query_count is 0");
+namespace {
+// The state of a pool described by info, its VkQueryPool not yet set.
+detail::Ref<detail::QueryPoolState> query_pool_state(const Device& device, const QueryPoolCreateInfo& info,
+                                                     const char* who) {
+    require_device(device, who);
+    if (info.query_count == 0) throw UsageError(std::string(who) + ": query_count is 0");
     const bool statistics = info.query_type == VK_QUERY_TYPE_PIPELINE_STATISTICS;
     if (statistics && info.pipeline_statistics == 0) {
-        throw UsageError("vkrc::QueryPool::create: a PIPELINE_STATISTICS pool with no pipeline_statistics flags");
+        throw UsageError(std::string(who) + ": a PIPELINE_STATISTICS pool with no pipeline_statistics flags");
     }
-    VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-    ci.pNext = info.next;
-    ci.queryType = info.query_type;
-    ci.queryCount = info.query_count;
-    ci.pipelineStatistics = info.pipeline_statistics;
     detail::Ref<detail::QueryPoolState> s(new detail::QueryPoolState);
     s->device = device;
     s->count = info.query_count;
     s->type = info.query_type;
     s->values_per_query = statistics ? static_cast<std::uint32_t>(std::popcount(info.pipeline_statistics)) : 1;
+    return s;
+}
+}  // namespace
+
+QueryPool QueryPool::adopt(const Device& device, VkQueryPool pool, const QueryPoolCreateInfo& info,
+                           Ownership ownership) {
+    auto s = query_pool_state(device, info, "vkrc::QueryPool::adopt");
+    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::QueryPool::adopt: the VkQueryPool is VK_NULL_HANDLE");
+    s->pool = pool;
+    s->ownership = ownership;
+    return QueryPool(std::move(s));
+}
+
+QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& info) {
+    auto s = query_pool_state(device, info, "vkrc::QueryPool::create");
+    VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    ci.pNext = info.next;
+    ci.queryType = info.query_type;
+    ci.queryCount = info.query_count;
+    ci.pipelineStatistics = info.pipeline_statistics;
     check(device.fn().vkCreateQueryPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateQueryPool");
     return QueryPool(std::move(s));
 }

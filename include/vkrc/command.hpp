@@ -41,6 +41,12 @@ class CommandPool : public Handle<detail::CommandPoolState> {
 public:
     CommandPool() noexcept = default;
     static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
+    // Wraps a pool made elsewhere from device for queue_family_index. With
+    // Ownership::owned vkrc destroys it once the GPU is done. Borrowed, its
+    // maker destroys it, after the GPU is done with every command buffer vkrc
+    // allocated from it; those dropped last stay allocated until then.
+    static CommandPool adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
+                             Ownership ownership);
 
     VkCommandPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -141,6 +147,11 @@ public:
     // Render passes and dynamic rendering
     void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
                            std::span<const VkClearValue> clear_values,
+                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
+        begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values, contents);
+    }
+    void begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
+                           std::span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
     void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
     void end_render_pass() const VKRC_UNCHECKED_NOEXCEPT;
@@ -228,16 +239,30 @@ public:
     void pipeline_barrier(std::span<const VkMemoryBarrier2> memory, std::span<const VkBufferMemoryBarrier2> buffers,
                           std::span<const VkImageMemoryBarrier2> images,
                           VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
-    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+        set_event(event.vk(), dependency);
+    }
+    void set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
+    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+        reset_event(event.vk(), stage_mask);
+    }
+    void reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
     void execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Queries
     void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
+                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
+        reset_query_pool(pool.vk(), first_query, query_count);
+    }
+    void reset_query_pool(VkQueryPool pool, std::uint32_t first_query,
                           std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT;
     void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
+                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+        write_timestamp(stage, pool.vk(), query);
+    }
+    void write_timestamp(VkPipelineStageFlags2 stage, VkQueryPool pool,
                          std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Transfer commands on whole images and buffers. Layouts are the images'
@@ -324,11 +349,23 @@ public:
 
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
     void begin_query(const QueryPool& pool, std::uint32_t query,
+                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        begin_query(pool.vk(), query, flags);
+    }
+    void begin_query(VkQueryPool pool, std::uint32_t query,
                      VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
-    void end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
+    void end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+        end_query(pool.vk(), query);
+    }
+    void end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
     void copy_query_results(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count,
                             const Buffer& dst, VkDeviceSize offset, VkDeviceSize stride,
+                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
+        copy_query_results(pool.vk(), first_query, query_count, dst.vk(), offset, stride, flags);
+    }
+    void copy_query_results(VkQueryPool pool, std::uint32_t first_query, std::uint32_t query_count, VkBuffer dst,
+                            VkDeviceSize offset, VkDeviceSize stride,
                             VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Debug-utils labels around and between commands, shown by debuggers and
@@ -508,6 +545,7 @@ public:
     Device device;
     VkCommandPool pool = VK_NULL_HANDLE;
     std::uint32_t queue_family_index = 0;
+    Ownership ownership = Ownership::owned;
     mutable Mutex mutex;
     PoolFreeList<VkCommandBuffer> pending;  // under mutex
     List<VkCommandBuffer> scratch;          // under mutex
@@ -556,14 +594,14 @@ inline VkCommandBufferLevel CommandBuffer::level() const VKRC_UNCHECKED_NOEXCEPT
     return state_->level;
 }
 
-inline void CommandBuffer::begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer,
-                                             VkRect2D render_area, std::span<const VkClearValue> clear_values,
+inline void CommandBuffer::begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
+                                             std::span<const VkClearValue> clear_values,
                                              VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
     VkRenderPassBeginInfo info{};
     info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
-    info.renderPass = render_pass.vk();
-    info.framebuffer = framebuffer.vk();
+    info.renderPass = render_pass;
+    info.framebuffer = framebuffer;
     info.renderArea = render_area;
     info.clearValueCount = static_cast<std::uint32_t>(clear_values.size());
     info.pClearValues = clear_values.data();
@@ -765,15 +803,13 @@ inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> me
     d.pImageMemoryBarriers = images.data();
     fn_->vkCmdPipelineBarrier2(cmd_, &d);
 }
-inline void CommandBuffer::set_event(const Event& event,
-                                     const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
-    fn_->vkCmdSetEvent2(cmd_, event.vk(), &dependency);
+    fn_->vkCmdSetEvent2(cmd_, event, &dependency);
 }
-inline void CommandBuffer::reset_event(const Event& event,
-                                       VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
-    fn_->vkCmdResetEvent2(cmd_, event.vk(), stage_mask);
+    fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
 }
 
 inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
@@ -787,15 +823,15 @@ inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secon
     }
 }
 
-inline void CommandBuffer::reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
+inline void CommandBuffer::reset_query_pool(VkQueryPool pool, std::uint32_t first_query,
                                             std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
-    fn_->vkCmdResetQueryPool(cmd_, pool.vk(), first_query, query_count);
+    fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
 }
-inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
+inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, VkQueryPool pool,
                                            std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
-    fn_->vkCmdWriteTimestamp2(cmd_, stage, pool.vk(), query);
+    fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
 }
 
 inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
@@ -876,21 +912,20 @@ inline void CommandBuffer::draw_indexed_indirect_count(VkBuffer buffer, VkDevice
                                        stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
 }
 
-inline void CommandBuffer::begin_query(const QueryPool& pool, std::uint32_t query,
+inline void CommandBuffer::begin_query(VkQueryPool pool, std::uint32_t query,
                                        VkQueryControlFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
-    fn_->vkCmdBeginQuery(cmd_, pool.vk(), query, flags);
+    fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
 }
-inline void CommandBuffer::end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
-    fn_->vkCmdEndQuery(cmd_, pool.vk(), query);
+    fn_->vkCmdEndQuery(cmd_, pool, query);
 }
-inline void CommandBuffer::copy_query_results(const QueryPool& pool, std::uint32_t first_query,
-                                              std::uint32_t query_count, const Buffer& dst, VkDeviceSize offset,
-                                              VkDeviceSize stride,
+inline void CommandBuffer::copy_query_results(VkQueryPool pool, std::uint32_t first_query, std::uint32_t query_count,
+                                              VkBuffer dst, VkDeviceSize offset, VkDeviceSize stride,
                                               VkQueryResultFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
-    fn_->vkCmdCopyQueryPoolResults(cmd_, pool.vk(), first_query, query_count, dst.vk(), offset, stride,
+    fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
                                    flags | VK_QUERY_RESULT_64_BIT);
 }
 

@@ -67,6 +67,7 @@ struct DeviceCreateInfo {
 };
 
 class Queue;
+struct DeviceExtensionFunctions;
 struct QueueAssignment;
 
 // A logical device; keeps its PhysicalDevice (and so its Instance) alive.
@@ -84,6 +85,8 @@ public:
 
     VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT;
     const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    // Every device-level extension command (include vkrc/extension_functions.hpp).
+    const DeviceExtensionFunctions& ext_fn() const;
     const PhysicalDevice& physical_device() const VKRC_UNCHECKED_NOEXCEPT;
     const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
     bool extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
@@ -435,6 +438,8 @@ public:
 
     VkDevice device = VK_NULL_HANDLE;
     DeviceFunctions fn;
+    // Loaded by the first Device::ext_fn() (src/extension_functions.cpp).
+    Atomic<DeviceExtensionFunctions*> ext_fn{nullptr};
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     List<Text> enabled_extensions;

@@ -18,6 +18,7 @@ class PhysicalDeviceState;
 }  // namespace detail
 
 class PhysicalDevice;
+struct InstanceExtensionFunctions;
 
 // One message from VK_EXT_debug_utils (the validation layer among others).
 struct DebugMessage {
@@ -25,6 +26,8 @@ struct DebugMessage {
     VkDebugUtilsMessageTypeFlagsEXT types{};
     const char* message_id_name{};  // may be null
     const char* message{};
+    // The objects the message is about, with their names (set_name) where given.
+    std::span<const VkDebugUtilsObjectNameInfoEXT> objects{};
 };
 using DebugCallback = Function<void(const DebugMessage&)>;
 
@@ -81,6 +84,8 @@ public:
     VkInstance vk() const VKRC_UNCHECKED_NOEXCEPT;
     const InstanceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
     const GlobalFunctions& global_fn() const VKRC_UNCHECKED_NOEXCEPT;
+    // Every instance-level extension command (include vkrc/extension_functions.hpp).
+    const InstanceExtensionFunctions& ext_fn() const;
     std::uint32_t api_version() const VKRC_UNCHECKED_NOEXCEPT;
     bool extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
     bool layer_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
@@ -96,6 +101,28 @@ private:
     friend class PhysicalDevice;
 };
 
+namespace detail {
+// A zeroed Vulkan struct with its sType (aggregate init would name every member).
+template <class T>
+constexpr T with_type(VkStructureType type) noexcept {
+    T t{};
+    t.sType = type;
+    return t;
+}
+}  // namespace detail
+
+// The Vulkan 1.0-1.3 feature structs, unchained: the sTypes are set and every
+// pNext is null, so copies are safe (vkrc chains them when it queries).
+struct DeviceFeatures {
+    VkPhysicalDeviceFeatures core{};
+    VkPhysicalDeviceVulkan11Features vulkan11 =
+        detail::with_type<VkPhysicalDeviceVulkan11Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES);
+    VkPhysicalDeviceVulkan12Features vulkan12 =
+        detail::with_type<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+    VkPhysicalDeviceVulkan13Features vulkan13 =
+        detail::with_type<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+};
+
 // What a device must offer to be chosen. Every unmet item is reported.
 // Every member is optional and read during select() only.
 struct DeviceRequirements {
@@ -105,6 +132,9 @@ struct DeviceRequirements {
     VkQueueFlags queue_flags = VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT;
     // Default none.
     List<const char*> required_extensions{};
+    // Every feature set to VK_TRUE must be supported; each missing one is
+    // named in the rejection. Default none.
+    DeviceFeatures required_features{};
     // A queue family of the chosen device must be able to present to it (default: no surface).
     VkSurfaceKHR present_surface = VK_NULL_HANDLE;
     // Devices of earlier types in this list win; CPU devices (lavapipe) are accepted.
@@ -149,6 +179,16 @@ public:
     const VkPhysicalDeviceProperties& properties() const VKRC_UNCHECKED_NOEXCEPT;
     const VkPhysicalDeviceMemoryProperties& memory_properties() const VKRC_UNCHECKED_NOEXCEPT;
     const List<VkQueueFamilyProperties>& queue_families() const VKRC_UNCHECKED_NOEXCEPT;
+    // The 1.0-1.3 features, read once (those of versions the device or the
+    // instance lacks stay VK_FALSE).
+    const DeviceFeatures& features() const VKRC_UNCHECKED_NOEXCEPT;
+    // vkGetPhysicalDeviceFormatProperties2 with VkFormatProperties3 (64-bit
+    // flags); before Vulkan 1.3, the 32-bit flags widened. pNext is null.
+    VkFormatProperties3 format_properties(VkFormat format) const;
+    // The family select() chose: the first with the requirements' queue_flags
+    // that can present to their present_surface, if one was given. For a
+    // device not chosen by select(), the first with graphics and compute; -1 if none.
+    int default_queue_family() const VKRC_UNCHECKED_NOEXCEPT;
     const char* name() const VKRC_UNCHECKED_NOEXCEPT { return properties().deviceName; }
     bool supports_extension(const char* name) const VKRC_UNCHECKED_NOEXCEPT;
     // First family with all the flags (and presentation to surface if given), or -1.
@@ -170,6 +210,8 @@ public:
     std::uint32_t api_version = 0;
     GlobalFunctions global_fn;
     InstanceFunctions fn;
+    // Loaded by the first Instance::ext_fn() (src/extension_functions.cpp).
+    Atomic<InstanceExtensionFunctions*> ext_fn{nullptr};
     List<Text> enabled_extensions;
     List<Text> enabled_layers;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
@@ -183,7 +225,9 @@ public:
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memory_properties{};
     List<VkQueueFamilyProperties> queue_families;
+    DeviceFeatures features;
     List<Text> extensions;
+    int default_queue_family = -1;
 };
 
 }  // namespace detail
@@ -228,6 +272,14 @@ inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties
 inline const List<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::queue_families");
     return state_->queue_families;
+}
+inline const DeviceFeatures& PhysicalDevice::features() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::features");
+    return state_->features;
+}
+inline int PhysicalDevice::default_queue_family() const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::default_queue_family");
+    return state_->default_queue_family;
 }
 
 VKRC_END_NAMESPACE

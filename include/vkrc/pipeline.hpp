@@ -33,6 +33,9 @@ public:
     PipelineLayout() noexcept = default;
     static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
     static PipelineLayout create(const Device& device);  // no sets, no push constants
+    // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
+    // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static PipelineLayout adopt(const Device& device, VkPipelineLayout layout, Ownership ownership);
     VkPipelineLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
@@ -69,6 +72,10 @@ class RenderPass : public Handle<detail::RenderPassState> {
 public:
     RenderPass() noexcept = default;
     static RenderPass create(const Device& device, const RenderPassCreateInfo& info);
+    // Wraps one made elsewhere from device; color_attachment_counts: each
+    // subpass's (copied). Ownership as for PipelineLayout::adopt.
+    static RenderPass adopt(const Device& device, VkRenderPass render_pass,
+                            std::span<const std::uint32_t> color_attachment_counts, Ownership ownership);
     VkRenderPass vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t color_attachment_count(std::uint32_t subpass) const;
@@ -99,6 +106,11 @@ class Framebuffer : public Handle<detail::FramebufferState> {
 public:
     Framebuffer() noexcept = default;
     static Framebuffer create(const Device& device, const FramebufferCreateInfo& info);
+    // Wraps one made elsewhere for render_pass. Its attachments are not kept
+    // alive: their maker keeps them until the framebuffer is gone. Ownership
+    // as for PipelineLayout::adopt.
+    static Framebuffer adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
+                             Ownership ownership);
     VkFramebuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkExtent2D extent() const VKRC_UNCHECKED_NOEXCEPT;
     const RenderPass& render_pass() const VKRC_UNCHECKED_NOEXCEPT;
@@ -117,6 +129,9 @@ public:
     // corrupt or foreign (other driver/device) file is ignored with a warning
     // on stderr: the cache starts empty and loaded_from_file() is false.
     static PipelineCache load(const Device& device, const char* file);
+    // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
+    // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static PipelineCache adopt(const Device& device, VkPipelineCache cache, Ownership ownership);
 
     VkPipelineCache vk() const VKRC_UNCHECKED_NOEXCEPT;
     bool loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT;
@@ -153,6 +168,12 @@ struct ComputePipelineCreateInfo {
 class Pipeline : public Handle<detail::PipelineState> {
 public:
     Pipeline() noexcept = default;
+    // Wraps a pipeline made elsewhere (any kind: graphics, compute, ray
+    // tracing) with layout, so that it binds through vkrc. With
+    // Ownership::owned vkrc destroys it once the GPU is done; borrowed, its
+    // maker does (after vkrc's last use).
+    static Pipeline adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
+                          Ownership ownership);
     VkPipeline vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkPipelineBindPoint bind_point() const VKRC_UNCHECKED_NOEXCEPT;
     const PipelineLayout& layout() const VKRC_UNCHECKED_NOEXCEPT;
@@ -367,6 +388,7 @@ public:
     ~PipelineLayoutState() override;
     Device device;
     VkPipelineLayout layout = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
 };
 
 class RenderPassState final : public RefCounted {
@@ -374,6 +396,7 @@ public:
     ~RenderPassState() override;
     Device device;
     VkRenderPass render_pass = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     List<std::uint32_t> color_counts;  // per subpass
 };
 
@@ -383,6 +406,7 @@ public:
     RenderPass render_pass;
     List<ImageView> attachments;
     VkFramebuffer framebuffer = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     VkExtent2D extent{};
 };
 
@@ -391,6 +415,7 @@ public:
     ~PipelineCacheState() override;
     Device device;
     VkPipelineCache cache = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     bool loaded_from_file = false;
 };
 
@@ -400,6 +425,7 @@ public:
     PipelineLayout layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
     VkPipelineBindPoint bind_point = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail

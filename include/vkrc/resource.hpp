@@ -154,6 +154,11 @@ class ImageView : public Handle<detail::ImageViewState> {
 public:
     ImageView() noexcept = default;
     static ImageView create(const Image& image, const ImageViewCreateInfo& info = {});
+    // Wraps a view of image made elsewhere, with the format and range it was
+    // made with (aspectMask set). With Ownership::owned vkrc destroys it once
+    // the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static ImageView adopt(const Image& image, VkImageView view, VkFormat format,
+                           const VkImageSubresourceRange& subresource_range, Ownership ownership);
 
     VkImageView vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Image& image() const VKRC_UNCHECKED_NOEXCEPT;
@@ -183,6 +188,9 @@ class BufferView : public Handle<detail::BufferViewState> {
 public:
     BufferView() noexcept = default;
     static BufferView create(const Buffer& buffer, const BufferViewCreateInfo& info);
+    // Wraps a view of buffer made elsewhere. With Ownership::owned vkrc
+    // destroys it once the GPU is done; borrowed, its maker does.
+    static BufferView adopt(const Buffer& buffer, VkBufferView view, Ownership ownership);
 
     VkBufferView vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Buffer& buffer() const VKRC_UNCHECKED_NOEXCEPT;
@@ -220,6 +228,9 @@ class Sampler : public Handle<detail::SamplerState> {
 public:
     Sampler() noexcept = default;
     static Sampler create(const Device& device, const SamplerCreateInfo& info = {});
+    // Wraps one made elsewhere from the same device. With Ownership::owned vkrc
+    // destroys it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static Sampler adopt(const Device& device, VkSampler sampler, Ownership ownership);
 
     VkSampler vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -275,6 +286,7 @@ public:
     ~ImageViewState() override;
     Image image;
     VkImageView view = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     VkFormat format = VK_FORMAT_UNDEFINED;
     VkImageSubresourceRange range{};
     SamplerYcbcrConversion ycbcr_conversion;  // if made with one
@@ -285,6 +297,7 @@ public:
     ~BufferViewState() override;
     Buffer buffer;
     VkBufferView view = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
 };
 
 class SamplerState final : public RefCounted {
@@ -292,6 +305,7 @@ public:
     ~SamplerState() override;
     Device device;
     VkSampler sampler = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     SamplerYcbcrConversion ycbcr_conversion;  // if made with one
 };
 

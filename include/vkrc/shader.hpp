@@ -20,6 +20,9 @@ public:
     // Bytes of a .spv file; also rejects a size that is not a multiple of 4.
     static ShaderModule create(const Device& device, std::span<const std::byte> spirv);
     static ShaderModule load(const Device& device, const char* spv_file);
+    // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
+    // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static ShaderModule adopt(const Device& device, VkShaderModule module, Ownership ownership);
 
     VkShaderModule vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -34,6 +37,7 @@ public:
     ~ShaderModuleState() override;
     Device device;
     VkShaderModule module = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
 };
 }  // namespace detail
 

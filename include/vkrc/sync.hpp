@@ -71,6 +71,9 @@ public:
     Event() noexcept = default;
     // device_only: VK_EVENT_CREATE_DEVICE_ONLY_BIT (no host set/reset/status).
     static Event create(const Device& device, bool device_only = false);
+    // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
+    // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    static Event adopt(const Device& device, VkEvent event, Ownership ownership);
 
     VkEvent vk() const VKRC_UNCHECKED_NOEXCEPT;
     // vkSetEvent / vkResetEvent (reset() drops the handle, as on every handle).
@@ -99,6 +102,10 @@ class QueryPool : public Handle<detail::QueryPoolState> {
 public:
     QueryPool() noexcept = default;
     static QueryPool create(const Device& device, const QueryPoolCreateInfo& info);
+    // Wraps a pool made elsewhere from device; info: what it was made with
+    // (read during the call). Ownership as for Event::adopt.
+    static QueryPool adopt(const Device& device, VkQueryPool pool, const QueryPoolCreateInfo& info,
+                           Ownership ownership);
 
     VkQueryPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t query_count() const VKRC_UNCHECKED_NOEXCEPT;
@@ -171,6 +178,7 @@ public:
     ~EventState() override;
     Device device;
     VkEvent event = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
 };
 
 class QueryPoolState final : public RefCounted {
@@ -178,6 +186,7 @@ public:
     ~QueryPoolState() override;
     Device device;
     VkQueryPool pool = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     std::uint32_t count = 0;
     VkQueryType type = VK_QUERY_TYPE_TIMESTAMP;
     std::uint32_t values_per_query = 1;

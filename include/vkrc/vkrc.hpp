@@ -3,6 +3,7 @@
 
 #include "vkrc/command.hpp"
 #include "vkrc/config.hpp"
+#include "vkrc/debug_utils.hpp"
 #include "vkrc/descriptor.hpp"
 #include "vkrc/descriptor_template.hpp"
 #include "vkrc/device.hpp"

@@ -1,0 +1,67 @@
+#include "vkrc/debug_utils.hpp"
+
+#include "debug_message.hpp"
+
+#include <string>
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+DebugMessengerState::~DebugMessengerState() {
+    if (ownership == Ownership::owned && messenger != VK_NULL_HANDLE) {
+        instance.fn().vkDestroyDebugUtilsMessengerEXT(instance.vk(), messenger, nullptr);
+    }
+}
+}  // namespace detail
+
+namespace {
+void require_debug_utils(const Instance& instance, const char* call) {
+    if (!instance) throw UsageError(std::string(call) + ": the Instance handle is empty");
+    if (!instance.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) {
+        throw UsageError(std::string(call) + ": the instance was created without VK_EXT_debug_utils");
+    }
+}
+}  // namespace
+
+DebugMessenger DebugMessenger::create(const Instance& instance, const DebugMessengerCreateInfo& info) {
+    require_debug_utils(instance, "vkrc::DebugMessenger::create");
+    if (!info.callback) throw UsageError("vkrc::DebugMessenger::create: the callback is empty");
+    // The state exists first: its callback's address is the user data.
+    detail::Ref<detail::DebugMessengerState> state(new detail::DebugMessengerState);
+    state->instance = instance;
+    state->callback = info.callback;
+    VkDebugUtilsMessengerCreateInfoEXT ci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT, info.next};
+    ci.messageSeverity = info.severities;
+    ci.messageType = info.types;
+    ci.pfnUserCallback = detail::debug_trampoline;
+    ci.pUserData = &state->callback;
+    check(instance.fn().vkCreateDebugUtilsMessengerEXT(instance.vk(), &ci, nullptr, &state->messenger),
+          "vkCreateDebugUtilsMessengerEXT");
+    return DebugMessenger(std::move(state));
+}
+
+DebugMessenger DebugMessenger::adopt(const Instance& instance, VkDebugUtilsMessengerEXT messenger,
+                                     Ownership ownership) {
+    require_debug_utils(instance, "vkrc::DebugMessenger::adopt");
+    if (messenger == VK_NULL_HANDLE) {
+        throw UsageError("vkrc::DebugMessenger::adopt: the VkDebugUtilsMessengerEXT is VK_NULL_HANDLE");
+    }
+    detail::Ref<detail::DebugMessengerState> state(new detail::DebugMessengerState);
+    state->instance = instance;
+    state->messenger = messenger;
+    state->ownership = ownership;
+    return DebugMessenger(std::move(state));
+}
+
+void set_name(const Device& device, VkObjectType type, std::uint64_t handle, const char* name) {
+    // Null when the instance did not enable VK_EXT_debug_utils (see device.cpp).
+    auto set = device.fn().vkSetDebugUtilsObjectNameEXT;
+    if (!set) return;
+    VkDebugUtilsObjectNameInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT};
+    info.objectType = type;
+    info.objectHandle = handle;
+    info.pObjectName = name;
+    check(set(device.vk(), &info), "vkSetDebugUtilsObjectNameEXT");
+}
+
+VKRC_END_NAMESPACE

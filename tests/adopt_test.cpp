@@ -1,0 +1,297 @@
+// Adopt: objects made with the raw API enter vkrc, owned (vkrc destroys them;
+// the validation layer reports a leak at vkDestroyDevice otherwise) or
+// borrowed (their maker destroys them; a double destroy would be reported).
+#include "support/vk_test.hpp"
+
+#include "shaders/spec_fill.comp.h"
+
+#include <functional>
+#include <span>
+
+namespace {
+
+using vkrc_test::VulkanTest;
+
+// Records through record, submits and waits.
+void run(const vkrc::Queue& queue, const std::function<void(const vkrc::CommandBuffer&)>& record) {
+    auto pool = vkrc::CommandPool::create(queue.device(), {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    record(cmd);
+    cmd.end();
+    auto fence = vkrc::Fence::create(queue.device());
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+}
+
+// A compute pipeline made entirely with the raw API, as another library would.
+struct RawCompute {
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+};
+
+RawCompute make_raw_compute(const vkrc::Device& device, VkDescriptorSetLayout set_layout) {
+    const auto& fn = device.fn();
+    RawCompute raw;
+    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    module_info.codeSize = vkrc_shaders::spec_fill_comp.size_bytes();
+    module_info.pCode = vkrc_shaders::spec_fill_comp.data();
+    EXPECT_EQ(fn.vkCreateShaderModule(device.vk(), &module_info, nullptr, &raw.module), VK_SUCCESS);
+    VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layout_info.setLayoutCount = 1;
+    layout_info.pSetLayouts = &set_layout;
+    EXPECT_EQ(fn.vkCreatePipelineLayout(device.vk(), &layout_info, nullptr, &raw.layout), VK_SUCCESS);
+    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    ci.stage.module = raw.module;
+    ci.stage.pName = "main";
+    ci.layout = raw.layout;
+    EXPECT_EQ(fn.vkCreateComputePipelines(device.vk(), VK_NULL_HANDLE, 1, &ci, nullptr, &raw.pipeline), VK_SUCCESS);
+    return raw;
+}
+
+TEST_F(VulkanTest, AdoptedPipelineBindsThroughVkrc) {
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto raw = make_raw_compute(device, set_layout.vk());
+    // Owned: vkrc destroys all three once the GPU is done with them.
+    auto module = vkrc::ShaderModule::adopt(device, raw.module, vkrc::Ownership::owned);
+    auto layout = vkrc::PipelineLayout::adopt(device, raw.layout, vkrc::Ownership::owned);
+    auto pipeline = vkrc::Pipeline::adopt(layout, raw.pipeline, VK_PIPELINE_BIND_POINT_COMPUTE, vkrc::Ownership::owned);
+    module.reset();  // a pipeline does not need its module after creation
+    EXPECT_EQ(pipeline.layout().vk(), raw.layout);
+    EXPECT_EQ(pipeline.bind_point(), VK_PIPELINE_BIND_POINT_COMPUTE);
+
+    auto buffer = vkrc::Buffer::create(
+        device,
+        {.size = 4, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto descriptors =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto set = descriptors.allocate(set_layout);
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer);
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.bind_pipeline(pipeline);
+        cmd.bind_descriptor_set(pipeline, 0, set);
+        cmd.dispatch(1);
+        auto to_host = vkrc::buffer_barrier(buffer.vk(), VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                                            VK_ACCESS_2_HOST_READ_BIT);
+        cmd.pipeline_barrier({}, std::span(&to_host, 1), {});
+    });
+    EXPECT_EQ(buffer.allocation().read_value<std::uint32_t>(0), 1u);  // the constants' defaults: 1 + 1 * 0
+}
+
+TEST_F(VulkanTest, AdoptedBorrowedObjectsAreLeftToTheirMaker) {
+    const auto& fn = device.fn();
+    VkSamplerCreateInfo sampler_info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    VkSampler sampler = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateSampler(device.vk(), &sampler_info, nullptr, &sampler), VK_SUCCESS);
+    VkEventCreateInfo event_info{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
+    VkEvent event = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateEvent(device.vk(), &event_info, nullptr, &event), VK_SUCCESS);
+    VkPipelineCacheCreateInfo cache_info{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+    VkPipelineCache cache = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreatePipelineCache(device.vk(), &cache_info, nullptr, &cache), VK_SUCCESS);
+
+    auto borrowed_event = vkrc::Event::adopt(device, event, vkrc::Ownership::borrowed);
+    borrowed_event.set();
+    EXPECT_EQ(borrowed_event.status(), VK_EVENT_SET);
+    vkrc::Sampler::adopt(device, sampler, vkrc::Ownership::borrowed).reset();
+    vkrc::PipelineCache::adopt(device, cache, vkrc::Ownership::borrowed).reset();
+    borrowed_event.reset();
+    device.wait_idle();  // runs any (wrongly) deferred destruction before the raw ones
+    fn.vkDestroySampler(device.vk(), sampler, nullptr);
+    fn.vkDestroyEvent(device.vk(), event, nullptr);
+    fn.vkDestroyPipelineCache(device.vk(), cache, nullptr);
+}
+
+TEST_F(VulkanTest, AdoptedOwnedObjectsAreDestroyedByVkrc) {
+    const auto& fn = device.fn();
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                     .extent = {4, 4, 1},
+                                     .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT});
+    auto buffer = vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT});
+
+    VkImageViewCreateInfo view_info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view_info.image = image.vk();
+    view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view_info.format = VK_FORMAT_R8G8B8A8_UNORM;
+    view_info.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkImageView view = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateImageView(device.vk(), &view_info, nullptr, &view), VK_SUCCESS);
+    auto image_view =
+        vkrc::ImageView::adopt(image, view, view_info.format, view_info.subresourceRange, vkrc::Ownership::owned);
+    EXPECT_EQ(image_view.format(), VK_FORMAT_R8G8B8A8_UNORM);
+    EXPECT_EQ(image_view.image().vk(), image.vk());
+
+    VkBufferViewCreateInfo buffer_view_info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    buffer_view_info.buffer = buffer.vk();
+    buffer_view_info.format = VK_FORMAT_R32_UINT;
+    buffer_view_info.range = VK_WHOLE_SIZE;
+    VkBufferView buffer_view = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateBufferView(device.vk(), &buffer_view_info, nullptr, &buffer_view), VK_SUCCESS);
+    vkrc::BufferView::adopt(buffer, buffer_view, vkrc::Ownership::owned);
+
+    VkQueryPoolCreateInfo query_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    query_info.queryCount = 2;
+    VkQueryPool raw_pool = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateQueryPool(device.vk(), &query_info, nullptr, &raw_pool), VK_SUCCESS);
+    auto queries = vkrc::QueryPool::adopt(device, raw_pool, {.query_count = 2}, vkrc::Ownership::owned);
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.reset_query_pool(queries, 0, 2);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries, 0);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries, 1);
+    });
+    std::uint64_t stamps[2] = {};
+    EXPECT_EQ(queries.results(0, stamps, VK_QUERY_RESULT_WAIT_BIT), VK_SUCCESS);
+    EXPECT_LE(stamps[0], stamps[1]);
+
+    VkAttachmentDescription attachment{0,
+                                       VK_FORMAT_R8G8B8A8_UNORM,
+                                       VK_SAMPLE_COUNT_1_BIT,
+                                       VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                       VK_ATTACHMENT_STORE_OP_STORE,
+                                       VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                       VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                       VK_IMAGE_LAYOUT_UNDEFINED,
+                                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    VkAttachmentReference color{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    VkSubpassDescription subpass{};
+    subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+    subpass.colorAttachmentCount = 1;
+    subpass.pColorAttachments = &color;
+    VkRenderPassCreateInfo pass_info{VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO};
+    pass_info.attachmentCount = 1;
+    pass_info.pAttachments = &attachment;
+    pass_info.subpassCount = 1;
+    pass_info.pSubpasses = &subpass;
+    VkRenderPass raw_pass = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateRenderPass(device.vk(), &pass_info, nullptr, &raw_pass), VK_SUCCESS);
+    const std::uint32_t color_counts[] = {1};
+    auto pass = vkrc::RenderPass::adopt(device, raw_pass, color_counts, vkrc::Ownership::owned);
+    EXPECT_EQ(pass.color_attachment_count(0), 1u);
+    VkFramebufferCreateInfo fb_info{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
+    fb_info.renderPass = raw_pass;
+    fb_info.attachmentCount = 1;
+    fb_info.pAttachments = &view;
+    fb_info.width = fb_info.height = 4;
+    fb_info.layers = 1;
+    VkFramebuffer raw_fb = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateFramebuffer(device.vk(), &fb_info, nullptr, &raw_fb), VK_SUCCESS);
+    auto framebuffer = vkrc::Framebuffer::adopt(pass, raw_fb, {4, 4}, vkrc::Ownership::owned);
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        VkClearValue clear{};
+        cmd.begin_render_pass(pass, framebuffer, {{0, 0}, {4, 4}}, std::span(&clear, 1));
+        cmd.end_render_pass();
+    });
+    // The image view must outlive the framebuffer: dropped last.
+    framebuffer.reset();
+    image_view.reset();
+}
+
+// A pool made elsewhere: vkrc allocates from it and records; borrowed, the
+// maker destroys it (with its command buffers) after the GPU is done.
+TEST_F(VulkanTest, AdoptedCommandPoolAllocatesAndRecords) {
+    VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    info.queueFamilyIndex = queue.family_index();
+    VkCommandPool raw = VK_NULL_HANDLE;
+    ASSERT_EQ(device.fn().vkCreateCommandPool(device.vk(), &info, nullptr, &raw), VK_SUCCESS);
+    for (auto ownership : {vkrc::Ownership::borrowed, vkrc::Ownership::owned}) {
+        auto pool = vkrc::CommandPool::adopt(device, raw, queue.family_index(), ownership);
+        EXPECT_EQ(pool.queue_family_index(), queue.family_index());
+        auto cmd = pool.allocate();
+        cmd.begin();
+        cmd.end();
+        auto fence = vkrc::Fence::create(device);
+        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    }
+    // The owned round destroyed the pool: a second destroy (or a leak) would be reported.
+    EXPECT_THROW(vkrc::CommandPool::adopt(device, VK_NULL_HANDLE, 0, vkrc::Ownership::owned), vkrc::UsageError);
+}
+
+// RawInterop: the recording methods that take query pools, events, render
+// passes and framebuffers also take their raw handles.
+TEST_F(VulkanTest, RawInteropQueriesAndEventsByRawHandle) {
+    const auto& fn = device.fn();
+    auto queries = vkrc::QueryPool::create(device, {.query_count = 2});
+    auto event = vkrc::Event::create(device);
+    auto results = vkrc::Buffer::create(
+        device,
+        {.size = 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    const VkQueryPool raw_pool = queries.vk();
+    const VkEvent raw_event = event.vk();
+    const VkBuffer raw_results = results.vk();
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.reset_query_pool(raw_pool, 0, 2);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, raw_pool, 0);
+        cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, raw_pool, 1);
+        cmd.copy_query_results(raw_pool, 0, 2, raw_results, 0, 8);
+        auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        VkDependencyInfo dependency{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dependency.memoryBarrierCount = 1;
+        dependency.pMemoryBarriers = &to_host;
+        cmd.set_event(raw_event, dependency);
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    });
+    EXPECT_EQ(fn.vkGetEventStatus(device.vk(), raw_event), VK_EVENT_SET);
+    auto first = results.allocation().read_value<std::uint64_t>(0);
+    auto second = results.allocation().read_value<std::uint64_t>(8);
+    EXPECT_NE(second, 0u);
+    EXPECT_LE(first, second);
+    run(queue,
+        [&](const vkrc::CommandBuffer& cmd) { cmd.reset_event(raw_event, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT); });
+    EXPECT_EQ(fn.vkGetEventStatus(device.vk(), raw_event), VK_EVENT_RESET);
+}
+
+TEST_F(VulkanTest, RawInteropRenderPassByRawHandle) {
+    auto image = vkrc::Image::create(
+        device,
+        {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT});
+    auto view = vkrc::ImageView::create(image);
+    VkAttachmentDescription attachment{0,
+                                       VK_FORMAT_R8G8B8A8_UNORM,
+                                       VK_SAMPLE_COUNT_1_BIT,
+                                       VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                       VK_ATTACHMENT_STORE_OP_STORE,
+                                       VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                       VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                       VK_IMAGE_LAYOUT_UNDEFINED,
+                                       VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+    auto pass = vkrc::RenderPass::create(
+        device, {.attachments = {attachment},
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}}});
+    auto framebuffer =
+        vkrc::Framebuffer::create(device, {.render_pass = pass, .attachments = {view}, .width = 4, .height = 4});
+    const VkRenderPass raw_pass = pass.vk();
+    const VkFramebuffer raw_framebuffer = framebuffer.vk();
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        VkClearValue clear{};
+        cmd.begin_render_pass(raw_pass, raw_framebuffer, {{0, 0}, {4, 4}}, std::span(&clear, 1));
+        cmd.end_render_pass();
+    });
+}
+
+TEST_F(VulkanTest, AdoptRejectsNullHandles) {
+    EXPECT_THROW(vkrc::Sampler::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+    EXPECT_THROW(vkrc::ShaderModule::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+    EXPECT_THROW(vkrc::Event::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+    EXPECT_THROW(vkrc::PipelineLayout::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+    EXPECT_THROW(vkrc::PipelineCache::adopt(vkrc::Device(), VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+    EXPECT_THROW(vkrc::Pipeline::adopt(vkrc::PipelineLayout(), VK_NULL_HANDLE, VK_PIPELINE_BIND_POINT_COMPUTE,
+                                       vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    EXPECT_THROW(vkrc::QueryPool::adopt(device, VK_NULL_HANDLE, {.query_count = 1}, vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    EXPECT_THROW(vkrc::QueryPool::adopt(device, VK_NULL_HANDLE, {}, vkrc::Ownership::owned), vkrc::UsageError);
+}
+
+}  // namespace
