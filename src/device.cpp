@@ -316,7 +316,12 @@ void assign_roles(detail::DeviceState& s) {
 // when there is one, else another queue of the graphics family if it has room.
 void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& info,
                        std::vector<QueueRequest>& requests) {
-    const int graphics = find_dedicated_queue_family(physical, QueueRole::graphics);
+    // The family select() chose (one that presents, when it was given a
+    // surface), else the first with graphics and compute.
+    int graphics = physical.default_queue_family();
+    if (graphics < 0 ||
+        !family_has(physical, static_cast<std::uint32_t>(graphics), VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
+        graphics = find_dedicated_queue_family(physical, QueueRole::graphics);
     if (graphics < 0) throw UsageError("vkrc::Device::create: no queue family with graphics and compute");
     requests.push_back(QueueRequest{static_cast<std::uint32_t>(graphics)});
     for (QueueRole role : {QueueRole::transfer, QueueRole::compute}) {
@@ -437,6 +442,7 @@ bool Device::extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
 }
 
 Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
+    VKRC_REQUIRE_STATE("vkrc::Device::queue");
     for (auto& q : state_->queues) {
         if (q.family_index == family_index && q.index == index) return Queue(*this, &q);
     }
@@ -445,11 +451,13 @@ Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
 }
 
 Queue Device::default_queue() const {
+    VKRC_REQUIRE_STATE("vkrc::Device::default_queue");
     if (state_->queues.empty()) throw UsageError("vkrc::Device::default_queue: the device has no queues");
     return Queue(*this, &state_->queues.front());
 }
 
 QueueAssignment Device::queue_for(QueueRole role) const {
+    VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
     VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
     if (state_->queues.empty()) throw UsageError("vkrc::Device::queue_for: the device has no queues");
     const std::size_t index = state_->role_queues[static_cast<int>(role)];
@@ -478,12 +486,10 @@ void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
     state_->collect();
 }
 std::size_t Device::deferred_count() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::deferred_count");
-    return state_->deferred.size() + state_->commands.held_count();
+    return live("vkrc::Device::deferred_count").deferred.size() + state_->commands.held_count();
 }
 bool Device::lost() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::lost");
-    return state_->lost.load(std::memory_order_relaxed);
+    return live("vkrc::Device::lost").lost.load(std::memory_order_relaxed);
 }
 
 namespace {

@@ -272,14 +272,10 @@ Uploader Uploader::create(const UploaderCreateInfo& info) {
     return Uploader(std::move(state));
 }
 
-const Queue& Uploader::queue() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Uploader::queue");
-    return state_->queue;
-}
+const Queue& Uploader::queue() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Uploader::queue").queue; }
 
 VkDeviceSize Uploader::staging_size() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Uploader::staging_size");
-    return state_->staging.size();
+    return live("vkrc::Uploader::staging_size").staging.size();
 }
 
 void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) const {
@@ -458,19 +454,14 @@ FrameRing FrameRing::create(const FrameRingCreateInfo& info) {
     return FrameRing(std::move(state));
 }
 
-const Buffer& FrameRing::buffer() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::FrameRing::buffer");
-    return state_->buffer;
-}
+const Buffer& FrameRing::buffer() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::FrameRing::buffer").buffer; }
 
 VkDeviceSize FrameRing::frame_size() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::FrameRing::frame_size");
-    return state_->frame_size;
+    return live("vkrc::FrameRing::frame_size").frame_size;
 }
 
 std::uint32_t FrameRing::frame_index() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::FrameRing::frame_index");
-    return state_->index;
+    return live("vkrc::FrameRing::frame_index").index;
 }
 
 void FrameRing::begin_frame() const {

@@ -254,8 +254,7 @@ VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> 
 }
 
 double QueryPool::timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::QueryPool::timestamp_period_ns");
-    return state_->device.physical_device().properties().limits.timestampPeriod;
+    return live("vkrc::QueryPool::timestamp_period_ns").device.physical_device().properties().limits.timestampPeriod;
 }
 
 VKRC_END_NAMESPACE

@@ -564,17 +564,12 @@ public:
 
 }  // namespace detail
 
-inline VkCommandPool CommandPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandPool::vk");
-    return state_->pool;
-}
+inline VkCommandPool CommandPool::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::CommandPool::vk").pool; }
 inline const Device& CommandPool::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandPool::device");
-    return state_->device;
+    return live("vkrc::CommandPool::device").device;
 }
 inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandPool::queue_family_index");
-    return state_->queue_family_index;
+    return live("vkrc::CommandPool::queue_family_index").queue_family_index;
 }
 
 inline VkCommandBuffer CommandBuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
@@ -586,12 +581,10 @@ inline const DeviceFunctions& CommandBuffer::fn() const VKRC_UNCHECKED_NOEXCEPT 
     return *fn_;
 }
 inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pool");
-    return state_->pool;
+    return live("vkrc::CommandBuffer::pool").pool;
 }
 inline VkCommandBufferLevel CommandBuffer::level() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::level");
-    return state_->level;
+    return live("vkrc::CommandBuffer::level").level;
 }
 
 inline void CommandBuffer::begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,

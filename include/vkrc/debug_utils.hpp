@@ -113,12 +113,10 @@ public:
 }  // namespace detail
 
 inline VkDebugUtilsMessengerEXT DebugMessenger::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DebugMessenger::vk");
-    return state_->messenger;
+    return live("vkrc::DebugMessenger::vk").messenger;
 }
 inline const Instance& DebugMessenger::instance() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DebugMessenger::instance");
-    return state_->instance;
+    return live("vkrc::DebugMessenger::instance").instance;
 }
 
 VKRC_END_NAMESPACE

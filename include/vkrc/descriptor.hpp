@@ -180,28 +180,20 @@ public:
 }  // namespace detail
 
 inline VkDescriptorSetLayout DescriptorSetLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSetLayout::vk");
-    return state_->layout;
+    return live("vkrc::DescriptorSetLayout::vk").layout;
 }
 inline const Device& DescriptorSetLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSetLayout::device");
-    return state_->device;
+    return live("vkrc::DescriptorSetLayout::device").device;
 }
 inline VkDescriptorPool DescriptorPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorPool::vk");
-    return state_->pool;
+    return live("vkrc::DescriptorPool::vk").pool;
 }
 inline const Device& DescriptorPool::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorPool::device");
-    return state_->device;
+    return live("vkrc::DescriptorPool::device").device;
 }
-inline VkDescriptorSet DescriptorSet::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::vk");
-    return state_->set;
-}
+inline VkDescriptorSet DescriptorSet::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::DescriptorSet::vk").set; }
 inline const DescriptorPool& DescriptorSet::pool() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::pool");
-    return state_->pool;
+    return live("vkrc::DescriptorSet::pool").pool;
 }
 
 VKRC_END_NAMESPACE

@@ -72,28 +72,22 @@ public:
 }  // namespace detail
 
 inline VkDescriptorUpdateTemplate DescriptorUpdateTemplate::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::vk");
-    return state_->update_template;
+    return live("vkrc::DescriptorUpdateTemplate::vk").update_template;
 }
 inline const Device& DescriptorUpdateTemplate::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::device");
-    return state_->device;
+    return live("vkrc::DescriptorUpdateTemplate::device").device;
 }
 inline VkDescriptorUpdateTemplateType DescriptorUpdateTemplate::template_type() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::template_type");
-    return state_->type;
+    return live("vkrc::DescriptorUpdateTemplate::template_type").type;
 }
 inline const DescriptorSetLayout& DescriptorUpdateTemplate::descriptor_set_layout() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::descriptor_set_layout");
-    return state_->set_layout;
+    return live("vkrc::DescriptorUpdateTemplate::descriptor_set_layout").set_layout;
 }
 inline const PipelineLayout& DescriptorUpdateTemplate::pipeline_layout() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::pipeline_layout");
-    return state_->pipeline_layout;
+    return live("vkrc::DescriptorUpdateTemplate::pipeline_layout").pipeline_layout;
 }
 inline std::uint32_t DescriptorUpdateTemplate::set() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorUpdateTemplate::set");
-    return state_->set;
+    return live("vkrc::DescriptorUpdateTemplate::set").set;
 }
 
 VKRC_END_NAMESPACE

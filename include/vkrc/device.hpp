@@ -485,21 +485,13 @@ void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) n
 
 }  // namespace detail
 
-inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::vk");
-    return state_->device;
-}
-inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::fn");
-    return state_->fn;
-}
+inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::vk").device; }
+inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::fn").fn; }
 inline const PhysicalDevice& Device::physical_device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::physical_device");
-    return state_->physical_device;
+    return live("vkrc::Device::physical_device").physical_device;
 }
 inline const Instance& Device::instance() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Device::instance");
-    return state_->physical_device.instance();
+    return live("vkrc::Device::instance").physical_device.instance();
 }
 
 inline VkQueue Queue::vk() const noexcept { return queue_->queue; }

@@ -277,6 +277,12 @@ public:
 
 protected:
     explicit Handle(detail::Ref<State> state) noexcept : state_(std::move(state)) {}
+    // The state, for the wrappers' accessors: who (e.g. "vkrc::Buffer::vk")
+    // names the call in the UsageError an empty handle gets.
+    State& live([[maybe_unused]] const char* who) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE(who);
+        return *state_;
+    }
     detail::Ref<State> state_;
 };
 

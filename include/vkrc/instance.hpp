@@ -232,54 +232,38 @@ public:
 
 }  // namespace detail
 
-inline VkInstance Instance::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Instance::vk");
-    return state_->instance;
-}
-inline const InstanceFunctions& Instance::fn() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Instance::fn");
-    return state_->fn;
-}
+inline VkInstance Instance::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Instance::vk").instance; }
+inline const InstanceFunctions& Instance::fn() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Instance::fn").fn; }
 inline const GlobalFunctions& Instance::global_fn() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Instance::global_fn");
-    return state_->global_fn;
+    return live("vkrc::Instance::global_fn").global_fn;
 }
 inline std::uint32_t Instance::api_version() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Instance::api_version");
-    return state_->api_version;
+    return live("vkrc::Instance::api_version").api_version;
 }
 
 inline VkPhysicalDevice PhysicalDevice::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::vk");
-    return state_->physical_device;
+    return live("vkrc::PhysicalDevice::vk").physical_device;
 }
 inline const Instance& PhysicalDevice::instance() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::instance");
-    return state_->instance;
+    return live("vkrc::PhysicalDevice::instance").instance;
 }
 inline const InstanceFunctions& PhysicalDevice::fn() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::fn");
-    return state_->instance.fn();
+    return live("vkrc::PhysicalDevice::fn").instance.fn();
 }
 inline const VkPhysicalDeviceProperties& PhysicalDevice::properties() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::properties");
-    return state_->properties;
+    return live("vkrc::PhysicalDevice::properties").properties;
 }
 inline const VkPhysicalDeviceMemoryProperties& PhysicalDevice::memory_properties() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::memory_properties");
-    return state_->memory_properties;
+    return live("vkrc::PhysicalDevice::memory_properties").memory_properties;
 }
 inline const List<VkQueueFamilyProperties>& PhysicalDevice::queue_families() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::queue_families");
-    return state_->queue_families;
+    return live("vkrc::PhysicalDevice::queue_families").queue_families;
 }
 inline const DeviceFeatures& PhysicalDevice::features() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::features");
-    return state_->features;
+    return live("vkrc::PhysicalDevice::features").features;
 }
 inline int PhysicalDevice::default_queue_family() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PhysicalDevice::default_queue_family");
-    return state_->default_queue_family;
+    return live("vkrc::PhysicalDevice::default_queue_family").default_queue_family;
 }
 
 VKRC_END_NAMESPACE

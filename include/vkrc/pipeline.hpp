@@ -431,52 +431,36 @@ public:
 }  // namespace detail
 
 inline VkPipelineLayout PipelineLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PipelineLayout::vk");
-    return state_->layout;
+    return live("vkrc::PipelineLayout::vk").layout;
 }
 inline const Device& PipelineLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PipelineLayout::device");
-    return state_->device;
+    return live("vkrc::PipelineLayout::device").device;
 }
-inline VkRenderPass RenderPass::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::RenderPass::vk");
-    return state_->render_pass;
-}
+inline VkRenderPass RenderPass::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::RenderPass::vk").render_pass; }
 inline const Device& RenderPass::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::RenderPass::device");
-    return state_->device;
+    return live("vkrc::RenderPass::device").device;
 }
 inline VkFramebuffer Framebuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Framebuffer::vk");
-    return state_->framebuffer;
+    return live("vkrc::Framebuffer::vk").framebuffer;
 }
 inline VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Framebuffer::extent");
-    return state_->extent;
+    return live("vkrc::Framebuffer::extent").extent;
 }
 inline const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Framebuffer::render_pass");
-    return state_->render_pass;
+    return live("vkrc::Framebuffer::render_pass").render_pass;
 }
 inline VkPipelineCache PipelineCache::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PipelineCache::vk");
-    return state_->cache;
+    return live("vkrc::PipelineCache::vk").cache;
 }
 inline bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PipelineCache::loaded_from_file");
-    return state_->loaded_from_file;
+    return live("vkrc::PipelineCache::loaded_from_file").loaded_from_file;
 }
-inline VkPipeline Pipeline::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Pipeline::vk");
-    return state_->pipeline;
-}
+inline VkPipeline Pipeline::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Pipeline::vk").pipeline; }
 inline VkPipelineBindPoint Pipeline::bind_point() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Pipeline::bind_point");
-    return state_->bind_point;
+    return live("vkrc::Pipeline::bind_point").bind_point;
 }
 inline const PipelineLayout& Pipeline::layout() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Pipeline::layout");
-    return state_->layout;
+    return live("vkrc::Pipeline::layout").layout;
 }
 
 VKRC_END_NAMESPACE

@@ -60,12 +60,10 @@ public:
 }  // namespace detail
 
 inline VkPrivateDataSlot PrivateDataSlot::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::vk");
-    return state_->slot;
+    return live("vkrc::PrivateDataSlot::vk").slot;
 }
 inline const Device& PrivateDataSlot::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::device");
-    return state_->device;
+    return live("vkrc::PrivateDataSlot::device").device;
 }
 
 VKRC_END_NAMESPACE

@@ -311,47 +311,23 @@ public:
 
 }  // namespace detail
 
-inline VkBuffer Buffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::vk");
-    return state_->buffer;
-}
-inline VkDeviceSize Buffer::size() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::size");
-    return state_->size;
-}
-inline VkBufferUsageFlags Buffer::usage() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::usage");
-    return state_->usage;
-}
-inline const Device& Buffer::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::device");
-    return state_->device;
-}
+inline VkBuffer Buffer::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::vk").buffer; }
+inline VkDeviceSize Buffer::size() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::size").size; }
+inline VkBufferUsageFlags Buffer::usage() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::usage").usage; }
+inline const Device& Buffer::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::device").device; }
 inline VkDeviceAddress Buffer::device_address() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::device_address");
-    return state_->device_address;
+    return live("vkrc::Buffer::device_address").device_address;
 }
 inline const Allocation& Buffer::allocation() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Buffer::allocation");
-    return state_->allocation;
+    return live("vkrc::Buffer::allocation").allocation;
 }
 
-inline VkImage Image::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::vk");
-    return state_->image;
-}
+inline VkImage Image::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::vk").image; }
 inline VkImageType Image::image_type() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::image_type");
-    return state_->image_type;
+    return live("vkrc::Image::image_type").image_type;
 }
-inline VkFormat Image::format() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::format");
-    return state_->format;
-}
-inline VkExtent3D Image::extent() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::extent");
-    return state_->extent;
-}
+inline VkFormat Image::format() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::format").format; }
+inline VkExtent3D Image::extent() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::extent").extent; }
 inline VkExtent3D Image::extent(std::uint32_t level) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::Image::extent");
     auto e = state_->extent;
@@ -359,63 +335,33 @@ inline VkExtent3D Image::extent(std::uint32_t level) const VKRC_UNCHECKED_NOEXCE
     return {half(e.width), half(e.height), half(e.depth)};
 }
 inline std::uint32_t Image::mip_levels() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::mip_levels");
-    return state_->mip_levels;
+    return live("vkrc::Image::mip_levels").mip_levels;
 }
 inline std::uint32_t Image::array_layers() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::array_layers");
-    return state_->array_layers;
+    return live("vkrc::Image::array_layers").array_layers;
 }
 inline VkSampleCountFlagBits Image::samples() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::samples");
-    return state_->samples;
+    return live("vkrc::Image::samples").samples;
 }
-inline VkImageUsageFlags Image::usage() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::usage");
-    return state_->usage;
-}
-inline const Device& Image::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::device");
-    return state_->device;
-}
+inline VkImageUsageFlags Image::usage() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::usage").usage; }
+inline const Device& Image::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::device").device; }
 inline const Allocation& Image::allocation() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Image::allocation");
-    return state_->allocation;
+    return live("vkrc::Image::allocation").allocation;
 }
 
-inline VkImageView ImageView::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ImageView::vk");
-    return state_->view;
-}
-inline const Image& ImageView::image() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ImageView::image");
-    return state_->image;
-}
-inline VkFormat ImageView::format() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ImageView::format");
-    return state_->format;
-}
+inline VkImageView ImageView::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::vk").view; }
+inline const Image& ImageView::image() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::image").image; }
+inline VkFormat ImageView::format() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::format").format; }
 inline const VkImageSubresourceRange& ImageView::subresource_range() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ImageView::subresource_range");
-    return state_->range;
+    return live("vkrc::ImageView::subresource_range").range;
 }
 
-inline VkBufferView BufferView::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::BufferView::vk");
-    return state_->view;
-}
+inline VkBufferView BufferView::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::BufferView::vk").view; }
 inline const Buffer& BufferView::buffer() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::BufferView::buffer");
-    return state_->buffer;
+    return live("vkrc::BufferView::buffer").buffer;
 }
 
-inline VkSampler Sampler::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Sampler::vk");
-    return state_->sampler;
-}
-inline const Device& Sampler::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Sampler::device");
-    return state_->device;
-}
+inline VkSampler Sampler::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Sampler::vk").sampler; }
+inline const Device& Sampler::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Sampler::device").device; }
 
 VKRC_END_NAMESPACE

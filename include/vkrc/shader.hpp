@@ -41,13 +41,9 @@ public:
 };
 }  // namespace detail
 
-inline VkShaderModule ShaderModule::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ShaderModule::vk");
-    return state_->module;
-}
+inline VkShaderModule ShaderModule::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ShaderModule::vk").module; }
 inline const Device& ShaderModule::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::ShaderModule::device");
-    return state_->device;
+    return live("vkrc::ShaderModule::device").device;
 }
 
 VKRC_END_NAMESPACE

@@ -54,13 +54,9 @@ public:
 
 }  // namespace detail
 
-inline VkSurfaceKHR Surface::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Surface::vk");
-    return state_->surface;
-}
+inline VkSurfaceKHR Surface::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Surface::vk").surface; }
 inline const Instance& Surface::instance() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Surface::instance");
-    return state_->instance;
+    return live("vkrc::Surface::instance").instance;
 }
 
 VKRC_END_NAMESPACE

@@ -194,45 +194,23 @@ public:
 
 }  // namespace detail
 
-inline VkFence Fence::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Fence::vk");
-    return state_->fence;
-}
-inline const Device& Fence::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Fence::device");
-    return state_->device;
-}
-inline VkSemaphore Semaphore::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Semaphore::vk");
-    return state_->semaphore;
-}
-inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Semaphore::type");
-    return state_->type;
-}
+inline VkFence Fence::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Fence::vk").fence; }
+inline const Device& Fence::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Fence::device").device; }
+inline VkSemaphore Semaphore::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Semaphore::vk").semaphore; }
+inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Semaphore::type").type; }
 inline const Device& Semaphore::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Semaphore::device");
-    return state_->device;
+    return live("vkrc::Semaphore::device").device;
 }
-inline VkEvent Event::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::Event::vk");
-    return state_->event;
-}
-inline VkQueryPool QueryPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::QueryPool::vk");
-    return state_->pool;
-}
+inline VkEvent Event::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Event::vk").event; }
+inline VkQueryPool QueryPool::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::QueryPool::vk").pool; }
 inline std::uint32_t QueryPool::query_count() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::QueryPool::query_count");
-    return state_->count;
+    return live("vkrc::QueryPool::query_count").count;
 }
 inline VkQueryType QueryPool::query_type() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::QueryPool::query_type");
-    return state_->type;
+    return live("vkrc::QueryPool::query_type").type;
 }
 inline std::uint32_t QueryPool::values_per_query() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::QueryPool::values_per_query");
-    return state_->values_per_query;
+    return live("vkrc::QueryPool::values_per_query").values_per_query;
 }
 
 VKRC_END_NAMESPACE

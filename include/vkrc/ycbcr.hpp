@@ -61,16 +61,13 @@ public:
 }  // namespace detail
 
 inline VkSamplerYcbcrConversion SamplerYcbcrConversion::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::SamplerYcbcrConversion::vk");
-    return state_->conversion;
+    return live("vkrc::SamplerYcbcrConversion::vk").conversion;
 }
 inline const Device& SamplerYcbcrConversion::device() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::SamplerYcbcrConversion::device");
-    return state_->device;
+    return live("vkrc::SamplerYcbcrConversion::device").device;
 }
 inline VkFormat SamplerYcbcrConversion::format() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::SamplerYcbcrConversion::format");
-    return state_->format;
+    return live("vkrc::SamplerYcbcrConversion::format").format;
 }
 
 VKRC_END_NAMESPACE
