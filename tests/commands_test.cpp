@@ -1,6 +1,7 @@
 // Issue 14's commands: blit, mipmaps, resolve, clears, update/copy regions,
 // indirect work, queries, debug-utils labels and the barrier helpers, each
 // read back and checked (validation messages fail the test, as everywhere).
+#include "support/features.hpp"
 #include "support/vk_test.hpp"
 
 #include "shaders/fill_pattern.comp.h"
@@ -14,6 +15,7 @@
 namespace {
 
 using vkrc_test::VulkanTest;
+using OneShot = vkrc_test::OneShotCommands;
 using Rgba = std::array<std::uint8_t, 4>;
 constexpr VkFormat rgba8 = VK_FORMAT_R8G8B8A8_UNORM;
 
@@ -21,23 +23,6 @@ struct RectPush {
     float color[4];
     float bounds[4];  // x0 y0 x1 y1, NDC
     float depth;
-};
-
-// One command buffer recorded by the test, submitted and waited for.
-struct OneShot {
-    vkrc::CommandPool pool;
-    vkrc::CommandBuffer cmd;
-    explicit OneShot(const vkrc::Queue& queue)
-        : pool(vkrc::CommandPool::create(queue.device(), {.queue_family_index = queue.family_index()})),
-          cmd(pool.allocate()) {
-        cmd.begin();
-    }
-    void run(const vkrc::Queue& queue) const {
-        cmd.end();
-        auto fence = vkrc::Fence::create(queue.device());
-        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
-        ASSERT_EQ(fence.wait(), VK_SUCCESS);
-    }
 };
 
 vkrc::Buffer host_buffer(const vkrc::Device& device, VkDeviceSize bytes, VkBufferUsageFlags usage,
