@@ -41,7 +41,9 @@ int find_dedicated_queue_family(const PhysicalDevice& physical_device, QueueRole
 // Every member is optional and read during create() (lists and extension names
 // are copied): nothing need outlive the call.
 struct DeviceCreateInfo {
-    // Empty: one queue from the first family with graphics and compute, plus
+    // Empty: one queue from the physical device's default_queue_family() (the
+    // one select() chose: it presents when a surface was asked for) if it has
+    // graphics and compute, else from the first family that has both; plus
     // the transfer and compute queues asked for below.
     List<QueueRequest> queue_requests{};
     // With queue_requests empty: also a queue for transfers (streaming) and
