@@ -36,15 +36,9 @@ log="$out/tmp-alloc.log"
 echo "== bench/alloc --csv FILE" >&2
 "$alloc" --csv "$csv" | tee "$log"
 device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$log" | head -1)
-prefix=$name
-[ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+prefix=$(bench_prefix "$name" "$device")
 {
-  echo "# device: $device"
-  echo "# driver: $driver"
-  echo "# date: $date_utc"
-  echo "# command: bench/alloc --csv FILE (Release build)"
-  echo "# git: $revision"
-  echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  bench_csv_header "$device" "bench/alloc --csv FILE (Release build)"
   cat "$csv"
 } >"$out/$prefix-alloc.csv"
 rm -f "$csv" "$log"

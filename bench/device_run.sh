@@ -42,15 +42,10 @@ run() {  # run FILE-SUFFIX teapot-args...
   "$teapot" --runs "${RUNS:-3}" "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
   local device
   device=$(awk -F': ' '/^device: / {print $2; exit}' "$log")
-  local prefix=$name
-  [ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+  local prefix
+  prefix=$(bench_prefix "$name" "$device")
   {
-    echo "# device: $device"
-    echo "# driver: $driver"
-    echo "# date: $date_utc"
-    echo "# command: $command"
-    echo "# git: $revision"
-    echo "# host: $(nproc) CPUs, $(uname -sr)"
+    bench_csv_header "$device" "$command"
     cat "$csv"
   } >"$out/$prefix-$suffix.csv"
   rm -f "$csv"

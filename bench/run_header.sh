@@ -25,3 +25,23 @@ bench_driver() {
     echo "mesa-vulkan-drivers $(dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
   fi
 }
+
+#   bench_prefix NAME DEVICE   a results file's prefix: NAME, else the date and a device slug
+bench_prefix() {
+  if [ -n "$1" ]; then
+    echo "$1"
+  else
+    echo "$(date -u +%Y-%m-%d)-$(echo "$2" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')"
+  fi
+}
+
+#   bench_csv_header DEVICE COMMAND   the '# key: value' lines scripts/gen_bench_docs.py reads;
+#   needs revision, driver and date_utc set (taken once, when the run starts)
+bench_csv_header() {
+  echo "# device: $1"
+  echo "# driver: $driver"
+  echo "# date: $date_utc"
+  echo "# command: $2"
+  echo "# git: $revision"
+  echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+}

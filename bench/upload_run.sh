@@ -46,15 +46,9 @@ for p in $(seq 1 "$processes"); do
   [ -s "$body" ] || head -1 "$out/tmp-upload.csv" | sed 's/^/process,/' >"$body"
   tail -n +2 "$out/tmp-upload.csv" | sed "s/^/$p,/" >>"$body"
 done
-prefix=$name
-[ -n "$prefix" ] || prefix=$(date -u +%Y-%m-%d)-$(echo "$device" | tr -c 'A-Za-z0-9\n' '-' | tr -s '-' | cut -c1-24 | sed 's/-$//')
+prefix=$(bench_prefix "$name" "$device")
 {
-  echo "# device: $device"
-  echo "# driver: $driver"
-  echo "# date: $date_utc"
-  echo "# command: bench/upload ${args[*]} --csv FILE, $processes processes (Release build)"
-  echo "# git: $revision"
-  echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
+  bench_csv_header "$device" "bench/upload ${args[*]} --csv FILE, $processes processes (Release build)"
   cat "$body"
 } >"$out/$prefix-upload.csv"
 rm -f "$body" "$out/tmp-upload.csv" "$out/tmp-upload.log"
