@@ -22,14 +22,10 @@ out=$2
 name=${3:-}
 alloc="$build/bench/alloc"
 [ -x "$alloc" ] || { echo "alloc_run.sh: no $alloc (build the alloc target first)" >&2; exit 1; }
-mkdir -p "$out"
-export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
-revision=$(bench_revision "$build")
-driver=$(bench_driver)
-date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+bench_start "$build" "$out"
 
 csv="$out/tmp-alloc.csv"
 log="$out/tmp-alloc.log"

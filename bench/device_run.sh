@@ -24,14 +24,10 @@ out=$2
 name=${3:-}
 teapot="$build/bench/teapot"
 [ -x "$teapot" ] || { echo "device_run.sh: no $teapot (build the teapot target first)" >&2; exit 1; }
-mkdir -p "$out"
-export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
-revision=$(bench_revision "$build")
-driver=$(bench_driver)
-date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+bench_start "$build" "$out"
 
 run() {  # run FILE-SUFFIX teapot-args...
   local suffix=$1

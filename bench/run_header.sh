@@ -1,6 +1,16 @@
 # Sourced by the bench/*_run.sh scripts: the provenance of a results CSV.
+#   bench_start BUILD_DIR OUT  makes OUT, a runtime directory for lavapipe, and
+#                              sets revision, driver and date_utc for the run
 #   bench_revision BUILD_DIR   the revision the build was made from
 #   bench_driver               the Vulkan driver of this machine
+bench_start() {
+  mkdir -p "$2"
+  export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
+  revision=$(bench_revision "$1")
+  driver=$(bench_driver)
+  date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+}
+
 bench_revision() {
   # Written at build time (bench/revision.cmake): right even where this
   # checkout's git metadata is stale, e.g. a copy run on another machine.

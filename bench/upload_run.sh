@@ -27,14 +27,10 @@ args=("$@")
 [ ${#args[@]} -gt 0 ] || args=(--blocks 3 --reps 1000)
 upload="$build/bench/upload"
 [ -x "$upload" ] || { echo "upload_run.sh: no $upload (build the upload target first)" >&2; exit 1; }
-mkdir -p "$out"
-export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-$(mktemp -d /tmp/vkrc-xdg.XXXXXX)}"
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
-revision=$(bench_revision "$build")
-driver=$(bench_driver)
-date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+bench_start "$build" "$out"
 
 body="$out/tmp-upload-body.csv"
 : >"$body"
