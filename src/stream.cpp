@@ -175,13 +175,7 @@ void end_batch(detail::UploaderState& s) {
 Ticket submit_batch(detail::UploaderState& s, std::span<const SemaphoreSubmit> waits) {
     end_batch(s);
     List<VkSemaphoreSubmitInfo> wait_infos;
-    for (const auto& w : waits) {
-        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        i.semaphore = w.semaphore;
-        i.value = w.value;
-        i.stageMask = w.stage_mask;
-        wait_infos.push_back(i);
-    }
+    for (const auto& w : waits) wait_infos.push_back(w.info());
     VkCommandBufferSubmitInfo cmd{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
     cmd.commandBuffer = s.open.vk();
     VkSubmitInfo2 info{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};

@@ -9,14 +9,6 @@ constexpr std::size_t inline_semaphores = 4;
 constexpr std::size_t inline_command_buffers = 8;
 constexpr std::size_t inline_batches = 4;
 
-VkSemaphoreSubmitInfo semaphore_info(const SemaphoreSubmit& s) noexcept {
-    VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-    i.semaphore = s.semaphore;
-    i.value = s.value;
-    i.stageMask = s.stage_mask;
-    return i;
-}
-
 // Fills info for batch, its semaphores and command buffers going to the
 // given arrays, which have room for them. Inlined into the one-batch submit,
 // the frame loop's.
@@ -26,10 +18,10 @@ VkSemaphoreSubmitInfo semaphore_info(const SemaphoreSubmit& s) noexcept {
     info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
     info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
     info.pWaitSemaphoreInfos = waits;
-    for (const auto& w : batch.waits) *waits++ = semaphore_info(w);
+    for (const auto& w : batch.waits) *waits++ = w.info();
     info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
     info.pSignalSemaphoreInfos = signals;
-    for (const auto& s : batch.signals) *signals++ = semaphore_info(s);
+    for (const auto& s : batch.signals) *signals++ = s.info();
     info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
     info.pCommandBufferInfos = cmds;
     for (const auto& c : batch.command_buffers) {

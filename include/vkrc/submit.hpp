@@ -20,6 +20,15 @@ struct SemaphoreSubmit {
     std::uint64_t value = 0;
     // Optional (default all commands).
     VkPipelineStageFlags2 stage_mask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+
+    // The Vulkan structure (device index 0).
+    VkSemaphoreSubmitInfo info() const noexcept {
+        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        i.semaphore = semaphore;
+        i.value = value;
+        i.stageMask = stage_mask;
+        return i;
+    }
 };
 
 // One batch of a submission (VkSubmitInfo2).
