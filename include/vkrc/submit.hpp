@@ -23,11 +23,12 @@ struct SemaphoreSubmit {
 
     // The Vulkan structure (device index 0).
     VkSemaphoreSubmitInfo info() const noexcept {
-        VkSemaphoreSubmitInfo i{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        i.semaphore = semaphore;
-        i.value = value;
-        i.stageMask = stage_mask;
-        return i;
+        return {.sType = VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO,
+                .pNext = nullptr,
+                .semaphore = semaphore,
+                .value = value,
+                .stageMask = stage_mask,
+                .deviceIndex = 0};
     }
 };
 
