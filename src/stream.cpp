@@ -105,9 +105,8 @@ void StagingRing::tag_open(std::uint64_t value) noexcept {
 }
 
 void StagingRing::retire(std::uint64_t completed) noexcept {
-    std::size_t n = 0;
-    while (n < regions_.size() && regions_[n].value != 0 && regions_[n].value <= completed) ++n;
-    regions_.erase_front(n);
+    while (!regions_.empty() && regions_.front().value != 0 && regions_.front().value <= completed)
+        regions_.pop_front();
 }
 
 }  // namespace detail
@@ -123,46 +122,44 @@ const char* const create_who = "vkrc::Uploader::create";
 // The batch's first command: earlier work on the queue finishes writing and
 // reading what the copies touch (one barrier per batch, not per copy).
 void begin_batch(detail::UploaderState& s) {
-    // A command buffer whose batch completed: by the cached value, else by
-    // the semaphore's (so that a stream that never fills the ring, and so
-    // never reads the semaphore there, still reuses them).
-    for (int pass = 0; pass < 2 && !s.open && !s.recorded.empty(); ++pass) {
-        const std::uint64_t completed = pass == 0 ? s.queue.state()->timeline.completed() : refresh_completed(s.queue);
-        for (auto& r : s.recorded) {
-            if (r.value <= completed) {
-                s.open = r.cmd;
-                break;
-            }
-        }
-    }
-    if (!s.open) {
-        s.recorded.push_back({s.pool.allocate(), UINT64_MAX});
-        s.open = s.recorded.back().cmd;
+    // The oldest batch's command buffer if that batch completed: by the
+    // cached value, else by the semaphore's (so that a stream that never
+    // fills the ring, and so never reads the semaphore there, still reuses
+    // them); else a new one.
+    if (!s.recorded.empty() && (s.recorded.front().value <= s.queue.state()->timeline.completed() ||
+                                s.recorded.front().value <= refresh_completed(s.queue))) {
+        s.open = std::move(s.recorded.front().cmd);
+        s.recorded.pop_front();
+    } else {
+        s.open = s.pool.allocate();
     }
     s.open.begin(VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT);
     const VkMemoryBarrier2 b =
         memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
                        VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
     s.open.pipeline_barrier({&b, 1}, {}, {});
-    s.batch = detail::Ref<detail::BatchValue>(new detail::BatchValue);
+    s.batch = {};  // made by the batch's first download only
 }
 
 // The barriers after the copies recorded so far: ownership releases, or,
-// within the family, the copies made visible to later work and the images
-// moved to their new layouts. Recorded at the batch's end, and before a
-// download, which may read what an upload of the batch wrote.
-void record_ends(detail::UploaderState& s) {
-    VkMemoryBarrier2 visible = memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+// within the family, the images moved to their new layouts, and, with
+// visible, the copies made visible to all later commands on the queue.
+// Recorded at the batch's end and before a download (which may read what an
+// upload of the batch wrote). A streaming batch's end needs no visibility
+// barrier: its consumers wait on its semaphore signal, which makes every
+// write of the batch visible to them.
+void record_ends(detail::UploaderState& s, bool visible) {
+    const VkMemoryBarrier2 b = memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw);
-    const bool same_family = s.consumer_family == s.queue.family_index();
-    s.open.pipeline_barrier({&visible, same_family ? 1u : 0u}, {s.buffer_releases.data(), s.buffer_releases.size()},
+    if (!visible && s.buffer_releases.empty() && s.image_ends.empty()) return;
+    s.open.pipeline_barrier({&b, visible ? 1u : 0u}, {s.buffer_releases.data(), s.buffer_releases.size()},
                             {s.image_ends.data(), s.image_ends.size()});
     s.buffer_releases.clear();
     s.image_ends.clear();
 }
 
 void end_batch(detail::UploaderState& s) {
-    record_ends(s);
+    record_ends(s, s.visible_at_end);
     if (s.host_reads) {
         const VkMemoryBarrier2 b = memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                                   VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
@@ -197,11 +194,9 @@ Ticket submit_batch(detail::UploaderState& s, std::span<const SemaphoreSubmit> w
         throw;
     }
     detail::close_submitted({&open, 1});
-    for (auto& r : s.recorded) {
-        if (r.cmd == open) r.value = value;
-    }
+    s.recorded.push_back({std::move(open), value});
     s.ring.tag_open(value);
-    s.batch->value.store(value);
+    if (s.batch) s.batch->value.store(value);
     Ticket ticket = std::move(s.pending);
     ticket.queue = s.queue;
     ticket.value = value;
@@ -236,6 +231,12 @@ VkDeviceSize reserve(detail::UploaderState& s, VkDeviceSize size, VkDeviceSize a
 
 void open_batch(detail::UploaderState& s) {
     if (!s.open) begin_batch(s);
+}
+
+// Where the open batch's submission number will be stored, for its downloads.
+detail::Ref<detail::BatchValue> open_batch_value(detail::UploaderState& s) {
+    if (!s.batch) s.batch = detail::Ref<detail::BatchValue>(new detail::BatchValue);
+    return s.batch;
 }
 
 }  // namespace
@@ -358,7 +359,7 @@ Buffer readback_buffer(detail::UploaderState& s, VkDeviceSize size) {
     info.memory.usage = MemoryUsage::readback;
     Buffer readback = Buffer::create(s.queue.device(), info);
     open_batch(s);
-    record_ends(s);
+    record_ends(s, true);
     s.host_reads = true;
     return readback;
 }
@@ -378,7 +379,7 @@ Download Uploader::download_buffer(const Buffer& buffer, VkDeviceSize offset, Vk
     const VkBufferCopy region{offset, 0, size};
     s.open.copy_buffer(buffer.vk(), d.readback_.vk(), {&region, 1});
     d.queue_ = s.queue;
-    d.batch_ = s.batch;
+    d.batch_ = open_batch_value(s);
     d.size_ = size;
     return d;
 }
@@ -407,7 +408,7 @@ Download Uploader::download_image(const Image& image, VkImageLayout layout, std:
                                          VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
                                          VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
     d.queue_ = s.queue;
-    d.batch_ = s.batch;
+    d.batch_ = open_batch_value(s);
     d.size_ = size;
     return d;
 }

@@ -166,7 +166,10 @@ VkDeviceSize image_data_size(const Image& image) {
 // one transfer, and a wait for its ticket.
 namespace {
 Uploader one_time_uploader(const Queue& queue, VkDeviceSize size) {
-    return Uploader::create({.queue = queue, .consumer_family = queue.family_index(), .staging_size = size});
+    Uploader uploader =
+        Uploader::create({.queue = queue, .consumer_family = queue.family_index(), .staging_size = size});
+    uploader.state()->visible_at_end = true;
+    return uploader;
 }
 }  // namespace
 

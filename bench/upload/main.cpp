@@ -246,13 +246,14 @@ int parse(const char* text) {
 
 int main(int argc, char** argv) try {
     int blocks = 3, reps = 1000;
-    std::string csv;
+    std::string csv, only;
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i];
         if (a == "--blocks") blocks = parse(argv[i + 1]);
         else if (a == "--reps") reps = parse(argv[i + 1]);
         else if (a == "--csv") csv = argv[i + 1];
-        else throw std::runtime_error("usage: upload [--blocks N] [--reps N] [--csv PATH]");
+        else if (a == "--case") only = argv[i + 1];
+        else throw std::runtime_error("usage: upload [--blocks N] [--reps N] [--csv PATH] [--case NAME-PREFIX]");
     }
     auto instance = vkrc::Instance::create({.application_name = "vkrc upload bench"});
     auto physical = vkrc::PhysicalDevice::select(instance, {});
@@ -269,6 +270,7 @@ int main(int argc, char** argv) try {
                                      {"image 4096^2 RGBA8 mips", 0, true, 2}};
     std::vector<Row> rows;
     for (const auto& c : cases) {
+        if (!c.name.starts_with(only)) continue;  // --case "buffer 4": that case only
         Target target;
         VkDeviceSize bytes = c.bytes;
         if (c.image) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "vkrc/descriptor.hpp"
+#include "vkrc/detail/fifo.hpp"
 #include "vkrc/submit.hpp"
 #include "vkrc/upload.hpp"
 
@@ -205,7 +206,7 @@ private:
         std::uint64_t value = 0;
     };
     VkDeviceSize capacity_;
-    List<Region> regions_;
+    Fifo<Region> regions_;
 };
 
 class UploaderState final : public RefCounted {
@@ -216,12 +217,13 @@ public:
     WriteOnlyView staging_view;
     StagingRing ring;
     CommandPool pool;
-    // Command buffers of earlier batches, each with its submission number.
+    // Command buffers of submitted batches, each with its submission number,
+    // oldest first: the front is the first to complete.
     struct Recorded {
         CommandBuffer cmd;
         std::uint64_t value = 0;
     };
-    List<Recorded> recorded;
+    Fifo<Recorded> recorded;
     // The open batch: its command buffer (empty when none), the barriers
     // recorded at its end, the acquires its ticket carries, its value.
     CommandBuffer open;
@@ -229,7 +231,10 @@ public:
     List<VkImageMemoryBarrier2> image_ends;
     Ticket pending;
     bool host_reads = false;
-    Ref<BatchValue> batch;
+    // The blocking helpers' batches end with the copies made visible: their
+    // callers' later submissions need not wait on the batch's semaphore.
+    bool visible_at_end = false;
+    Ref<BatchValue> batch;  // made by the open batch's first download (empty: none yet)
     Ticket last;
     mutable Mutex mutex;
 };
