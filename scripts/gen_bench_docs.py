@@ -2,7 +2,8 @@
 """Regenerates the benchmark results in docs/benchmarks.md and README.md from
 the CSV files under docs/results/ (one file per run: '# key: value' header
 lines, then the program's CSV): the teapot runs (bench/device_run.sh), the
-allocation runs (bench/alloc_run.sh) and the header-cost runs
+allocation runs (bench/alloc_run.sh), the contention runs
+(bench/contention_run.sh) and the header-cost runs
 (bench/header_cost_run.sh).
 
 Every generated block sits between '<!-- generated:NAME -->' and
@@ -388,6 +389,123 @@ def upload_section(pattern, pending):
     return out[:-1]
 
 
+CONTENTION_GOAL = 4.0  # PoolAllocator alloc+free rate at 8 threads vs 1 thread (issue 17)
+CONTENTION_GOAL_THREADS = 8
+CONTENTION_GOAL_CASE = "alloc-pool"
+
+
+def median(values):
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
+
+
+def contention_runs(pattern):
+    return sorted(results(pattern, "ops_per_second"), key=lambda r: r["path"])
+
+
+def contention_ratios(rows, case, threads, repeat="1"):
+    """Per (process, block): the rate at threads (repeat) over the first thread count's (repeat 1)
+    of the same block; the counts of a block run back to back."""
+    first = rows[0]["threads"]
+    get = {(x["process"], x["block"], x["threads"], x["repeat"]): float(x["ops_per_second"])
+           for x in rows if x["case"] == case}
+    return sorted(get[(p, b, t, rep)] / get[(p, b, first, "1")] for (p, b, t, rep) in get
+                  if t == threads and rep == repeat and get.get((p, b, first, "1")))
+
+
+def host_cpus(r):
+    m = re.match(r"(\d+) CPUs", r["meta"].get("host", ""))
+    return int(m.group(1)) if m else 0
+
+
+def interval(values, digits=2):
+    return f"{median(values):.{digits}f} [{values[0]:.{digits}f}, {values[-1]:.{digits}f}]"
+
+
+def contention_goal(r):
+    rows = r["rows"]
+    ratios = contention_ratios(rows, CONTENTION_GOAL_CASE, str(CONTENTION_GOAL_THREADS))
+    if not ratios:
+        return f"not measured ({CONTENTION_GOAL_THREADS} threads or {CONTENTION_GOAL_CASE} missing)"
+    text = f"{CONTENTION_GOAL_CASE} at {CONTENTION_GOAL_THREADS} threads: {interval(ratios)}x the 1-thread rate"
+    cpus = host_cpus(r)
+    if ratios[0] >= CONTENTION_GOAL:
+        verdict = "met"
+    elif ratios[-1] < CONTENTION_GOAL:
+        verdict = "not met"
+    else:
+        verdict = "not resolved (the interval straddles the goal)"
+    note = (f" This host has {cpus} CPUs: {CONTENTION_GOAL_THREADS} threads cannot all run at once, so it cannot "
+            "show the goal whatever the allocator does." if 0 < cpus < CONTENTION_GOAL_THREADS else "")
+    return f"{text}: **{verdict}** here.{note}"
+
+
+def contention_lock(r):
+    """Whether the shared PoolAllocator's lock limits alloc-pool's scaling: its speed-up against a pool
+    per thread (alloc-pool-own) and the uncontended handle-own at the most threads this host runs at once."""
+    rows = r["rows"]
+    cpus = host_cpus(r) or 1
+    counts = sorted({int(x["threads"]) for x in rows if int(x["threads"]) <= max(cpus, 2)})
+    if len(counts) < 2:
+        return ""
+    n = str(counts[-1])
+    get = {c: contention_ratios(rows, c, n) for c in ("handle-own", "alloc-pool", "alloc-pool-own")}
+    if not all(get.values()):
+        return ""
+    pool, own = get["alloc-pool"], get["alloc-pool-own"]
+    if pool[-1] < own[0]:
+        verdict = "the shared pool scales less than a pool per thread: its lock limits it"
+    elif pool[0] > own[-1]:
+        verdict = "the shared pool scales more than a pool per thread"
+    else:
+        verdict = "the two intervals overlap: this run does not show the shared lock limiting"
+    return (f"At {n} threads (this host has {cpus} CPUs): handle-own (nothing shared) {interval(get['handle-own'])}x, "
+            f"alloc-pool {interval(pool)}x, alloc-pool-own (a PoolAllocator per thread) {interval(own)}x: "
+            f"{verdict}.")
+
+
+def contention_section(pattern, pending):
+    found = contention_runs(pattern)
+    if not found:
+        return [pending]
+    out = []
+    for r in found:
+        rows = r["rows"]
+        processes = len({x["process"] for x in rows})
+        blocks = len({x["block"] for x in rows})
+        cases = []
+        for x in rows:
+            if x["case"] not in cases:
+                cases.append(x["case"])
+        counts = []
+        for x in rows:
+            if x["threads"] not in counts:
+                counts.append(x["threads"])
+        out += [run_line(r), "", f"    {r['meta'].get('command', '?')}", "",
+                f"{processes} processes x {blocks} blocks per case and thread count. Speed-up: the rate over the "
+                f"same block's {counts[0]}-thread rate; on the {counts[0]}-thread rows, the A/A control instead "
+                "(the block's second 1-thread measurement over its first). Median [min, max] over every block "
+                "of every process.", "",
+                "| case | threads | ops/s median [min, max] | speed-up vs 1 thread (1 thread: A/A) |",
+                "|---|---:|---:|---:|"]
+        for c in cases:
+            for n in counts:
+                rates = sorted(float(x["ops_per_second"]) for x in rows
+                               if x["case"] == c and x["threads"] == n and x["repeat"] == "1")
+                if n == counts[0]:
+                    ratio = "A/A " + interval(contention_ratios(rows, c, n, "2"))
+                else:
+                    ratio = interval(contention_ratios(rows, c, n)) + "x"
+                out.append(f"| {c} | {n} | {thousands(median(rates))} [{thousands(rates[0])}, "
+                           f"{thousands(rates[-1])}] | {ratio} |")
+        out += ["", f"Goal (PoolAllocator alloc+free at {CONTENTION_GOAL_THREADS} threads at least "
+                f"{CONTENTION_GOAL:.0f}x its 1-thread rate, the whole interval above it): {contention_goal(r)}"]
+        lock = contention_lock(r)
+        out += (["", lock] if lock else []) + [""]
+    return out[:-1]
+
+
 BLOCKS = {
     "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
     "upload-h200": lambda: upload_section(
@@ -407,6 +525,11 @@ BLOCKS = {
         "(its run's output was not committed; it is in docs/benchmarks.md at 8c4a8a5), so it is removed. "
         "`bench/device_run.sh` (or `bench/alloc_run.sh`) produces the CSV; committed under docs/results/, it "
         "appears here."),
+    "contention-lavapipe": lambda: contention_section(
+        "llvmpipe", "No lavapipe contention results in docs/results/ yet."),
+    "contention-h200": lambda: contention_section(
+        "H200", "**Pending:** no H200 contention run is committed yet. `bench/contention_run.sh BUILD_DIR OUT NAME` "
+        "on the H200 machine writes the CSV; committed under docs/results/, it appears here."),
     "header-cost": header_cost_section,
     "readme-compile-cost": readme_compile_row,
     "readme-alloc": readme_alloc_row,

@@ -5,7 +5,10 @@
 //   handle-own        the same, each thread its own Buffer (the uncontended baseline)
 //   alloc-pool        allocate + free 64 KiB through a PoolAllocator, no resource:
 //   alloc-dedicated   the allocator's own cost and lock (and, dedicated, vkAllocateMemory)
+//   alloc-pool-own    alloc-pool with a PoolAllocator per thread: no shared lock or
+//                     blocks, what a per-thread fast path could reach at best
 //   buffer-pool       Buffer::create + drop (64 KiB storage buffer), PoolAllocator
+//   buffer-pool-own   the same, a PoolAllocator per thread
 //   buffer-dedicated  the same, DedicatedAllocator
 //   buffer-raw        raw Vulkan: create, requirements, vkAllocateMemory, bind, destroy, free
 //   buffer-bound      raw Vulkan: create, requirements, bind to the thread's own memory, destroy
@@ -13,8 +16,9 @@
 //   image-*           the same four for a 64x64 RGBA8 optimal-tiling sampled image
 //   sets-free         allocate + drop one descriptor set, a FREE_DESCRIPTOR_SET pool per thread
 //   sets-reset        allocate 64 sets, drop them, reset the pool (a pool per thread; 64 ops)
-// The allocators, the set layout and the device are shared by all threads, as
-// in a program; the pools and raw memory are per thread.
+// The allocators (but the -own cases'), the set layout and the device are
+// shared by all threads, as in a program; the descriptor pools and raw memory
+// are per thread.
 //
 // A measurement starts N threads, lets each set up and do one warm-up
 // operation, releases them together, stops them after --ms milliseconds and
@@ -54,7 +58,8 @@ struct Shared {
     vkrc::Device device;
     vkrc::SharedAllocator pool = vkrc::make_allocator<vkrc::PoolAllocator>();
     vkrc::SharedAllocator dedicated = vkrc::make_allocator<vkrc::DedicatedAllocator>();
-    vkrc::Buffer buffer;  // handle-shared's object
+    std::vector<vkrc::SharedAllocator> own_pools;  // the -own cases', one per thread index
+    vkrc::Buffer buffer;                           // handle-shared's object
     vkrc::DescriptorSetLayout layout;
     vkrc::AllocationRequest request;  // alloc-*: a buffer's
     VkBufferCreateInfo buffer_info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -180,32 +185,48 @@ Step sets_reset_step(const Shared& s) {
 
 struct Case {
     const char* name;
-    std::function<Step(const Shared&)> make;  // called on the measuring thread
+    // Called on the measuring thread with its index.
+    std::function<Step(const Shared&, unsigned thread)> make;
 };
 
+enum class Source { pool, dedicated, own_pool };
+
+const vkrc::SharedAllocator& allocator_of(const Shared& s, Source source, unsigned thread) {
+    if (source == Source::own_pool) return s.own_pools[thread];
+    return source == Source::pool ? s.pool : s.dedicated;
+}
+
 std::vector<Case> all_cases() {
-    auto resource = [](bool image, bool pool) {
-        return [image, pool](const Shared& s) -> Step {
-            const vkrc::SharedAllocator allocator = pool ? s.pool : s.dedicated;
+    auto alloc = [](Source source) {
+        return [source](const Shared& s, unsigned t) { return alloc_step(s, allocator_of(s, source, t)); };
+    };
+    auto resource = [](bool image, Source source) {
+        return [image, source](const Shared& s, unsigned t) -> Step {
+            const vkrc::SharedAllocator allocator = allocator_of(s, source, t);
             if (image) return [&s, allocator] { return make_image(s, allocator) ? std::size_t{1} : 0; };
             return [&s, allocator] { return make_buffer(s, allocator) ? std::size_t{1} : 0; };
         };
     };
+    auto raw = [](bool image, bool bound) {
+        return [image, bound](const Shared& s, unsigned) { return raw_step(s, image, bound); };
+    };
     return {
-        {"handle-shared", [](const Shared& s) { return copy_step(s.buffer); }},
-        {"handle-own", [](const Shared& s) { return copy_step(make_buffer(s, s.pool)); }},
-        {"alloc-pool", [](const Shared& s) { return alloc_step(s, s.pool); }},
-        {"alloc-dedicated", [](const Shared& s) { return alloc_step(s, s.dedicated); }},
-        {"buffer-pool", resource(false, true)},
-        {"buffer-dedicated", resource(false, false)},
-        {"buffer-raw", [](const Shared& s) { return raw_step(s, false, false); }},
-        {"buffer-bound", [](const Shared& s) { return raw_step(s, false, true); }},
-        {"image-pool", resource(true, true)},
-        {"image-dedicated", resource(true, false)},
-        {"image-raw", [](const Shared& s) { return raw_step(s, true, false); }},
-        {"image-bound", [](const Shared& s) { return raw_step(s, true, true); }},
-        {"sets-free", sets_free_step},
-        {"sets-reset", sets_reset_step},
+        {"handle-shared", [](const Shared& s, unsigned) { return copy_step(s.buffer); }},
+        {"handle-own", [](const Shared& s, unsigned) { return copy_step(make_buffer(s, s.pool)); }},
+        {"alloc-pool", alloc(Source::pool)},
+        {"alloc-pool-own", alloc(Source::own_pool)},
+        {"alloc-dedicated", alloc(Source::dedicated)},
+        {"buffer-pool", resource(false, Source::pool)},
+        {"buffer-pool-own", resource(false, Source::own_pool)},
+        {"buffer-dedicated", resource(false, Source::dedicated)},
+        {"buffer-raw", raw(false, false)},
+        {"buffer-bound", raw(false, true)},
+        {"image-pool", resource(true, Source::pool)},
+        {"image-dedicated", resource(true, Source::dedicated)},
+        {"image-raw", raw(true, false)},
+        {"image-bound", raw(true, true)},
+        {"sets-free", [](const Shared& s, unsigned) { return sets_free_step(s); }},
+        {"sets-reset", [](const Shared& s, unsigned) { return sets_reset_step(s); }},
     };
 }
 
@@ -218,7 +239,7 @@ struct Measurement {
 // threads threads run c's step until stopped, after block_ms milliseconds.
 Measurement measure(const Case& c, const Shared& s, unsigned threads, unsigned block_ms) {
     using Clock = std::chrono::steady_clock;
-    std::atomic<unsigned> ready{0};
+    std::atomic<unsigned> ready{0}, started{0};
     std::atomic<bool> go{false}, stop{false};
     Clock::time_point start;
     std::vector<std::size_t> operations(threads);
@@ -229,22 +250,25 @@ Measurement measure(const Case& c, const Shared& s, unsigned threads, unsigned b
     for (unsigned t = 0; t < threads; ++t) {
         workers.emplace_back([&, t] {
             try {
-                Step step = c.make(s);
+                Step step = c.make(s, t);
                 step();  // warm-up: the pool's block, the driver's first-use work
                 ready.fetch_add(1);
                 ready.notify_one();
                 go.wait(false);
-                std::size_t n = 0;
+                std::size_t n = step();
+                started.fetch_add(1);
+                started.notify_one();
                 while (!stop.load(std::memory_order_relaxed)) n += step();
                 ends[t] = Clock::now();
                 operations[t] = n;
             } catch (...) {
                 const std::lock_guard lock(error_mutex);
                 error = std::current_exception();
-                if (!go.load()) {
-                    ready.fetch_add(1);
-                    ready.notify_one();
-                }
+                // Counted as ready and started, so that the main thread goes on.
+                if (!go.load()) ready.fetch_add(1);
+                ready.notify_one();
+                started.fetch_add(1);
+                started.notify_one();
             }
         });
     }
@@ -253,6 +277,9 @@ Measurement measure(const Case& c, const Shared& s, unsigned threads, unsigned b
     go.store(true);
     go.notify_all();
     std::this_thread::sleep_for(std::chrono::milliseconds(block_ms));
+    // On a loaded machine a thread may wake late: stop only once every
+    // thread has done an operation, so that the rate covers all of them.
+    for (unsigned n = started.load(); n < threads; n = started.load()) started.wait(n);
     stop.store(true);
     for (auto& w : workers) w.join();
     if (error) std::rethrow_exception(error);
@@ -264,9 +291,10 @@ Measurement measure(const Case& c, const Shared& s, unsigned threads, unsigned b
     return m;
 }
 
-Shared make_shared_state(const vkrc::Device& device) {
+Shared make_shared_state(const vkrc::Device& device, unsigned max_threads) {
     Shared s;
     s.device = device;
+    for (unsigned t = 0; t < max_threads; ++t) s.own_pools.push_back(vkrc::make_allocator<vkrc::PoolAllocator>());
     s.buffer_info.size = buffer_bytes;
     s.buffer_info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     auto& i = s.image_info;
@@ -400,7 +428,8 @@ int main(int argc, char** argv) try {
 
     auto instance = vkrc::Instance::create({.application_name = "vkrc contention bench"});
     auto physical = vkrc::PhysicalDevice::select(instance);
-    const Shared shared = make_shared_state(vkrc::Device::create(physical));
+    const Shared shared =
+        make_shared_state(vkrc::Device::create(physical), *std::max_element(threads.begin(), threads.end()));
     std::printf("device: %s; %u hardware threads; %u blocks of %u ms per case and thread count\n", physical.name(),
                 std::thread::hardware_concurrency(), blocks, block_ms);
 
