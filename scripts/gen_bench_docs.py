@@ -6,6 +6,9 @@ allocation runs (bench/alloc_run.sh), the contention runs
 (bench/contention_run.sh) and the header-cost runs
 (bench/header_cost_run.sh).
 
+The contention runs also get a figure each (docs/img/<results file>.svg),
+written and checked like the tables.
+
 Every generated block sits between '<!-- generated:NAME -->' and
 '<!-- end generated:NAME -->', a generated table row ends with
 '<!-- generated-row:NAME -->'; nothing else is touched.
@@ -454,7 +457,10 @@ def contention_lock(r):
     if not all(get.values()):
         return ""
     pool, own = get["alloc-pool"], get["alloc-pool-own"]
-    if pool[-1] < own[0]:
+    if median(get["handle-own"]) < 0.75 * int(n):
+        verdict = ("handle-own, which shares nothing, does not scale either: the host gave the process no spare "
+                   "CPU (other work ran), so this run decides nothing about contention")
+    elif pool[-1] < own[0]:
         verdict = "the shared pool scales less than a pool per thread: its lock limits it"
     elif pool[0] > own[-1]:
         verdict = "the shared pool scales more than a pool per thread"
@@ -463,6 +469,67 @@ def contention_lock(r):
     return (f"At {n} threads (this host has {cpus} CPUs): handle-own (nothing shared) {interval(get['handle-own'])}x, "
             f"alloc-pool {interval(pool)}x, alloc-pool-own (a PoolAllocator per thread) {interval(own)}x: "
             f"{verdict}.")
+
+
+# Generated figures: path (relative to ROOT) -> SVG text, written (or checked) with the Markdown.
+FIGURES = {}
+PLOT_CASES = ["handle-shared", "handle-own", "alloc-pool", "alloc-pool-own", "alloc-dedicated", "buffer-pool",
+              "buffer-dedicated", "buffer-raw", "buffer-bound", "sets-free"]
+PLOT_COLOURS = ["#1f77b4", "#aec7e8", "#d62728", "#ff9896", "#9467bd", "#2ca02c", "#98df8a", "#8c564b",
+                "#c49c94", "#7f7f7f"]
+
+
+def contention_plot(r):
+    """An SVG of the median speed-up against the thread count (both axes log2), one line per case of
+    PLOT_CASES, with the ideal (speed-up = threads) dashed; returns its path relative to docs/."""
+    import math
+    rows = r["rows"]
+    counts = sorted({int(x["threads"]) for x in rows})
+    lines = {}
+    for c in PLOT_CASES:
+        points = [(1, 1.0)] + [(n, median(contention_ratios(rows, c, str(n)))) for n in counts[1:]
+                               if contention_ratios(rows, c, str(n))]
+        if len(points) > 1:
+            lines[c] = points
+    top = max([counts[-1]] + [y for pts in lines.values() for _, y in pts])
+    bottom = min([1.0] + [y for pts in lines.values() for _, y in pts])
+    lo, hi = math.floor(math.log2(bottom)), math.ceil(math.log2(top))
+    w, h, left, right, pad = 640, 360, 60, 170, 30
+
+    def x(n):
+        return left + (w - left - right) * math.log2(n) / max(1, math.log2(counts[-1]))
+
+    def y(v):
+        return h - pad - (h - 2 * pad) * (math.log2(v) - lo) / max(1, hi - lo)
+
+    svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" '
+           'font-size="11">', f'<rect width="{w}" height="{h}" fill="white"/>']
+    for e in range(lo, hi + 1):
+        v = 2.0 ** e
+        svg.append(f'<line x1="{left}" x2="{w - right}" y1="{y(v):.1f}" y2="{y(v):.1f}" stroke="#ddd"/>')
+        svg.append(f'<text x="{left - 6}" y="{y(v) + 4:.1f}" text-anchor="end">{v:g}x</text>')
+    for n in counts:
+        svg.append(f'<text x="{x(n):.1f}" y="{h - pad + 16}" text-anchor="middle">{n}</text>')
+    svg.append(f'<text x="{(left + w - right) / 2:.0f}" y="{h - 2}" text-anchor="middle">threads</text>')
+    svg.append(f'<text x="{left}" y="14">median speed-up vs 1 thread ({r["meta"].get("device", "?")})</text>')
+    ideal = " ".join(f"{x(n):.1f},{y(n):.1f}" for n in counts if lo <= math.log2(n) <= hi)
+    svg.append(f'<polyline points="{ideal}" fill="none" stroke="black" stroke-dasharray="4 3"/>')
+    for i, (c, pts) in enumerate(lines.items()):
+        colour = PLOT_COLOURS[i % len(PLOT_COLOURS)]
+        svg.append(f'<polyline points="{" ".join(f"{x(n):.1f},{y(v):.1f}" for n, v in pts)}" fill="none" '
+                   f'stroke="{colour}" stroke-width="2"/>')
+        ly = pad + 16 * i
+        svg.append(f'<line x1="{w - right + 10}" x2="{w - right + 30}" y1="{ly}" y2="{ly}" stroke="{colour}" '
+                   'stroke-width="2"/>')
+        svg.append(f'<text x="{w - right + 35}" y="{ly + 4}">{c}</text>')
+    ly = pad + 16 * len(lines)
+    svg.append(f'<line x1="{w - right + 10}" x2="{w - right + 30}" y1="{ly}" y2="{ly}" stroke="black" '
+               'stroke-dasharray="4 3"/>')
+    svg.append(f'<text x="{w - right + 35}" y="{ly + 4}">ideal</text>')
+    svg.append("</svg>")
+    name = "img/" + os.path.splitext(os.path.basename(r["path"]))[0] + ".svg"
+    FIGURES[os.path.join("docs", name)] = "\n".join(svg) + "\n"
+    return name
 
 
 def contention_section(pattern, pending):
@@ -499,7 +566,8 @@ def contention_section(pattern, pending):
                     ratio = interval(contention_ratios(rows, c, n)) + "x"
                 out.append(f"| {c} | {n} | {thousands(median(rates))} [{thousands(rates[0])}, "
                            f"{thousands(rates[-1])}] | {ratio} |")
-        out += ["", f"Goal (PoolAllocator alloc+free at {CONTENTION_GOAL_THREADS} threads at least "
+        out += ["", f"![speed-up against threads, {r['meta'].get('device', '?')}]({contention_plot(r)})",
+                "", f"Goal (PoolAllocator alloc+free at {CONTENTION_GOAL_THREADS} threads at least "
                 f"{CONTENTION_GOAL:.0f}x its 1-thread rate, the whole interval above it): {contention_goal(r)}"]
         lock = contention_lock(r)
         out += (["", lock] if lock else []) + [""]
@@ -584,6 +652,12 @@ def main():
             changed.append(name)
             if not args.check:
                 open(path, "w").write(new)
+    for name, svg in FIGURES.items():
+        path = os.path.join(ROOT, name)
+        if not os.path.exists(path) or open(path).read() != svg:
+            changed.append(name)
+            if not args.check:
+                open(path, "w").write(svg)
     if args.check and changed:
         sys.exit("gen_bench_docs.py --check: out of date (run scripts/gen_bench_docs.py): " + ", ".join(changed))
     print(("would change: " if args.check else "regenerated: ") + (", ".join(changed) or "nothing"))
