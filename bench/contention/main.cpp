@@ -21,9 +21,10 @@
 // are per thread.
 //
 // A measurement starts N threads, lets each set up and do one warm-up
-// operation, releases them together, stops them after --ms milliseconds and
-// counts what they completed: ops/s = operations / (start to the last
-// thread's end). Each block measures every case at every thread count in
+// operation, releases them together, stops them after --ms milliseconds
+// (once each has done an operation) and counts what they completed:
+// ops/s = operations / (start to the last thread's end). After an untimed
+// warm-up block, each block measures every case at every thread count in
 // turn, then the first count again (repeat 2: an A/A control of the
 // block-to-block noise). Run several processes (bench/contention_run.sh) so
 // that the intervals include the spread between runs.
@@ -338,26 +339,40 @@ double median(std::vector<double> v) {
     return n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
 }
 
-// Per case and thread count: the median rate over the blocks and the
-// median, min and max of the per-block speed-up over the first thread count.
+// The block's rate of r's case at repeat `repeat` of thread count n, or 0.
+double rate_of(const std::vector<Row>& rows, const Row& r, unsigned n, int repeat) {
+    for (const Row& x : rows) {
+        if (x.name == r.name && x.block == r.block && x.threads == n && x.repeat == repeat) return x.m.rate();
+    }
+    return 0;
+}
+
+// One line per case: the first count's median rate, its A/A ratio (repeat 2
+// over repeat 1), then per count the speed-up over the first count, each the
+// median [min, max] over the blocks.
 void print_summary(const std::vector<Row>& rows, const std::vector<Case>& cases, const std::vector<unsigned>& threads) {
-    std::printf("%-17s %7s %14s   %s\n", "case", "threads", "ops/s median",
-                "vs 1st count per block: median [min, max]");
+    std::printf("%-17s %14s %26s   speed-up vs %u thread(s) per block: median [min, max]\n", "case", "ops/s median",
+                "A/A", threads[0]);
     for (const Case& c : cases) {
-        for (unsigned n : threads) {
-            std::vector<double> rates, ratios;
-            for (const Row& r : rows) {
-                if (r.name != c.name || r.threads != n || r.repeat != 1) continue;
-                rates.push_back(r.m.rate());
-                for (const Row& base : rows) {
-                    if (base.name == r.name && base.block == r.block && base.threads == threads[0] && base.repeat == 1)
-                        ratios.push_back(r.m.rate() / base.m.rate());
-                }
-            }
-            std::sort(ratios.begin(), ratios.end());
-            std::printf("%-17s %7u %14.0f   %.2fx [%.2f, %.2f]\n", c.name, n, median(rates), median(ratios),
-                        ratios.front(), ratios.back());
+        std::vector<double> rates, control;
+        std::vector<std::vector<double>> ratios(threads.size());
+        for (const Row& r : rows) {
+            if (r.name != c.name || r.threads != threads[0] || r.repeat != 1) continue;
+            rates.push_back(r.m.rate());
+            control.push_back(rate_of(rows, r, threads[0], 2) / r.m.rate());
+            for (std::size_t i = 0; i < threads.size(); ++i)
+                ratios[i].push_back(rate_of(rows, r, threads[i], 1) / r.m.rate());
         }
+        auto interval = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            char text[64];
+            std::snprintf(text, sizeof text, "%.2f [%.2f, %.2f]", median(v), v.front(), v.back());
+            return std::string(text);
+        };
+        std::printf("%-17s %14.0f %26s  ", c.name, median(rates), interval(control).c_str());
+        for (std::size_t i = 1; i < threads.size(); ++i)
+            std::printf(" %u: %s", threads[i], interval(ratios[i]).c_str());
+        std::printf("\n");
     }
 }
 
@@ -433,6 +448,9 @@ int main(int argc, char** argv) try {
     std::printf("device: %s; %u hardware threads; %u blocks of %u ms per case and thread count\n", physical.name(),
                 std::thread::hardware_concurrency(), blocks, block_ms);
 
+    // One untimed block first: the process's first measurements pay for
+    // first-use work (page faults, the driver's caches) that is no contention.
+    for (const Case& c : cases) measure(c, shared, threads[0], block_ms);
     std::vector<Row> rows;
     for (unsigned b = 1; b <= blocks; ++b) {
         for (const Case& c : cases) {
