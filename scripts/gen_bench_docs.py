@@ -2,8 +2,12 @@
 """Regenerates the benchmark results in docs/benchmarks.md and README.md from
 the CSV files under docs/results/ (one file per run: '# key: value' header
 lines, then the program's CSV): the teapot runs (bench/device_run.sh), the
-allocation runs (bench/alloc_run.sh) and the header-cost runs
+allocation runs (bench/alloc_run.sh), the contention runs
+(bench/contention_run.sh) and the header-cost runs
 (bench/header_cost_run.sh).
+
+The contention runs also get a figure each (docs/img/<results file>.svg),
+written and checked like the tables.
 
 Every generated block sits between '<!-- generated:NAME -->' and
 '<!-- end generated:NAME -->', a generated table row ends with
@@ -388,6 +392,188 @@ def upload_section(pattern, pending):
     return out[:-1]
 
 
+CONTENTION_GOAL = 4.0  # PoolAllocator alloc+free rate at 8 threads vs 1 thread (issue 17)
+CONTENTION_GOAL_THREADS = 8
+CONTENTION_GOAL_CASE = "alloc-pool"
+
+
+def median(values):
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
+
+
+def contention_runs(pattern):
+    return sorted(results(pattern, "ops_per_second"), key=lambda r: r["path"])
+
+
+def contention_ratios(rows, case, threads, repeat="1"):
+    """Per (process, block): the rate at threads (repeat) over the first thread count's (repeat 1)
+    of the same block; the counts of a block run back to back."""
+    first = rows[0]["threads"]
+    get = {(x["process"], x["block"], x["threads"], x["repeat"]): float(x["ops_per_second"])
+           for x in rows if x["case"] == case}
+    return sorted(get[(p, b, t, rep)] / get[(p, b, first, "1")] for (p, b, t, rep) in get
+                  if t == threads and rep == repeat and get.get((p, b, first, "1")))
+
+
+def host_cpus(r):
+    m = re.match(r"(\d+) CPUs", r["meta"].get("host", ""))
+    return int(m.group(1)) if m else 0
+
+
+def interval(values, digits=2):
+    return f"{median(values):.{digits}f} [{values[0]:.{digits}f}, {values[-1]:.{digits}f}]"
+
+
+def contention_goal(r):
+    rows = r["rows"]
+    ratios = contention_ratios(rows, CONTENTION_GOAL_CASE, str(CONTENTION_GOAL_THREADS))
+    if not ratios:
+        return f"not measured ({CONTENTION_GOAL_THREADS} threads or {CONTENTION_GOAL_CASE} missing)"
+    text = f"{CONTENTION_GOAL_CASE} at {CONTENTION_GOAL_THREADS} threads: {interval(ratios)}x the 1-thread rate"
+    cpus = host_cpus(r)
+    if ratios[0] >= CONTENTION_GOAL:
+        verdict = "met"
+    elif ratios[-1] < CONTENTION_GOAL:
+        verdict = "not met"
+    else:
+        verdict = "not resolved (the interval straddles the goal)"
+    note = (f" This host has {cpus} CPUs: {CONTENTION_GOAL_THREADS} threads cannot all run at once, so it cannot "
+            "show the goal whatever the allocator does." if 0 < cpus < CONTENTION_GOAL_THREADS else "")
+    return f"{text}: **{verdict}** here.{note}"
+
+
+def contention_lock(r):
+    """Whether the shared PoolAllocator's lock limits alloc-pool's scaling: its speed-up against a pool
+    per thread (alloc-pool-own) and the uncontended handle-own at the most threads this host runs at once."""
+    rows = r["rows"]
+    cpus = host_cpus(r) or 1
+    counts = sorted({int(x["threads"]) for x in rows if int(x["threads"]) <= max(cpus, 2)})
+    if len(counts) < 2:
+        return ""
+    n = str(counts[-1])
+    get = {c: contention_ratios(rows, c, n) for c in ("handle-own", "alloc-pool", "alloc-pool-own")}
+    if not all(get.values()):
+        return ""
+    pool, own = get["alloc-pool"], get["alloc-pool-own"]
+    if median(get["handle-own"]) < 0.75 * int(n):
+        verdict = ("handle-own, which shares nothing, does not scale either: the host gave the process no spare "
+                   "CPU (other work ran), so this run decides nothing about contention")
+    elif pool[-1] < own[0]:
+        verdict = "the shared pool scales less than a pool per thread: its lock limits it"
+    elif pool[0] > own[-1]:
+        verdict = "the shared pool scales more than a pool per thread"
+    else:
+        verdict = "the two intervals overlap: this run does not show the shared lock limiting"
+    return (f"At {n} threads (this host has {cpus} CPUs): handle-own (nothing shared) {interval(get['handle-own'])}x, "
+            f"alloc-pool {interval(pool)}x, alloc-pool-own (a PoolAllocator per thread) {interval(own)}x: "
+            f"{verdict}.")
+
+
+# Generated figures: path (relative to ROOT) -> SVG text, written (or checked) with the Markdown.
+FIGURES = {}
+PLOT_CASES = ["handle-shared", "handle-own", "alloc-pool", "alloc-pool-own", "alloc-dedicated", "buffer-pool",
+              "buffer-dedicated", "buffer-raw", "buffer-bound", "sets-free"]
+PLOT_COLOURS = ["#1f77b4", "#aec7e8", "#d62728", "#ff9896", "#9467bd", "#2ca02c", "#98df8a", "#8c564b",
+                "#c49c94", "#7f7f7f"]
+
+
+def contention_plot(r):
+    """An SVG of the median speed-up against the thread count (both axes log2), one line per case of
+    PLOT_CASES, with the ideal (speed-up = threads) dashed; returns its path relative to docs/."""
+    import math
+    rows = r["rows"]
+    counts = sorted({int(x["threads"]) for x in rows})
+    lines = {}
+    for c in PLOT_CASES:
+        points = [(1, 1.0)] + [(n, median(contention_ratios(rows, c, str(n)))) for n in counts[1:]
+                               if contention_ratios(rows, c, str(n))]
+        if len(points) > 1:
+            lines[c] = points
+    top = max([counts[-1]] + [y for pts in lines.values() for _, y in pts])
+    bottom = min([1.0] + [y for pts in lines.values() for _, y in pts])
+    lo, hi = math.floor(math.log2(bottom)), math.ceil(math.log2(top))
+    w, h, left, right, pad = 640, 360, 60, 170, 30
+
+    def x(n):
+        return left + (w - left - right) * math.log2(n) / max(1, math.log2(counts[-1]))
+
+    def y(v):
+        return h - pad - (h - 2 * pad) * (math.log2(v) - lo) / max(1, hi - lo)
+
+    svg = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" '
+           'font-size="11">', f'<rect width="{w}" height="{h}" fill="white"/>']
+    for e in range(lo, hi + 1):
+        v = 2.0 ** e
+        svg.append(f'<line x1="{left}" x2="{w - right}" y1="{y(v):.1f}" y2="{y(v):.1f}" stroke="#ddd"/>')
+        svg.append(f'<text x="{left - 6}" y="{y(v) + 4:.1f}" text-anchor="end">{v:g}x</text>')
+    for n in counts:
+        svg.append(f'<text x="{x(n):.1f}" y="{h - pad + 16}" text-anchor="middle">{n}</text>')
+    svg.append(f'<text x="{(left + w - right) / 2:.0f}" y="{h - 2}" text-anchor="middle">threads</text>')
+    svg.append(f'<text x="{left}" y="14">median speed-up vs 1 thread ({r["meta"].get("device", "?")})</text>')
+    ideal = " ".join(f"{x(n):.1f},{y(n):.1f}" for n in counts if lo <= math.log2(n) <= hi)
+    svg.append(f'<polyline points="{ideal}" fill="none" stroke="black" stroke-dasharray="4 3"/>')
+    for i, (c, pts) in enumerate(lines.items()):
+        colour = PLOT_COLOURS[i % len(PLOT_COLOURS)]
+        svg.append(f'<polyline points="{" ".join(f"{x(n):.1f},{y(v):.1f}" for n, v in pts)}" fill="none" '
+                   f'stroke="{colour}" stroke-width="2"/>')
+        ly = pad + 16 * i
+        svg.append(f'<line x1="{w - right + 10}" x2="{w - right + 30}" y1="{ly}" y2="{ly}" stroke="{colour}" '
+                   'stroke-width="2"/>')
+        svg.append(f'<text x="{w - right + 35}" y="{ly + 4}">{c}</text>')
+    ly = pad + 16 * len(lines)
+    svg.append(f'<line x1="{w - right + 10}" x2="{w - right + 30}" y1="{ly}" y2="{ly}" stroke="black" '
+               'stroke-dasharray="4 3"/>')
+    svg.append(f'<text x="{w - right + 35}" y="{ly + 4}">ideal</text>')
+    svg.append("</svg>")
+    name = "img/" + os.path.splitext(os.path.basename(r["path"]))[0] + ".svg"
+    FIGURES[os.path.join("docs", name)] = "\n".join(svg) + "\n"
+    return name
+
+
+def contention_section(pattern, pending):
+    found = contention_runs(pattern)
+    if not found:
+        return [pending]
+    out = []
+    for r in found:
+        rows = r["rows"]
+        processes = len({x["process"] for x in rows})
+        blocks = len({x["block"] for x in rows})
+        cases = []
+        for x in rows:
+            if x["case"] not in cases:
+                cases.append(x["case"])
+        counts = []
+        for x in rows:
+            if x["threads"] not in counts:
+                counts.append(x["threads"])
+        out += [run_line(r), "", f"    {r['meta'].get('command', '?')}", "",
+                f"{processes} processes x {blocks} blocks per case and thread count. Speed-up: the rate over the "
+                f"same block's {counts[0]}-thread rate; on the {counts[0]}-thread rows, the A/A control instead "
+                "(the block's second 1-thread measurement over its first). Median [min, max] over every block "
+                "of every process.", "",
+                "| case | threads | ops/s median [min, max] | speed-up vs 1 thread (1 thread: A/A) |",
+                "|---|---:|---:|---:|"]
+        for c in cases:
+            for n in counts:
+                rates = sorted(float(x["ops_per_second"]) for x in rows
+                               if x["case"] == c and x["threads"] == n and x["repeat"] == "1")
+                if n == counts[0]:
+                    ratio = "A/A " + interval(contention_ratios(rows, c, n, "2"))
+                else:
+                    ratio = interval(contention_ratios(rows, c, n)) + "x"
+                out.append(f"| {c} | {n} | {thousands(median(rates))} [{thousands(rates[0])}, "
+                           f"{thousands(rates[-1])}] | {ratio} |")
+        out += ["", f"![speed-up against threads, {r['meta'].get('device', '?')}]({contention_plot(r)})",
+                "", f"Goal (PoolAllocator alloc+free at {CONTENTION_GOAL_THREADS} threads at least "
+                f"{CONTENTION_GOAL:.0f}x its 1-thread rate, the whole interval above it): {contention_goal(r)}"]
+        lock = contention_lock(r)
+        out += (["", lock] if lock else []) + [""]
+    return out[:-1]
+
+
 BLOCKS = {
     "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
     "upload-h200": lambda: upload_section(
@@ -407,6 +593,11 @@ BLOCKS = {
         "(its run's output was not committed; it is in docs/benchmarks.md at 8c4a8a5), so it is removed. "
         "`bench/device_run.sh` (or `bench/alloc_run.sh`) produces the CSV; committed under docs/results/, it "
         "appears here."),
+    "contention-lavapipe": lambda: contention_section(
+        "llvmpipe", "No lavapipe contention results in docs/results/ yet."),
+    "contention-h200": lambda: contention_section(
+        "H200", "**Pending:** no H200 contention run is committed yet. `bench/contention_run.sh BUILD_DIR OUT NAME` "
+        "on the H200 machine writes the CSV; committed under docs/results/, it appears here."),
     "header-cost": header_cost_section,
     "readme-compile-cost": readme_compile_row,
     "readme-alloc": readme_alloc_row,
@@ -461,6 +652,12 @@ def main():
             changed.append(name)
             if not args.check:
                 open(path, "w").write(new)
+    for name, svg in FIGURES.items():
+        path = os.path.join(ROOT, name)
+        if not os.path.exists(path) or open(path).read() != svg:
+            changed.append(name)
+            if not args.check:
+                open(path, "w").write(svg)
     if args.check and changed:
         sys.exit("gen_bench_docs.py --check: out of date (run scripts/gen_bench_docs.py): " + ", ".join(changed))
     print(("would change: " if args.check else "regenerated: ") + (", ".join(changed) or "nothing"))
