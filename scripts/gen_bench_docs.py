@@ -336,6 +336,8 @@ def readme_row():
 
 UPLOAD_RAW_GOAL = 0.95  # vkrc-stream vs raw-stream throughput (issue 15)
 UPLOAD_BLOCKING_GOAL = 5.0  # vkrc-stream vs vkrc-blocking throughput, 4 KiB uploads
+# raw-stream-aa (runs from 2026-11-23 r3 on) is raw-stream again: the A/A control.
+UPLOAD_VARIANTS = ("vkrc-stream", "raw-stream", "vkrc-blocking", "raw-stream-aa")
 
 
 def upload_stats(rows, upload, variant, column):
@@ -370,19 +372,23 @@ def upload_section(pattern, pending):
                 "| blocks |",
                 "|---|---|---:|---:|---:|---:|"]
         for u in uploads:
-            for v in ("vkrc-stream", "raw-stream", "vkrc-blocking"):
+            for v in [v for v in UPLOAD_VARIANTS if any(x["variant"] == v for x in rows)]:
                 g = upload_stats(rows, u, v, "gb_per_s")
                 c = upload_stats(rows, u, v, "cpu_us_per_upload")
                 per_block = next(x["uploads"] for x in rows if x["upload"] == u and x["variant"] == v)
                 out.append(f"| {u} | {v} | {per_block} | {g[0]:.3f} [{g[1]:.3f}, {g[2]:.3f}] | "
                            f"{c[0]:.1f} [{c[1]:.1f}, {c[2]:.1f}] | {g[3]} |")
+        control = any(x["variant"] == "raw-stream-aa" for x in rows)
         out += ["", "| upload | vkrc-stream / raw-stream GB/s, median [min, max] of the blocks | "
-                "vkrc-stream / vkrc-blocking |", "|---|---:|---:|"]
+                "vkrc-stream / vkrc-blocking |" + (" A/A: raw-stream / raw-stream-aa |" if control else ""),
+                "|---|---:|---:|" + ("---:|" if control else "")]
         for u in uploads:
             raw = upload_ratio(rows, u, "vkrc-stream", "raw-stream")
             blocking = upload_ratio(rows, u, "vkrc-stream", "vkrc-blocking")
+            aa = upload_ratio(rows, u, "raw-stream", "raw-stream-aa") if control else None
             out.append(f"| {u} | {raw[0]:.3f} [{raw[1]:.3f}, {raw[2]:.3f}] | "
-                       f"{blocking[0]:.2f} [{blocking[1]:.2f}, {blocking[2]:.2f}] |")
+                       f"{blocking[0]:.2f} [{blocking[1]:.2f}, {blocking[2]:.2f}] |" +
+                       (f" {aa[0]:.3f} [{aa[1]:.3f}, {aa[2]:.3f}] |" if control else ""))
         raw_all = [upload_ratio(rows, u, "vkrc-stream", "raw-stream")[0] for u in uploads]
         small = upload_ratio(rows, uploads[0], "vkrc-stream", "vkrc-blocking")[0]
         out += ["", f"Goals: vkrc-stream at least {UPLOAD_RAW_GOAL}x raw-stream's throughput (median ratios "

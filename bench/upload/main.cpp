@@ -4,7 +4,8 @@
 // transfer queue, one timeline semaphore) on the same device and queue.
 // Each case runs --blocks blocks per variant, the variants interleaved; a
 // block uploads the case's data --reps times (scaled down for large cases)
-// and waits once at its end. GB/s: bytes / wall time of the block; CPU us:
+// and waits once at its end. raw-stream-aa is raw-stream again (a second
+// instance): the A/A control of the ratios. GB/s: bytes / wall time of the block; CPU us:
 // the uploading thread's CPU time per upload (lavapipe's copies run on its
 // own threads, so this is the submitting cost).
 //
@@ -95,6 +96,17 @@ public:
         VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
         fn_->vkBeginCommandBuffer(cmd, &bi);
+        // Earlier copies into the same target finish first (write after
+        // write), as in the Uploader's batches: the same synchronisation, by hand.
+        VkMemoryBarrier2 before{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+        before.srcStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+        before.srcAccessMask = VK_ACCESS_2_MEMORY_WRITE_BIT;
+        before.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+        before.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT;
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.memoryBarrierCount = 1;
+        dep.pMemoryBarriers = &before;
+        fn_->vkCmdPipelineBarrier2(cmd, &dep);
         if (t.buffer) {
             const VkBufferCopy region{at, 0, size};
             fn_->vkCmdCopyBuffer(cmd, staging_, t.buffer.vk(), 1, &region);
@@ -288,7 +300,7 @@ int main(int argc, char** argv) try {
         const VkDeviceSize ring = std::max<VkDeviceSize>(2 * bytes, 16 << 20);
         auto uploader = vkrc::Uploader::create(
             {.queue = transfer.queue, .consumer_family = transfer.queue.family_index(), .staging_size = ring});
-        RawStream raw(transfer.queue, ring);
+        RawStream raw(transfer.queue, ring), raw_aa(transfer.queue, ring);
         const std::vector<std::pair<std::string, std::function<void()>>> variants = {
             {"vkrc-stream",
              [&] {
@@ -301,9 +313,11 @@ int main(int argc, char** argv) try {
                  if (c.image) vkrc::upload_image(transfer.queue, target.image, data);
                  else vkrc::upload_buffer(transfer.queue, target.buffer, 0, data);
              }},
-            {"raw-stream", [&] { raw.upload(target, data.data(), bytes); }}};
+            {"raw-stream", [&] { raw.upload(target, data.data(), bytes); }},
+            // The A/A control: the reference again, so its ratio shows the noise floor.
+            {"raw-stream-aa", [&] { raw_aa.upload(target, data.data(), bytes); }}};
         const std::vector<std::function<void()>> finish = {[&] { uploader.submit().wait_on_host(); }, [] {},
-                                                           [&] { raw.wait_all(); }};
+                                                           [&] { raw.wait_all(); }, [&] { raw_aa.wait_all(); }};
         for (int block = 0; block <= blocks; ++block) {  // block 0 warms up
             for (std::size_t v = 0; v < variants.size(); ++v) {
                 const auto start = std::chrono::steady_clock::now();
