@@ -13,17 +13,19 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 DescriptorSetLayoutState::~DescriptorSetLayoutState() {
-    defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout, serial());
 }
 
 DescriptorPoolState::~DescriptorPoolState() {
     // Destroying the pool frees every set still in it, pending ones included.
-    defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool, serial());
+    if (ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool, serial());
 }
 
 DescriptorSetState::~DescriptorSetState() {
     auto& p = *pool.state();
-    if (!p.can_free_sets || set == VK_NULL_HANDLE) return;
+    if (!p.can_free_sets || set == VK_NULL_HANDLE || ownership == Ownership::borrowed) return;
     LockGuard lock(p.mutex);
     if (p.generation == generation) p.pending.push(*p.device.state(), set, serial());
 }
@@ -54,8 +56,7 @@ void check_immutable_samplers(const Device& device, const DescriptorSetLayoutBin
 // the validation layer: immutable samplers, and binding flags
 // (VUID-VkDescriptorSetLayoutCreateInfo-flags-03000,
 // VUID-VkDescriptorSetLayoutBindingFlagsCreateInfo-pBindingFlags-03004).
-void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
-    constexpr const char* who = "vkrc::DescriptorSetLayout::create";
+void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& info, const char* who) {
     std::uint32_t highest = 0;
     for (const auto& b : info.bindings) highest = std::max(highest, b.binding);
     for (const auto& b : info.bindings) {
@@ -74,6 +75,19 @@ void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& i
     }
 }
 
+// The bindings a layout checks writes against, and its variable-count binding.
+void keep_bindings(detail::DescriptorSetLayoutState& s, const Device& device,
+                   const List<DescriptorSetLayoutBinding>& bindings) {
+    s.device = device;
+    s.bindings = bindings;
+    for (const auto& b : bindings) {
+        if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {
+            s.has_variable_binding = true;
+            s.variable_binding = b.binding;
+        }
+    }
+}
+
 }  // namespace
 
 DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
@@ -84,7 +98,7 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
             "vkrc::DescriptorSetLayout::create: PUSH_DESCRIPTOR_BIT_KHR needs VK_KHR_push_descriptor enabled on the "
             "device");
     }
-    check_bindings(device, info);
+    check_bindings(device, info, "vkrc::DescriptorSetLayout::create");
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     std::vector<VkDescriptorSetLayoutBinding> bindings;
     std::vector<VkDescriptorBindingFlags> flags;
@@ -103,10 +117,6 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
         bindings.push_back({b.binding, b.descriptor_type, b.descriptor_count, b.stage_flags, immutable});
         flags.push_back(b.binding_flags);
         any_flags = any_flags || b.binding_flags != 0;
-        if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {
-            s->has_variable_binding = true;
-            s->variable_binding = b.binding;
-        }
     }
     VkDescriptorSetLayoutBindingFlagsCreateInfo flags_info{
         VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO, info.next};
@@ -118,11 +128,35 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
     ci.flags = info.flags;
     ci.bindingCount = static_cast<std::uint32_t>(bindings.size());
     ci.pBindings = bindings.data();
-    s->device = device;
-    s->bindings = info.bindings;
+    keep_bindings(*s, device, info.bindings);
     check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->layout),
           "vkCreateDescriptorSetLayout");
     return DescriptorSetLayout(std::move(s));
+}
+
+DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescriptorSetLayout layout,
+                                               const DescriptorSetLayoutCreateInfo& info, Ownership ownership) {
+    constexpr const char* who = "vkrc::DescriptorSetLayout::adopt";
+    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    if (layout == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSetLayout is VK_NULL_HANDLE");
+    check_bindings(device, info, who);
+    detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
+    keep_bindings(*s, device, info.bindings);
+    s->layout = layout;
+    s->ownership = ownership;
+    return DescriptorSetLayout(std::move(s));
+}
+
+DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
+                                     Ownership ownership) {
+    if (!device) throw UsageError("vkrc::DescriptorPool::adopt: the Device handle is empty");
+    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::DescriptorPool::adopt: the VkDescriptorPool is VK_NULL_HANDLE");
+    detail::Ref<detail::DescriptorPoolState> s(new detail::DescriptorPoolState);
+    s->device = device;
+    s->pool = pool;
+    s->ownership = ownership;
+    s->can_free_sets = (flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
+    return DescriptorPool(std::move(s));
 }
 
 DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPoolCreateInfo& info) {
@@ -145,8 +179,7 @@ namespace {
 
 // The largest count a set of layout may ask for its variable binding; throws
 // when the layout has none and a count was given.
-void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::uint32_t count) {
-    constexpr const char* who = "vkrc::DescriptorPool::allocate";
+void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::uint32_t count, const char* who) {
     if (!layout.has_variable_binding) {
         if (count == 0) return;
         throw UsageError(std::string(who) + ": variable_descriptor_count is " + std::to_string(count) +
@@ -169,7 +202,7 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
     if (!(layout.device() == device())) {
         throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout belongs to another device");
     }
-    check_variable_count(*layout.state(), variable_descriptor_count);
+    check_variable_count(*layout.state(), variable_descriptor_count, "vkrc::DescriptorPool::allocate");
     auto& p = *state_;
     auto& d = *p.device.state();
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
@@ -196,6 +229,27 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
     }
     check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->set), "vkAllocateDescriptorSets");
     s->generation = p.generation;
+    return DescriptorSet(std::move(s));
+}
+
+DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorSetLayout& layout, VkDescriptorSet set,
+                                   Ownership ownership, std::uint32_t variable_descriptor_count) {
+    constexpr const char* who = "vkrc::DescriptorSet::adopt";
+    if (!pool) throw UsageError(std::string(who) + ": the DescriptorPool handle is empty");
+    if (!layout) throw UsageError(std::string(who) + ": the DescriptorSetLayout handle is empty");
+    if (set == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSet is VK_NULL_HANDLE");
+    if (!(layout.device() == pool.device())) {
+        throw UsageError(std::string(who) + ": the DescriptorSetLayout belongs to another device");
+    }
+    check_variable_count(*layout.state(), variable_descriptor_count, who);
+    detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
+    s->pool = pool;
+    s->layout = layout;
+    s->set = set;
+    s->ownership = ownership;
+    s->variable_count = variable_descriptor_count;
+    LockGuard lock(pool.state()->mutex);
+    s->generation = pool.state()->generation;
     return DescriptorSet(std::move(s));
 }
 

@@ -50,6 +50,12 @@ class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
 public:
     DescriptorSetLayout() noexcept = default;
     static DescriptorSetLayout create(const Device& device, const DescriptorSetLayoutCreateInfo& info);
+    // A layout made by other code; info describes it as its creation did (the
+    // bindings are copied to check writes; next is ignored). Owned: vkrc
+    // destroys it after the GPU is done; borrowed: its maker does, after
+    // every vkrc handle to it has gone.
+    static DescriptorSetLayout adopt(const Device& device, VkDescriptorSetLayout layout,
+                                     const DescriptorSetLayoutCreateInfo& info, Ownership ownership);
     VkDescriptorSetLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
@@ -81,6 +87,10 @@ class DescriptorPool : public Handle<detail::DescriptorPoolState> {
 public:
     DescriptorPool() noexcept = default;
     static DescriptorPool create(const Device& device, const DescriptorPoolCreateInfo& info);
+    // A pool made by other code with these creation flags (FREE_DESCRIPTOR_SET
+    // decides whether dropped sets are freed). Ownership as for DescriptorSetLayout::adopt.
+    static DescriptorPool adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
+                                Ownership ownership);
 
     VkDescriptorPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -103,6 +113,12 @@ private:
 class DescriptorSet : public Handle<detail::DescriptorSetState> {
 public:
     DescriptorSet() noexcept = default;
+    // A set allocated by other code from pool with layout (variable_descriptor_count
+    // as it was allocated with). Owned: dropping it frees it as an allocated
+    // set is freed (with FREE_DESCRIPTOR_SET, once the GPU is done); borrowed:
+    // vkrc never frees it. It is invalid after the pool's reset_sets().
+    static DescriptorSet adopt(const DescriptorPool& pool, const DescriptorSetLayout& layout, VkDescriptorSet set,
+                               Ownership ownership, std::uint32_t variable_descriptor_count = 0);
     VkDescriptorSet vk() const VKRC_UNCHECKED_NOEXCEPT;
     const DescriptorPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
 
@@ -147,6 +163,7 @@ public:
     ~DescriptorSetLayoutState() override;
     Device device;
     VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     // For checking writes against the layout.
     List<DescriptorSetLayoutBinding> bindings;
     // The binding with VARIABLE_DESCRIPTOR_COUNT, if any.
@@ -159,6 +176,7 @@ public:
     ~DescriptorPoolState() override;
     Device device;
     VkDescriptorPool pool = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     bool can_free_sets = false;
     mutable Mutex mutex;
     // Under mutex: sets dropped while in use, and how many resets happened
@@ -173,6 +191,7 @@ public:
     DescriptorPool pool;
     DescriptorSetLayout layout;  // checks writes (the raw layout may go once the set exists)
     VkDescriptorSet set = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     std::uint64_t generation = 0;
     std::uint32_t variable_count = 0;  // of the layout's variable binding, if it has one
 };
