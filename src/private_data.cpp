@@ -5,10 +5,22 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 PrivateDataSlotState::~PrivateDataSlotState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroyPrivateDataSlot>(*device.state(), slot, serial());
+    if (device && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroyPrivateDataSlot>(*device.state(), slot, serial());
 }
 
 }  // namespace detail
+
+PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership) {
+    if (!device) throw UsageError("vkrc::PrivateDataSlot::adopt: the Device handle is empty");
+    if (slot == VK_NULL_HANDLE)
+        throw UsageError("vkrc::PrivateDataSlot::adopt: the VkPrivateDataSlot is VK_NULL_HANDLE");
+    detail::Ref<detail::PrivateDataSlotState> state(new detail::PrivateDataSlotState);
+    state->device = device;
+    state->slot = slot;
+    state->ownership = ownership;
+    return PrivateDataSlot(std::move(state));
+}
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
     if (!device) throw UsageError("vkrc::PrivateDataSlot::create: the Device handle is empty");

@@ -1,14 +1,32 @@
 #include "vkrc/ycbcr.hpp"
 
+#include <string>
+
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
 SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
-    if (device) defer_destroy<&DeviceFunctions::vkDestroySamplerYcbcrConversion>(*device.state(), conversion, serial());
+    if (device && ownership == Ownership::owned)
+        defer_destroy<&DeviceFunctions::vkDestroySamplerYcbcrConversion>(*device.state(), conversion, serial());
 }
 
 }  // namespace detail
+
+SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSamplerYcbcrConversion conversion,
+                                                     VkFormat format, Ownership ownership) {
+    constexpr const char* who = "vkrc::SamplerYcbcrConversion::adopt";
+    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    if (conversion == VK_NULL_HANDLE)
+        throw UsageError(std::string(who) + ": the VkSamplerYcbcrConversion is VK_NULL_HANDLE");
+    if (format == VK_FORMAT_UNDEFINED) throw UsageError(std::string(who) + ": format is VK_FORMAT_UNDEFINED");
+    detail::Ref<detail::SamplerYcbcrConversionState> state(new detail::SamplerYcbcrConversionState);
+    state->device = device;
+    state->conversion = conversion;
+    state->format = format;
+    state->ownership = ownership;
+    return SamplerYcbcrConversion(std::move(state));
+}
 
 SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
                                                       const SamplerYcbcrConversionCreateInfo& info) {

@@ -38,4 +38,28 @@ TEST_F(VulkanTest, PrivateDataOnSeveralObjectTypes) {
     EXPECT_EQ(slot.device(), device);
 }
 
+// A slot made with the raw API: owned, vkrc destroys it (the layer reports a
+// leak otherwise); borrowed, its maker does (a double destroy would be reported).
+TEST_F(VulkanTest, PrivateDataAdoptedSlot) {
+    if (!vkrc_test::supported_features(physical_device).v13.privateData) GTEST_SKIP() << "the device lacks privateData";
+    vkrc::DeviceCreateInfo info;
+    info.vulkan13_features.privateData = VK_TRUE;
+    device = vkrc::Device::create(physical_device, info);
+    queue = device.default_queue();
+    auto buffer = vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+    for (const auto ownership : {vkrc::Ownership::owned, vkrc::Ownership::borrowed}) {
+        VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO};
+        VkPrivateDataSlot raw = VK_NULL_HANDLE;
+        ASSERT_EQ(device.fn().vkCreatePrivateDataSlot(device.vk(), &ci, nullptr, &raw), VK_SUCCESS);
+        {
+            auto slot = vkrc::PrivateDataSlot::adopt(device, raw, ownership);
+            slot.set(VK_OBJECT_TYPE_BUFFER, buffer.vk(), 7);
+            EXPECT_EQ(slot.get(VK_OBJECT_TYPE_BUFFER, buffer.vk()), 7u);
+        }
+        device.wait_idle();  // runs a (wrongly) deferred destruction before the raw one
+        if (ownership == vkrc::Ownership::borrowed) device.fn().vkDestroyPrivateDataSlot(device.vk(), raw, nullptr);
+    }
+    EXPECT_THROW(vkrc::PrivateDataSlot::adopt(device, VK_NULL_HANDLE, vkrc::Ownership::owned), vkrc::UsageError);
+}
+
 }  // namespace

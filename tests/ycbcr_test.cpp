@@ -60,6 +60,35 @@ TEST_F(YcbcrTest, YcbcrConversionWithSamplerAndImageView) {
     conversion.reset();  // the view and sampler still hold it: no validation error at their destruction
 }
 
+// A conversion made with the raw API samples like vkrc's own; owned, vkrc
+// destroys it, borrowed, its maker does (the layer reports a leak or a double destroy).
+TEST_F(YcbcrTest, YcbcrAdoptedConversion) {
+    for (const auto ownership : {vkrc::Ownership::owned, vkrc::Ownership::borrowed}) {
+        VkSamplerYcbcrConversionCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_YCBCR_CONVERSION_CREATE_INFO};
+        ci.format = nv12;
+        ci.ycbcrModel = VK_SAMPLER_YCBCR_MODEL_CONVERSION_YCBCR_709;
+        ci.ycbcrRange = VK_SAMPLER_YCBCR_RANGE_ITU_FULL;
+        ci.xChromaOffset = ci.yChromaOffset = location;
+        ci.chromaFilter = VK_FILTER_NEAREST;
+        VkSamplerYcbcrConversion raw = VK_NULL_HANDLE;
+        ASSERT_EQ(device.fn().vkCreateSamplerYcbcrConversion(device.vk(), &ci, nullptr, &raw), VK_SUCCESS);
+        {
+            auto conversion = vkrc::SamplerYcbcrConversion::adopt(device, raw, nv12, ownership);
+            EXPECT_EQ(conversion.format(), nv12);
+            auto image =
+                vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+            auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+            EXPECT_NE(view.vk(), VK_NULL_HANDLE);
+        }
+        device.wait_idle();  // runs a (wrongly) deferred destruction before the raw one
+        if (ownership == vkrc::Ownership::borrowed) {
+            device.fn().vkDestroySamplerYcbcrConversion(device.vk(), raw, nullptr);
+        }
+    }
+    EXPECT_THROW(vkrc::SamplerYcbcrConversion::adopt(device, VK_NULL_HANDLE, nv12, vkrc::Ownership::owned),
+                 vkrc::UsageError);
+}
+
 vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcrConversion& conversion) {
     return vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
                                           .min_filter = VK_FILTER_NEAREST,

@@ -25,6 +25,8 @@ class PrivateDataSlot : public Handle<detail::PrivateDataSlotState> {
 public:
     PrivateDataSlot() noexcept = default;
     static PrivateDataSlot create(const Device& device, const PrivateDataSlotCreateInfo& info = {});
+    // A slot made by other code. Ownership as for SamplerYcbcrConversion::adopt.
+    static PrivateDataSlot adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership);
 
     VkPrivateDataSlot vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -55,6 +57,7 @@ public:
     ~PrivateDataSlotState() override;
     Device device;
     VkPrivateDataSlot slot = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail

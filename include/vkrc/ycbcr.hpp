@@ -39,6 +39,10 @@ class SamplerYcbcrConversion : public Handle<detail::SamplerYcbcrConversionState
 public:
     SamplerYcbcrConversion() noexcept = default;
     static SamplerYcbcrConversion create(const Device& device, const SamplerYcbcrConversionCreateInfo& info);
+    // A conversion made by other code for format. Owned: vkrc destroys it
+    // after the GPU is done; borrowed: its maker does, after every vkrc handle to it has gone.
+    static SamplerYcbcrConversion adopt(const Device& device, VkSamplerYcbcrConversion conversion, VkFormat format,
+                                        Ownership ownership);
 
     VkSamplerYcbcrConversion vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -56,6 +60,7 @@ public:
     Device device;
     VkSamplerYcbcrConversion conversion = VK_NULL_HANDLE;
     VkFormat format = VK_FORMAT_UNDEFINED;
+    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail
