@@ -1,12 +1,9 @@
-// A small forward renderer written only against vkrc (no raw Vulkan call):
-// teapots on a textured ground under a directional light, with a shadow
-// map, bindless textures whose mip chains are blitted on the GPU, an HDR
-// multisampled main pass recorded on several threads, a compute tone-map,
-// and GPU timestamps per pass.
-//     renderer [--threads N] [--frames N] [--resize-every N] [--report N] [--validation]    a window
-//     renderer --headless [--out FILE.png] [--frames N] [--threads N] [--validation]
-// Read top to bottom: options, device, scene geometry, textures, pipelines,
-// per-frame resources, the frame loop. The scene's layout is scene.hpp.
+// A small forward renderer written only against vkrc (no raw Vulkan call), to be read top to bottom:
+// teapots (scene.hpp) on a textured ground under a directional light, a shadow map, bindless textures
+// with mip chains blitted on the GPU, a multisampled HDR main pass recorded on several threads, a
+// compute tone-map, GPU timestamps per pass.
+//     renderer [--threads N] [--frames N] [--resize-every N] [--report N] [--validation]   a window
+//     renderer --headless [--out FILE.png] [--frames N] [--threads N] [--validation]  (1 frame by default)
 #include <vkrc/glfw.hpp>
 #include <vkrc/vkrc.hpp>
 
@@ -22,7 +19,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <string>
 #include <thread>
 #include <vector>
 
@@ -35,36 +31,7 @@ constexpr VkFormat ldr_format = VK_FORMAT_R8G8B8A8_UNORM;  // what the tone-map 
 constexpr std::uint32_t shadow_size = 1024, texture_size = 256, max_textures = 16, frames_in_flight = 2;
 constexpr int fixed_level = 16;  // the tessellation a renderer without LOD would draw everywhere
 
-struct Options {
-    bool headless = false, validation = false;
-    long frames = -1;  // -1: until the window closes (headless: 3)
-    std::uint32_t threads = multi_thread ? 2 : 1;
-    long resize_every = 0, report_every = 100;
-    std::string out_file = "renderer.png";
-};
-
-Options parse(int argc, char** argv) {
-    Options o;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        const bool has_value = i + 1 < argc;
-        if (a == "--headless") o.headless = true;
-        else if (a == "--validation") o.validation = true;
-        else if (a == "--out" && has_value) o.out_file = argv[++i];
-        else if (a == "--frames" && has_value) o.frames = std::stol(argv[++i]);
-        else if (a == "--threads" && has_value) o.threads = std::uint32_t(std::stoul(argv[++i]));
-        else if (a == "--resize-every" && has_value) o.resize_every = std::stol(argv[++i]);
-        else if (a == "--report" && has_value) o.report_every = std::stol(argv[++i]);
-        else throw std::runtime_error("unknown argument " + a + " (see the usage at the top of main.cpp)");
-    }
-    if (o.threads < 1 || (!multi_thread && o.threads > 1))
-        throw std::runtime_error("--threads must be 1" + std::string(multi_thread ? " or more" : " in the st build"));
-    if (o.frames < 0 && o.headless) o.frames = 3;
-    return o;
-}
-
-// The uniforms every draw reads (set 0, binding 0), written each frame into
-// the frame ring, and the push constants of one draw.
+// The uniforms every draw reads (set 0, binding 0; in the frame ring), and one draw's push constants.
 struct FrameUniforms {
     glm::mat4 view_proj, light_view_proj;
     glm::vec4 light_direction, camera_position;
@@ -74,100 +41,77 @@ struct DrawConstants {
     std::uint32_t texture_index;
     float uv_scale;
 };
-// A mesh's place in the shared vertex and index buffers.
+// Every mesh's vertices and indices, appended to one set of arrays; a mesh is a range of them.
 struct MeshRange {
     std::uint32_t first_index, index_count;
     std::int32_t vertex_offset;
+};
+struct Geometry {
+    std::vector<glm::vec3> positions, normals;
+    std::vector<std::uint16_t> indices;
+    MeshRange add(const teapot::Mesh& m) {
+        const MeshRange r{std::uint32_t(indices.size()), std::uint32_t(m.indices.size()),
+                          std::int32_t(positions.size())};
+        positions.insert(positions.end(), m.positions.begin(), m.positions.end());
+        normals.insert(normals.end(), m.normals.begin(), m.normals.end());
+        indices.insert(indices.end(), m.indices.begin(), m.indices.end());
+        return r;
+    }
 };
 struct Draw {
     DrawConstants constants;
     MeshRange mesh;
 };
-
-// Every mesh's vertices and indices, appended to one set of arrays.
-struct Geometry {
-    std::vector<glm::vec3> positions, normals;
-    std::vector<std::uint16_t> indices;
-    MeshRange add(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& n,
-                  const std::vector<std::uint16_t>& i) {
-        const MeshRange r{std::uint32_t(indices.size()), std::uint32_t(i.size()), std::int32_t(positions.size())};
-        positions.insert(positions.end(), p.begin(), p.end());
-        normals.insert(normals.end(), n.begin(), n.end());
-        indices.insert(indices.end(), i.begin(), i.end());
-        return r;
-    }
-};
-
-// One tessellation level of the teapot: its mesh and its largest distance
-// from the exact surface, in model units.
+// One tessellation level of the teapot, with its largest distance from the exact surface (model units).
 struct Lod {
     int level;
     double error;
     MeshRange mesh;
 };
 
-// Per teapot, the coarsest level whose error, projected at the teapot's
-// distance into an image of this size, stays under one pixel.
-std::array<std::size_t, renderer::teapots.size()> choose_lods(const std::vector<Lod>& lods, VkExtent2D extent) {
-    std::array<std::size_t, renderer::teapots.size()> chosen{};
-    const double short_side = std::min(extent.width, extent.height);
-    for (std::size_t t = 0; t < chosen.size(); ++t) {
-        const auto& teapot = renderer::teapots[t];
-        const double distance =
-            glm::distance(renderer::camera_position, teapot.position + glm::vec3(0.0f, 1.5f * teapot.scale, 0.0f));
-        const double pixels_per_unit = short_side / (2.0 * std::tan(renderer::camera_fov / 2.0) * distance);
-        chosen[t] = lods.size() - 1;
-        for (std::size_t l = 0; l < lods.size(); ++l)
-            if (lods[l].error * teapot.scale * pixels_per_unit < 1.0) {
-                chosen[t] = l;
-                break;
-            }
-    }
-    return chosen;
-}
-
 // Texel (x, y) of procedural texture index: ground tiles, red stripes, blue dots.
 std::array<std::uint8_t, 4> texel(std::uint32_t index, std::uint32_t x, std::uint32_t y) {
-    const int dx = int(x % 32) - 16, dy = int(y % 32) - 16;
+    using Rgba = std::array<std::uint8_t, 4>;
     const std::uint8_t v = x % 64 < 3 || y % 64 < 3 ? 150 : (x / 64 + y / 64) % 2 ? 190 : 215;
+    const int dx = int(x % 32) - 16, dy = int(y % 32) - 16;
     if (index == 0) return {v, std::uint8_t(v - 12), std::uint8_t(v - 30), 255};
-    if (index == 1)
-        return (x + y) % 64 < 24 ? std::array<std::uint8_t, 4>{200, 40, 30, 255}
-                                 : std::array<std::uint8_t, 4>{235, 220, 190, 255};
-    return dx * dx + dy * dy < 64 ? std::array<std::uint8_t, 4>{240, 240, 245, 255}
-                                  : std::array<std::uint8_t, 4>{40, 80, 190, 255};
+    if (index == 1) return (x + y) % 64 < 24 ? Rgba{200, 40, 30, 255} : Rgba{235, 220, 190, 255};
+    return dx * dx + dy * dy < 64 ? Rgba{240, 240, 245, 255} : Rgba{40, 80, 190, 255};
 }
 
-// The colour images the main pass and the tone-map use, re-created when the
-// presented extent changes (the old ones live until the GPU is done).
+// The images the main pass and the tone-map use, re-created when the presented extent changes.
 struct Targets {
     VkExtent2D extent{};
     vkrc::Image msaa, hdr, depth, ldr;  // msaa: empty without MSAA; ldr: only where the output is blitted
     vkrc::ImageView msaa_view, hdr_view, depth_view, ldr_view;
 };
 
-Targets make_targets(const vkrc::Device& device, VkExtent2D extent, VkSampleCountFlagBits samples, bool blit) {
-    Targets t{.extent = extent};
-    auto image = [&](VkFormat format, VkSampleCountFlagBits n, VkImageUsageFlags usage, vkrc::ImageView& view) {
-        auto i = vkrc::Image::create(
-            device, {.format = format, .extent = {extent.width, extent.height, 1}, .samples = n, .usage = usage});
-        view = vkrc::ImageView::create(i);
-        return i;
-    };
+// A single-level 2D image and its view.
+vkrc::Image image(const vkrc::Device& device, VkFormat format, VkExtent2D extent, VkSampleCountFlagBits samples,
+                  VkImageUsageFlags usage, vkrc::ImageView& view) {
+    auto i = vkrc::Image::create(
+        device, {.format = format, .extent = {extent.width, extent.height, 1}, .samples = samples, .usage = usage});
+    view = vkrc::ImageView::create(i);
+    return i;
+}
+
+Targets make_targets(const vkrc::Device& device, VkExtent2D e, VkSampleCountFlagBits samples, bool blit) {
     constexpr auto colour = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-    if (samples != VK_SAMPLE_COUNT_1_BIT) t.msaa = image(hdr_format, samples, colour, t.msaa_view);
-    t.hdr = image(hdr_format, VK_SAMPLE_COUNT_1_BIT, colour | VK_IMAGE_USAGE_SAMPLED_BIT, t.hdr_view);
-    t.depth = image(depth_format, samples, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, t.depth_view);
+    constexpr auto one = VK_SAMPLE_COUNT_1_BIT;
+    Targets t;
+    t.extent = e;
+    if (samples != one) t.msaa = image(device, hdr_format, e, samples, colour, t.msaa_view);
+    t.hdr = image(device, hdr_format, e, one, colour | VK_IMAGE_USAGE_SAMPLED_BIT, t.hdr_view);
+    t.depth = image(device, depth_format, e, samples, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, t.depth_view);
     if (blit)
-        t.ldr = image(ldr_format, VK_SAMPLE_COUNT_1_BIT, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                      t.ldr_view);
+        t.ldr =
+            image(device, ldr_format, e, one, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, t.ldr_view);
     return t;
 }
 
-// How an image is used at some point of the frame: its layout, and the
-// stage and access that use it there. A transition goes from one use to the
-// next; without keep, the old contents are discarded (layout UNDEFINED) and
-// the barrier only orders the new use after the old one.
+// How an image is used at some point of the frame: its layout, and the stage and access that use
+// it there. A transition goes from one use to the next; without keep, the old contents are
+// discarded (layout UNDEFINED) and the barrier only orders the new use after the old one.
 struct Use {
     VkImageLayout layout;
     VkPipelineStageFlags2 stage;
@@ -198,34 +142,12 @@ void transition(const vkrc::CommandBuffer& cmd, const vkrc::Image& image, Use fr
     cmd.pipeline_barrier({}, {}, std::span(&b, 1));
 }
 
-// What every draw of a pass binds, then the draws themselves.
-struct PassBindings {
-    const vkrc::GraphicsPipeline* pipeline;
-    std::span<const VkDescriptorSet> sets;
-    std::uint32_t dynamic_offset;
-    std::array<VkBuffer, 2> vertex_buffers;  // positions, normals
-    VkBuffer index_buffer;
-    VkExtent2D extent;
-};
-
-void record_draws(const vkrc::CommandBuffer& cmd, const PassBindings& b, std::span<const Draw> draws) {
-    cmd.bind_pipeline(*b.pipeline);
-    cmd.set_viewport_and_scissor(b.extent);  // dynamic state: never inherited by secondaries
-    cmd.bind_descriptor_sets(*b.pipeline, 0, b.sets, std::span(&b.dynamic_offset, 1));
-    cmd.bind_vertex_buffers(0, b.vertex_buffers, std::array<VkDeviceSize, 2>{0, 0});
-    cmd.bind_index_buffer(b.index_buffer, 0, VK_INDEX_TYPE_UINT16);
-    for (const Draw& d : draws) {
-        cmd.push_constants(b.pipeline->layout(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                           d.constants);
-        cmd.draw_indexed(d.mesh.index_count, 1, d.mesh.first_index, d.mesh.vertex_offset);
-    }
-}
-
-int run(const Options& options) {
-    // 1. Instance, device and presenter, as in examples/teapot. Headless, the
-    //    tone-map writes the presented image itself (storage usage); a
-    //    window's swapchain formats seldom allow storage, so there it writes
-    //    an intermediate that is blitted into the swapchain image.
+int run(const vkrc_examples::WindowOrHeadless& options) {
+    // 1. Instance, device and presenter, as in examples/teapot. Headless, the tone-map writes the
+    //    presented image itself (storage usage); a window's swapchain formats seldom allow storage,
+    //    so there it writes an intermediate that is blitted into the swapchain image.
+    const auto threads = std::uint32_t(options.threads > 0 ? options.threads : multi_thread ? 2 : 1);
+    if (!multi_thread && threads > 1) throw std::runtime_error("the st build records on one thread: --threads 1");
     vkrc::InstanceCreateInfo instance_info{.application_name = "vkrc renderer", .validation = options.validation};
     vkrc::DeviceRequirements requirements;
     vkrc::glfw::WindowSurface window;
@@ -260,36 +182,30 @@ int run(const Options& options) {
              .image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     vkrc::Presenter& presenter = options.headless ? static_cast<vkrc::Presenter&>(headless) : swapchain;
     const auto& limits = physical.properties().limits;
-    const VkSampleCountFlagBits samples =
-        (limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT)
-            ? VK_SAMPLE_COUNT_4_BIT
-            : VK_SAMPLE_COUNT_1_BIT;
-    std::printf("device: %s; %s textures; %ux MSAA; %u recording thread(s) (vkrc::%s)\n", physical.name(),
-                bindless ? "bindless" : "fixed-array (no descriptor indexing)", unsigned(samples), options.threads,
-                multi_thread ? "mt" : "st");
+    const auto samples = VkSampleCountFlagBits(
+        limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT ? 4 : 1);
+    std::printf("device: %s; %s textures; %ux MSAA; %u recording thread(s)\n", physical.name(),
+                bindless ? "bindless" : "fixed-array (no descriptor indexing)", unsigned(samples), threads);
 
-    // 2. Geometry: the ground and the teapot at several tessellation levels,
-    //    each with its error against the exact surface, so that every frame
-    //    can draw each teapot as coarse as its size on screen allows.
+    // 2. Geometry: the ground and the teapot at several tessellation levels, each with its error
+    //    against the exact surface, so that each teapot is drawn as coarse as its size allows.
     Geometry geometry;
     const float g = renderer::ground_half_size;
-    const MeshRange ground = geometry.add({{-g, -g, 0}, {g, -g, 0}, {g, g, 0}, {-g, g, 0}},
-                                          std::vector<glm::vec3>(4, glm::vec3(0, 0, 1)), {0, 1, 2, 0, 2, 3});
+    const MeshRange ground = geometry.add(
+        {{{-g, -g, 0}, {g, -g, 0}, {g, g, 0}, {-g, g, 0}}, std::vector(4, glm::vec3(0, 0, 1)), {0, 1, 2, 0, 2, 3}, {}});
     std::vector<Lod> lods;
     for (int level : {2, 3, 4, 5, 6, 7, 8, 10, 12, fixed_level}) {
         const auto mesh = teapot::tessellate(teapot::newell_teapot(), level);
-        lods.push_back({level, teapot::geometric_error(teapot::newell_teapot(), mesh, 3).max,
-                        geometry.add(mesh.positions, mesh.normals, mesh.indices)});
+        lods.push_back({level, teapot::geometric_error(teapot::newell_teapot(), mesh, 3).max, geometry.add(mesh)});
     }
 
-    // 3. Streaming: the buffers and each texture's level 0 (generated here)
-    //    go through the Uploader in one batch; the mip chains are then
-    //    blitted on the GPU, and every level read back and checked.
+    // 3. Streaming: the buffers and each texture's level 0 (generated here) go through the Uploader
+    //    in one batch; the mip chains are then blitted on the GPU, every level read back and checked.
     auto uploader = vkrc::Uploader::create({.queue = queue, .staging_size = 8 << 20});
+    constexpr auto transfer_dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;  // the same bit for images
     auto gpu_buffer = [&](const auto& data, VkBufferUsageFlags usage) {
         const auto bytes = std::as_bytes(std::span(data));
-        auto buffer =
-            vkrc::Buffer::create(device, {.size = bytes.size(), .usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        auto buffer = vkrc::Buffer::create(device, {.size = bytes.size(), .usage = usage | transfer_dst});
         uploader.upload_buffer(buffer, 0, bytes);
         return buffer;
     };
@@ -298,30 +214,28 @@ int run(const Options& options) {
     auto indices = gpu_buffer(geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     const std::uint32_t mip_levels = std::uint32_t(std::log2(texture_size)) + 1;
     std::vector<vkrc::Image> textures;
+    std::vector<vkrc::ImageView> texture_views;
     for (std::uint32_t index = 0; index < 3; ++index) {
+        constexpr auto usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | transfer_dst;
+        const VkExtent3D extent{texture_size, texture_size, 1};
         textures.push_back(vkrc::Image::create(
-            device,
-            {.format = ldr_format,
-             .extent = {texture_size, texture_size, 1},
-             .mip_levels = mip_levels,
-             .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT}));
+            device, {.format = ldr_format, .extent = extent, .mip_levels = mip_levels, .usage = usage}));
         std::vector<std::uint8_t> texels;
         for (std::uint32_t y = 0; y < texture_size; ++y)
             for (std::uint32_t x = 0; x < texture_size; ++x)
                 for (auto c : texel(index, x, y)) texels.push_back(c);
+        texture_views.push_back(vkrc::ImageView::create(textures.back()));
         uploader.upload_image(textures.back(), std::as_bytes(std::span(texels)),
                               {.new_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, .level_count = 1});
     }
     const vkrc::Ticket uploaded = uploader.submit();
-    auto setup_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
-    auto setup = setup_pool.allocate();
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto setup = pool.allocate();
     setup.begin();
     for (const auto& texture : textures) vkrc::generate_mipmaps(setup, texture);  // ends in SHADER_READ_ONLY
     setup.end();
-    auto setup_done = vkrc::Fence::create(device);
     const auto after_upload = uploaded.wait(VK_PIPELINE_STAGE_2_BLIT_BIT);
-    vkrc::submit(queue, {.waits = std::span(&after_upload, 1), .command_buffers = std::span(&setup, 1)}, setup_done);
-    setup_done.wait();
+    vkrc::submit(queue, {.waits = std::span(&after_upload, 1), .command_buffers = std::span(&setup, 1)});
     std::vector<vkrc::Download> levels;
     for (const auto& texture : textures)
         for (std::uint32_t level = 0; level < mip_levels; ++level)
@@ -337,22 +251,18 @@ int run(const Options& options) {
             if (b % 4 < 3) mean[b % 4] += double(bytes[b]) * 4.0 / double(bytes.size());
         if (i % mip_levels == 0) base = mean;
         for (int c = 0; c < 3; ++c)
-            if (!(std::abs(mean[c] - base[c]) < 12.0))
-                throw std::runtime_error("mip level " + std::to_string(i % mip_levels) + " of texture " +
-                                         std::to_string(i / mip_levels) + " was not written");
+            if (!(std::abs(mean[c] - base[c]) < 12.0)) throw std::runtime_error("a mip level was not written");
     }
     std::printf("textures: %zu x %u mip levels generated by blits, every level read back and checked\n",
                 textures.size(), mip_levels);
 
-    // 4. Descriptors. Set 0: the per-frame uniforms (a dynamic uniform
-    //    buffer over the frame ring) and the shadow map, sampled with
-    //    comparison. Set 1: the textures, an array indexed by a push constant.
+    // 4. Descriptors. Set 0: the per-frame uniforms (a dynamic uniform buffer over the frame ring)
+    //    and the shadow map, sampled with comparison. Set 1: the textures, indexed by a push constant.
     auto ring = vkrc::FrameRing::create({.queue = queue, .frame_size = 64 << 10, .frames_in_flight = frames_in_flight});
-    auto shadow_map = vkrc::Image::create(
-        device, {.format = depth_format,
-                 .extent = {shadow_size, shadow_size, 1},
-                 .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
-    auto shadow_view = vkrc::ImageView::create(shadow_map);
+    vkrc::ImageView shadow_view;
+    const auto shadow_map =
+        image(device, depth_format, {shadow_size, shadow_size}, VK_SAMPLE_COUNT_1_BIT,
+              VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, shadow_view);
     auto shadow_sampler = vkrc::Sampler::create(device, {.address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
                                                          .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
                                                          .compare_enable = true,
@@ -363,21 +273,19 @@ int run(const Options& options) {
     auto frame_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1, graphics},
                               {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT}}});
+    const VkDescriptorBindingFlags indexing =
+        VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT;
     auto texture_layout = vkrc::DescriptorSetLayout::create(
-        device, {.flags = bindless ? VkDescriptorSetLayoutCreateFlags(
-                                         VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT)
-                                   : 0,
+        device, {.flags = bindless ? VkFlags(VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT) : 0u,
                  .bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, max_textures, VK_SHADER_STAGE_FRAGMENT_BIT,
-                               bindless ? VkDescriptorBindingFlags(VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT |
-                                                                   VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT)
-                                        : 0}}});
+                               bindless ? indexing : 0}}});
     auto post_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT},
                               {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT}}});
     // One pool for every set; update-after-bind sets need its flag.
     auto descriptor_pool = vkrc::DescriptorPool::create(
         device, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT |
-                          (bindless ? VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT : 0u),
+                          (bindless ? VkFlags(VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT) : 0u),
                  .max_sets = 2 + frames_in_flight,
                  .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1},
                                 {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + max_textures + frames_in_flight},
@@ -387,13 +295,10 @@ int run(const Options& options) {
     frame_set.write_image(1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, shadow_view,
                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, shadow_sampler);
     auto texture_set = descriptor_pool.allocate(texture_layout);
-    std::vector<vkrc::ImageView> texture_views;
-    std::vector<VkDescriptorImageInfo> texture_infos;
-    for (const auto& texture : textures) texture_views.push_back(vkrc::ImageView::create(texture));
     // Bindless: just the textures that exist. The fixed array is written whole.
+    std::vector<VkDescriptorImageInfo> texture_infos;
     for (std::size_t i = 0; i < (bindless ? textures.size() : max_textures); ++i)
-        texture_infos.push_back(
-            {texture_sampler.vk(), texture_views[i % textures.size()].vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+        texture_infos.push_back({texture_sampler.vk(), texture_views[i % textures.size()].vk(), fragment_read.layout});
     texture_set.write_images(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, texture_infos);
     const std::array<VkDescriptorSet, 2> scene_sets{frame_set.vk(), texture_set.vk()};
 
@@ -432,73 +337,85 @@ int run(const Options& options) {
     auto hdr_sampler =
         vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
 
-    // 6. Per frame in flight: a primary command buffer, a fence, the
-    //    tone-map's descriptor set, a command pool per recording thread,
-    //    and four timestamps (start, after shadow, after main, after post).
+    // Both passes bind the same sets and buffers, then draw; the main pass
+    // does it in secondaries, which inherit no state from the primary.
+    auto record_draws = [&](const vkrc::CommandBuffer& cmd, const vkrc::GraphicsPipeline& pipeline, VkExtent2D extent,
+                            std::uint32_t uniforms, std::span<const Draw> list) {
+        cmd.bind_pipeline(pipeline);
+        cmd.set_viewport_and_scissor(extent);
+        cmd.bind_descriptor_sets(pipeline, 0, scene_sets, std::span(&uniforms, 1));
+        cmd.bind_vertex_buffers(0, std::array{positions.vk(), normals.vk()}, std::array<VkDeviceSize, 2>{0, 0});
+        cmd.bind_index_buffer(indices, 0, VK_INDEX_TYPE_UINT16);
+        for (const Draw& d : list) {
+            cmd.push_constants(scene_layout, graphics, d.constants);
+            cmd.draw_indexed(d.mesh.index_count, 1, d.mesh.first_index, d.mesh.vertex_offset);
+        }
+    };
+
+    // 6. Per frame in flight: a primary command buffer, a fence, the tone-map's descriptor set and
+    //    four timestamps (start, after shadow, main, post); and a command pool per recording thread.
     struct FrameResources {
         vkrc::CommandBuffer cmd;
         vkrc::Fence done;
         vkrc::DescriptorSet post_set;
-        std::vector<vkrc::CommandPool> thread_pools;
         bool timed = false;
     };
-    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     std::array<FrameResources, frames_in_flight> in_flight;
-    for (auto& f : in_flight) {
-        f = {pool.allocate(), vkrc::Fence::create(device, true), descriptor_pool.allocate(post_layout), {}, false};
-        for (std::uint32_t t = 0; t < options.threads; ++t)
-            f.thread_pools.push_back(vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}));
-    }
+    for (auto& f : in_flight)
+        f = {pool.allocate(), vkrc::Fence::create(device, true), descriptor_pool.allocate(post_layout), false};
+    std::vector<vkrc::CommandPool> thread_pools;  // a secondary returns to its pool once its frame is done
+    for (std::uint32_t t = 0; t < threads; ++t)
+        thread_pools.push_back(vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}));
     auto timestamps = vkrc::QueryPool::create(device, {.query_count = 4 * frames_in_flight});
     std::array<double, 4> totals{};  // ms: shadow, main, post (GPU), frame (CPU)
-    long totalled = 0;
+    double totalled = 0;
     auto add_timestamps = [&](FrameResources& f, std::uint32_t first) {  // once its frame is done
-        std::array<std::uint64_t, 4> ticks{};
-        if (!f.timed || timestamps.results(first, ticks) != VK_SUCCESS) return;
-        for (int i = 0; i < 3; ++i)
-            totals[i] += double(ticks[i + 1] - ticks[i]) * timestamps.timestamp_period_ns() / 1e6;
+        std::array<std::uint64_t, 4> t{};
+        if (f.timed && timestamps.results(first, t) == VK_SUCCESS)
+            for (int i = 0; i < 3; ++i) totals[i] += double(t[i + 1] - t[i]) * timestamps.timestamp_period_ns() / 1e6;
         f.timed = false;
     };
     auto report = [&](const char* when) {
-        if (totalled == 0) return;
-        std::printf("%s, %ld frames: shadow %.3f ms, main %.3f ms, post %.3f ms (GPU); frame %.3f ms (CPU)\n", when,
+        std::printf("%s, %.0f frames: shadow %.3f ms, main %.3f ms, post %.3f ms (GPU); frame %.3f ms (CPU)\n", when,
                     totalled, totals[0] / totalled, totals[1] / totalled, totals[2] / totalled, totals[3] / totalled);
-        totals = {};
-        totalled = 0;
+        totals = {}, totalled = 0;
     };
 
     // 7. The scene's draws: the ground, then each teapot at its level.
     std::vector<Draw> draws;
     auto build_draws = [&](VkExtent2D extent) {
-        const auto chosen = choose_lods(lods, extent);
-        draws = {{{glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -8.0f)) * renderer::z_up_to_y_up(),
-                   renderer::ground_texture, 0.25f},
+        draws = {{{glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -8.0f)) * renderer::z_up_to_y_up(), 0, 0.25f},
                   ground}};
         std::size_t drawn = 0, fixed = 0;
         std::printf("tessellation for %ux%u: levels", extent.width, extent.height);
-        for (std::size_t t = 0; t < chosen.size(); ++t) {
-            const auto& teapot = renderer::teapots[t];
-            draws.push_back({{renderer::teapot_world(teapot), teapot.texture, 0.4f}, lods[chosen[t]].mesh});
-            drawn += lods[chosen[t]].mesh.index_count / 3;
+        for (const auto& teapot : renderer::teapots) {
+            // The coarsest level whose error, seen at the teapot's distance, stays under a pixel.
+            const double distance =
+                glm::distance(renderer::camera_position, teapot.position + glm::vec3(0.0f, 1.5f * teapot.scale, 0.0f));
+            const double pixels_per_unit =
+                std::min(extent.width, extent.height) / (2.0 * std::tan(renderer::camera_fov / 2.0) * distance);
+            std::size_t l = 0;
+            while (l + 1 < lods.size() && lods[l].error * teapot.scale * pixels_per_unit >= 1.0) ++l;
+            draws.push_back({{renderer::teapot_world(teapot), teapot.texture, 0.4f}, lods[l].mesh});
+            drawn += lods[l].mesh.index_count / 3;
             fixed += lods.back().mesh.index_count / 3;
-            std::printf(" %d", lods[chosen[t]].level);
+            std::printf(" %d", lods[l].level);
         }
         std::printf("; %zu triangles instead of %zu at level %d everywhere (%zu saved)\n", drawn, fixed, fixed_level,
                     fixed - drawn);
     };
 
-    // 8. The frame loop: wait for the frame's last use and read its
-    //    timestamps, acquire, write the uniforms, record the main pass's
-    //    draws on the threads, then record and submit shadow, main, post.
+    // 8. The frame loop: wait for the frame's last use and read its timestamps, acquire, write the
+    //    uniforms, record the main pass's draws on the threads, then record and submit every pass.
     Targets targets;
     vkrc::Frame frame;
     auto last = std::chrono::steady_clock::now();
-    for (long n = 0; options.frames < 0 || n < options.frames;) {
+    for (long n = 0, frames = options.frame_limit(); frames < 0 || n < frames;) {
         if (!options.headless) vkrc::glfw::Window::poll_events();
         if (window.window && window.window.should_close()) break;
         if (!options.headless && options.resize_every > 0 && n > 0 && n % options.resize_every == 0) {
-            const int k = int(n / options.resize_every % 3);  // 480x270 (the start), 640x360, 320x180
-            glfwSetWindowSize(window.window.get(), 320 + 160 * ((k + 1) % 3), 180 + 90 * ((k + 1) % 3));
+            const int k = int(n / options.resize_every) % 3;  // 320x180, 400x225, 240x135, 320x180, ...
+            glfwSetWindowSize(window.window.get(), 240 + 80 * k, 135 + 45 * k);
         }
         FrameResources& f = in_flight[std::size_t(n) % frames_in_flight];
         const std::uint32_t q = std::uint32_t(n % frames_in_flight) * 4;
@@ -525,27 +442,22 @@ int run(const Options& options) {
                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, hdr_sampler);
         f.post_set.write_image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, blit_output ? targets.ldr_view : frame.view(),
                                VK_IMAGE_LAYOUT_GENERAL);
-        const PassBindings main_pass{
-            &scene_pipeline, scene_sets,  uniforms.dynamic_offset(), {positions.vk(), normals.vk()},
-            indices.vk(),    frame.extent};
-
-        // The main pass's draws, split over the threads: each records a
-        // secondary command buffer from its own pool (vkrc::mt: allocation
-        // takes the pool's lock, recording takes none).
-        std::vector<vkrc::CommandBuffer> secondaries(options.threads);
+        // The main pass's draws, split over the threads: each records a secondary from its own pool
+        // (vkrc::mt: allocation takes the pool's lock, recording takes none).
+        std::vector<vkrc::CommandBuffer> secondaries(threads);
         auto record_share = [&](std::uint32_t t) {
-            auto cmd = f.thread_pools[t].allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+            auto cmd = thread_pools[t].allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
             cmd.begin_secondary({.color_formats = std::span(&hdr_format, 1),
                                  .depth_format = depth_format,
                                  .rasterization_samples = samples});
-            const std::size_t begin = draws.size() * t / options.threads,
-                              end = draws.size() * (t + 1) / options.threads;
-            record_draws(cmd, main_pass, std::span(draws).subspan(begin, end - begin));
+            const std::size_t begin = draws.size() * t / threads, end = draws.size() * (t + 1) / threads;
+            record_draws(cmd, scene_pipeline, frame.extent, uniforms.dynamic_offset(),
+                         std::span(draws).subspan(begin, end - begin));
             cmd.end();
             secondaries[t] = std::move(cmd);
         };
         std::vector<std::thread> workers;
-        for (std::uint32_t t = 1; t < options.threads; ++t) workers.emplace_back(record_share, t);
+        for (std::uint32_t t = 1; t < threads; ++t) workers.emplace_back(record_share, t);
         record_share(0);
         for (auto& w : workers) w.join();
 
@@ -559,10 +471,8 @@ int run(const Options& options) {
         vkrc::RenderingAttachment shadow_target{shadow_view.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
         shadow_target.clear_value.depthStencil = {1.0f, 0};
         cmd.begin_rendering({.render_area = {{0, 0}, {shadow_size, shadow_size}}, .depth_attachment = &shadow_target});
-        PassBindings shadow_pass = main_pass;
-        shadow_pass.pipeline = &shadow_pipeline;
-        shadow_pass.extent = {shadow_size, shadow_size};
-        record_draws(cmd, shadow_pass, std::span(draws).subspan(1));  // the ground casts no shadow
+        record_draws(cmd, shadow_pipeline, {shadow_size, shadow_size}, uniforms.dynamic_offset(),
+                     std::span(draws).subspan(1));  // the ground casts no shadow
         cmd.end_rendering();
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 1);
 
@@ -617,10 +527,8 @@ int run(const Options& options) {
         presenter.present(frame);
         f.timed = true;
 
-        const auto now = std::chrono::steady_clock::now();
-        totals[3] += std::chrono::duration<double, std::milli>(now - last).count();
-        last = now;
-        ++totalled;
+        totals[3] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last).count();
+        last = std::chrono::steady_clock::now(), ++totalled;
         if (++n % options.report_every == 0) report("every --report");
     }
     device.wait_idle();
@@ -632,11 +540,4 @@ int run(const Options& options) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    try {
-        return run(parse(argc, argv));
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "renderer: %s\n", e.what());
-        return 1;
-    }
-}
+int main(int argc, char** argv) { return vkrc_examples::run_example(argc, argv, "renderer", run); }

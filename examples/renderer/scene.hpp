@@ -1,6 +1,6 @@
 // examples/renderer's scene, free of Vulkan: where the teapots stand, the
-// camera and the light. main.cpp renders it; check.cpp computes from it
-// where a shadow must fall in the rendered image.
+// camera and the light. main.cpp renders it; support/renderer_check.cpp
+// computes from it where a shadow must fall in the rendered image.
 #pragma once
 
 #include "scene/teapot_scene.hpp"
@@ -27,14 +27,12 @@ inline constexpr std::array<Teapot, 5> teapots = {{{{-5.0f, 0.0f, 4.0f}, 1.0f, 2
                                                    {{-1.5f, 0.0f, -6.0f}, 1.2f, 75.0f, 2},
                                                    {{6.0f, 0.0f, -13.0f}, 1.5f, 160.0f, 1},
                                                    {{-9.0f, 0.0f, -24.0f}, 2.0f, 210.0f, 2}}};
-inline constexpr float ground_half_size = 40.0f;  // the ground: a square about the origin
-inline constexpr std::uint32_t ground_texture = 0;
+inline constexpr float ground_half_size = 40.0f;  // the ground: a square about the origin, texture 0
 
 inline glm::mat4 teapot_world(const Teapot& t) {
-    return glm::scale(glm::rotate(glm::translate(glm::mat4(1.0f), t.position), glm::radians(t.yaw_degrees),
-                                  glm::vec3(0.0f, 1.0f, 0.0f)),
-                      glm::vec3(t.scale)) *
-           z_up_to_y_up();
+    const glm::mat4 placed = glm::rotate(glm::translate(glm::mat4(1.0f), t.position), glm::radians(t.yaw_degrees),
+                                         glm::vec3(0.0f, 1.0f, 0.0f));
+    return glm::scale(placed, glm::vec3(t.scale)) * z_up_to_y_up();
 }
 
 inline const glm::vec3 camera_position{0.0f, 7.0f, 18.0f};

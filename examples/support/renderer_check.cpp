@@ -1,4 +1,5 @@
-// Checks an image written by `renderer --headless`:
+// The renderer example's image check, a test tool like png_check: checks an image
+// written by `renderer --headless`:
 //     renderer_check FILE.png
 // - the shadow: a ground point whose path to the light passes through the
 //   nearest teapot's body is darker than a ground point further along the
