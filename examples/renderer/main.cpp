@@ -159,8 +159,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     }
     auto instance = options.headless ? vkrc::Instance::create(instance_info) : window.instance;
     const auto physical = vkrc::PhysicalDevice::select(instance, requirements);
-    // Bindless textures need descriptor indexing (partially bound,
-    // update-after-bind arrays); without it a fully written fixed array does.
+    // Bindless textures need descriptor indexing; without it a fully written fixed array does.
     const auto& have = physical.features().vulkan12;
     const bool bindless = have.descriptorBindingPartiallyBound && have.descriptorBindingSampledImageUpdateAfterBind;
     vkrc::DeviceCreateInfo device_info{.enabled_extension_names = requirements.required_extensions};
@@ -367,18 +366,20 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     for (std::uint32_t t = 0; t < threads; ++t)
         thread_pools.push_back(vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}));
     auto timestamps = vkrc::QueryPool::create(device, {.query_count = 4 * frames_in_flight});
-    std::array<double, 4> totals{};  // ms: shadow, main, post (GPU), frame (CPU)
-    double totalled = 0;
+    std::array<double, 4> totals{};  // ms since the start: shadow, main, post (GPU), frame (CPU)
+    double gpu_frames = 0, cpu_frames = 0;
     auto add_timestamps = [&](FrameResources& f, std::uint32_t first) {  // once its frame is done
         std::array<std::uint64_t, 4> t{};
-        if (f.timed && timestamps.results(first, t) == VK_SUCCESS)
+        if (f.timed && timestamps.results(first, t) == VK_SUCCESS) {
             for (int i = 0; i < 3; ++i) totals[i] += double(t[i + 1] - t[i]) * timestamps.timestamp_period_ns() / 1e6;
+            ++gpu_frames;
+        }
         f.timed = false;
     };
-    auto report = [&](const char* when) {
-        std::printf("%s, %.0f frames: shadow %.3f ms, main %.3f ms, post %.3f ms (GPU); frame %.3f ms (CPU)\n", when,
-                    totalled, totals[0] / totalled, totals[1] / totalled, totals[2] / totalled, totals[3] / totalled);
-        totals = {}, totalled = 0;
+    auto report = [&](const char* when) {  // averages since the start
+        const double g = std::max(gpu_frames, 1.0);
+        std::printf("%s: shadow %.3f ms, main %.3f ms, post %.3f ms (GPU, %.0f frames); frame %.3f ms (CPU)\n", when,
+                    totals[0] / g, totals[1] / g, totals[2] / g, gpu_frames, totals[3] / std::max(cpu_frames, 1.0));
     };
 
     // 7. The scene's draws: the ground, then each teapot at its level.
@@ -465,8 +466,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.begin();
         cmd.reset_query_pool(timestamps, q, 4);
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q);
-        // Shadow pass: the teapots' depth from the light, once the last
-        // frame's main pass is done sampling the map.
+        // Shadow pass: the teapots' depth from the light, once the last frame is done sampling the map.
         transition(cmd, shadow_map, fragment_read, depth_write, false);
         vkrc::RenderingAttachment shadow_target{shadow_view.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
         shadow_target.clear_value.depthStencil = {1.0f, 0};
@@ -476,8 +476,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.end_rendering();
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 1);
 
-        // Main pass: the secondaries' draws into the multisampled HDR image,
-        // resolved into targets.hdr once the last frame's tone-map has read it.
+        // Main pass: the secondaries' draws into the multisampled HDR image, resolved into targets.hdr
+        // once the last frame's tone-map has read it.
         transition(cmd, shadow_map, depth_write, fragment_read);
         transition(cmd, targets.hdr, compute_read, colour_write, false);
         if (targets.msaa) transition(cmd, targets.msaa, colour_write, colour_write, false);
@@ -501,8 +501,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.end_rendering();
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 2);
 
-        // Post: tone-map targets.hdr into the 8-bit image, which is either the
-        // presented one or an intermediate blitted into it.
+        // Post: tone-map targets.hdr into the 8-bit image: the presented one or an intermediate blitted into it.
         const Use presented{frame.present_layout, VK_PIPELINE_STAGE_2_NONE, 0};
         transition(cmd, targets.hdr, colour_write, compute_read);
         transition(cmd, ldr, blit_output ? blit_read : acquired, storage_write, false);
@@ -528,8 +527,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         f.timed = true;
 
         totals[3] += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last).count();
-        last = std::chrono::steady_clock::now(), ++totalled;
-        if (++n % options.report_every == 0) report("every --report");
+        last = std::chrono::steady_clock::now(), ++cpu_frames;
+        ++n;
+        if (options.report_every > 0 && n % options.report_every == 0) report("every --report frames");
     }
     device.wait_idle();
     for (std::uint32_t i = 0; i < frames_in_flight; ++i) add_timestamps(in_flight[i], i * 4);
