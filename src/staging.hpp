@@ -20,6 +20,9 @@ void check_buffer_range(const Buffer& buffer, VkDeviceSize offset, VkDeviceSize 
 FormatBlock checked_block(const Image& image, const char* who);
 // Bytes of one array layer of a mip level, in whole blocks.
 VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlock& block, const char* who);
+// The number of levels an upload of level_count (VK_REMAINING_MIP_LEVELS:
+// all) covers; UsageError when it is 0 or more than the image has.
+std::uint32_t uploaded_levels(const Image& image, std::uint32_t level_count, const char* who);
 // upload_image's checks of data and info against the image.
 void check_image_upload(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info,
                         const char* who);

@@ -297,11 +297,11 @@ void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, std::spa
 
 namespace {
 
-// One region per mip level (every layer), from offset on in the staging ring.
-List<VkBufferImageCopy> level_regions(const Image& image, VkDeviceSize offset, const FormatBlock& block,
-                                      const char* who) {
+// One region per uploaded mip level (every layer), from offset on in the staging ring.
+List<VkBufferImageCopy> level_regions(const Image& image, std::uint32_t levels, VkDeviceSize offset,
+                                      const FormatBlock& block, const char* who) {
     List<VkBufferImageCopy> regions;
-    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
+    for (std::uint32_t level = 0; level < levels; ++level) {
         VkBufferImageCopy r{};
         r.bufferOffset = offset;
         r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, image.array_layers()};
@@ -331,7 +331,7 @@ void Uploader::upload_image(const Image& image, std::span<const std::byte> data,
                                        VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                                        VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     s.open.pipeline_barrier({}, {}, {&to_copy, 1});
-    const auto regions = level_regions(image, at, block, who);
+    const auto regions = level_regions(image, detail::uploaded_levels(image, info.level_count, who), at, block, who);
     s.open.copy_buffer_to_image(s.staging.vk(), image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                 {regions.data(), regions.size()});
     const std::uint32_t family = s.queue.family_index();

@@ -116,6 +116,15 @@ FormatBlock checked_block(const Image& image, const char* who) {
     return block;
 }
 
+std::uint32_t uploaded_levels(const Image& image, std::uint32_t level_count, const char* who) {
+    if (level_count == VK_REMAINING_MIP_LEVELS) return image.mip_levels();
+    if (level_count == 0 || level_count > image.mip_levels()) {
+        throw UsageError(std::string(who) + ": level_count " + std::to_string(level_count) +
+                         " is not 1 to the image's " + std::to_string(image.mip_levels()) + " levels");
+    }
+    return level_count;
+}
+
 VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlock& block, const char* who) {
     const VkExtent3D e = image.extent(level);
     const VkDeviceSize columns = (VkDeviceSize(e.width) + block.width - 1) / block.width;
@@ -126,10 +135,13 @@ VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlo
 void check_image_upload(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info,
                         const char* who) {
     checked_block(image, who);
-    const VkDeviceSize expected = image_data_size(image);
+    uploaded_levels(image, info.level_count, who);
+    const VkDeviceSize expected = image_data_size(image, info.level_count);
     if (data.size() != expected) {
-        throw UsageError(std::string(who) + ": " + std::to_string(data.size()) +
-                         " bytes given; every level and layer of " + "the image takes " + std::to_string(expected));
+        throw UsageError(std::string(who) + ": " + std::to_string(data.size()) + " bytes given; " +
+                         (info.level_count == VK_REMAINING_MIP_LEVELS ? std::string("every level")
+                                                                      : std::to_string(info.level_count) + " levels") +
+                         " and layer of the image take " + std::to_string(expected));
     }
     if (info.new_layout == VK_IMAGE_LAYOUT_UNDEFINED || info.new_layout == VK_IMAGE_LAYOUT_PREINITIALIZED) {
         throw UsageError(std::string(who) + ": new_layout must be a layout an image can be transitioned to");
@@ -148,11 +160,12 @@ void check_image_download(const Image& image, VkImageLayout layout, std::uint32_
 
 }  // namespace detail
 
-VkDeviceSize image_data_size(const Image& image) {
+VkDeviceSize image_data_size(const Image& image, std::uint32_t level_count) {
     constexpr const char* who = "vkrc::image_data_size";
     const FormatBlock block = detail::checked_block(image, who);
+    const std::uint32_t levels = detail::uploaded_levels(image, level_count, who);
     VkDeviceSize total = 0;
-    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
+    for (std::uint32_t level = 0; level < levels; ++level) {
         VkDeviceSize level_bytes;
         if (__builtin_mul_overflow(detail::level_size(image, level, block, who), image.array_layers(), &level_bytes) ||
             total + level_bytes < total)

@@ -291,6 +291,45 @@ TEST_F(StreamingTest, UploaderBlockCompressedImageByBlockSize) {
     EXPECT_EQ(at, data.size());
 }
 
+// Level 0 alone (ImageUploadInfo::level_count), the rest filled on the GPU
+// by generate_mipmaps: every level reads back, level 0 as uploaded and each
+// smaller one the average of a uniform colour (the same colour).
+TEST_F(StreamingTest, UploaderBaseLevelThenGeneratedMips) {
+    auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                              .extent = {16, 8, 1},
+                                              .mip_levels = 5,
+                                              .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                                       VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+    ASSERT_EQ(vkrc::image_data_size(image, 1), 16u * 8 * 4);
+    const std::vector<std::uint32_t> base(16 * 8, 0x80402010u);
+    auto uploader = vkrc::Uploader::create({.queue = queue});
+    EXPECT_THROW(uploader.upload_image(image, std::as_bytes(std::span(base)), {.level_count = 0}), vkrc::UsageError);
+    EXPECT_THROW(uploader.upload_image(image, std::as_bytes(std::span(base)), {.level_count = 6}), vkrc::UsageError);
+    EXPECT_THROW(uploader.upload_image(image, std::as_bytes(std::span(base)), {.level_count = 2}), vkrc::UsageError);
+    uploader.upload_image(image, std::as_bytes(std::span(base)),
+                          {.new_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, .level_count = 1});
+    const auto ticket = uploader.submit();
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    vkrc::generate_mipmaps(cmd, image,
+                           {.final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            .dst_stage = VK_PIPELINE_STAGE_2_COPY_BIT,
+                            .dst_access = VK_ACCESS_2_TRANSFER_READ_BIT});
+    cmd.end();
+    const auto wait = ticket.wait(VK_PIPELINE_STAGE_2_BLIT_BIT);
+    vkrc::submit(queue, {.waits = {&wait, 1}, .command_buffers = {&cmd, 1}});
+    for (std::uint32_t level = 0; level < image.mip_levels(); ++level) {
+        const auto got = vkrc::download_image(queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, level);
+        ASSERT_EQ(got.size(), std::size_t(image.extent(level).width) * image.extent(level).height * 4);
+        for (std::size_t i = 0; i < got.size(); i += 4) {
+            std::uint32_t texel;
+            std::memcpy(&texel, got.data() + i, 4);
+            ASSERT_EQ(texel, 0x80402010u) << "level " << level << " byte " << i;
+        }
+    }
+}
+
 TEST_F(StreamingTest, UploaderDownloadIsNonBlocking) {
     std::mt19937 rng(4);
     const auto data = random_bytes(rng, 4096);

@@ -1,7 +1,10 @@
 // The command line and the ending shared by the examples that render into a
-// window or, headless, into a PNG (triangle, teapot):
+// window or, headless, into a PNG (triangle, teapot, renderer):
 //     NAME [--frames N] [--validation]                                a window (closes after N frames)
 //     NAME --headless [--frames N] [--validation] [--out NAME.png]
+// and, for the examples that use them (renderer): --threads N (recording
+// threads), --resize-every N (resize the window every N frames, for tests),
+// --report N (print timings every N frames).
 // Header-only: it uses vkrc's presenter, and each example picks its policy.
 #pragma once
 
@@ -24,6 +27,9 @@ struct WindowOrHeadless {
     bool validation = false;
     long frames = -1;  // -1: until the window closes (one frame headless)
     std::string out_file;
+    long threads = 0;  // 0: the example's default
+    long resize_every = 0;
+    long report_every = 100;
 
     // How many frames the loop draws; -1: until the window closes.
     long frame_limit() const { return frames >= 0 ? frames : headless ? 1 : -1; }
@@ -41,8 +47,17 @@ inline int run_example(int argc, char** argv, const char* name, int (*run)(const
         else if (std::strcmp(argv[i], "--out") == 0 && has_value) options.out_file = argv[++i];
         else if (std::strcmp(argv[i], "--frames") == 0 && has_value)
             options.frames = std::strtol(argv[++i], nullptr, 10);
+        else if (std::strcmp(argv[i], "--threads") == 0 && has_value)
+            options.threads = std::strtol(argv[++i], nullptr, 10);
+        else if (std::strcmp(argv[i], "--resize-every") == 0 && has_value)
+            options.resize_every = std::strtol(argv[++i], nullptr, 10);
+        else if (std::strcmp(argv[i], "--report") == 0 && has_value)
+            options.report_every = std::strtol(argv[++i], nullptr, 10);
         else {
-            std::fprintf(stderr, "usage: %s [--headless [--out FILE.png]] [--frames N] [--validation]\n", argv[0]);
+            std::fprintf(stderr,
+                         "usage: %s [--headless [--out FILE.png]] [--frames N] [--validation] [--threads N] "
+                         "[--resize-every N] [--report N]\n",
+                         argv[0]);
             return 2;
         }
     }
