@@ -499,6 +499,27 @@ void write_frames(const std::string& dir, const ConfigRun& r) {
                   v.image);
 }
 
+// The image check across thread counts: every variant's reference frame in a
+// threaded configuration must also be the 1-thread raw-direct's (the check
+// within a configuration compares with raw-direct at the same thread count,
+// which records threaded too). Counted as one more compared frame.
+void check_threaded_images(RunData& data) {
+    for (ConfigRun& r : data.configs) {
+        if (r.config.threads == 1) continue;
+        auto base = std::find_if(data.configs.begin(), data.configs.end(), [&](const ConfigRun& other) {
+            return config_tag(other.config) == config_tag(one_thread(r.config));
+        });
+        if (base == data.configs.end()) continue;
+        for (VariantRun& v : r.variants) {
+            auto [differing, channel] = compare_images(v.image, base->variants.at(0).image);
+            ++v.image_blocks;
+            if (differing) ++v.image_mismatch_blocks;
+            v.worst_pixels = std::max(v.worst_pixels, differing);
+            v.worst_channel = std::max(v.worst_channel, channel);
+        }
+    }
+}
+
 // Every configuration in this process, with the sweep's image error (each
 // level's reference frame against the finest level's).
 RunData measure(const Options& options, const std::vector<PlannedConfig>& configs, std::uint64_t seed) {
@@ -522,6 +543,7 @@ RunData measure(const Options& options, const std::vector<PlannedConfig>& config
         r.image_error_pixels = differing;
         r.image_error_channel = channel;
     }
+    check_threaded_images(data);
     if (options.worker_index == 0) {
         std::filesystem::create_directories(options.out_dir);
         for (const ConfigRun& r : data.configs) write_frames(options.out_dir, r);
