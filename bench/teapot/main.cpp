@@ -711,8 +711,8 @@ struct BlockSource {
     std::size_t config = 0, variant = 0;
 };
 
-// ratios[run][block]: the block medians of `mine` over those of `theirs`,
-// block b with block b. Within one configuration these are neighbours (the
+// ratios[run][block]: the block medians of numerator over those of
+// denominator, block b with block b. Within one configuration these are neighbours (the
 // same round); across configurations (the speed-up) they are the same
 // round's blocks of configurations run one after the other in that run.
 std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, BlockSource numerator,
@@ -723,8 +723,8 @@ std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, 
         const auto& theirs = run.configs.at(denominator.config).variants.at(denominator.variant).blocks[stage];
         std::vector<double> per_block;
         for (std::size_t b = 0; b < std::min(mine.size(), theirs.size()); ++b) {
-            double denominator = median_of(theirs[b]);
-            if (denominator > 0) per_block.push_back(median_of(mine[b]) / denominator);
+            const double reference = median_of(theirs[b]);
+            if (reference > 0) per_block.push_back(median_of(mine[b]) / reference);
         }
         ratios.push_back(std::move(per_block));
     }
