@@ -52,6 +52,7 @@ constexpr const char* stage_names[] = {"preinit", "acquire", "uniform", "command
                                        "present", "wait",    "update",  "frame",   "floor"};
 constexpr int stage_count = 10;            // preinit, the seven per-frame stages, their sum, the floor
 constexpr int frame_stages = 7;            // acquire .. update
+constexpr int command_stage = 3;           // what --threads spreads over threads
 constexpr int frame_stage = 8;             // the sum of the seven
 constexpr int floor_stage = 9;             // an empty timed region, measured every frame
 constexpr double frame_step = 1.0 / 60.0;  // simulated seconds per frame
@@ -870,7 +871,6 @@ void print_table(const ConfigAnalysis& a) {
 
 // The threaded configurations' command stage next to their 1-thread one's.
 void print_threads(const std::vector<ConfigAnalysis>& results) {
-    const int command = 4;
     std::printf(
         "\ncommand stage by recording threads: speed-up is the 1-thread configuration's block medians over this "
         "one's,\nratio is to %s at the same thread count; 95%% CI over blocks and runs\n",
@@ -883,7 +883,7 @@ void print_threads(const std::vector<ConfigAnalysis>& results) {
         });
         if (a.config.threads == 1 && !has_threaded) continue;
         for (const StageRow& row : a.rows) {
-            if (row.stage != command) continue;
+            if (row.stage != command_stage) continue;
             std::printf("%-28s %7d %-18s %11.3f %-26s %s\n", config_tag(one_thread(a.config)).c_str(), a.config.threads,
                         row.variant.c_str(), row.summary.median,
                         row.speedup ? format_ratio(*row.speedup).c_str() : (a.config.threads == 1 ? "1" : "-"),
@@ -1006,7 +1006,6 @@ void write_plots(const std::string& dir, const ConfigAnalysis& a) {
 // Per 1-thread configuration that has threaded ones: the command stage's
 // speed-up against threads, one line per variant.
 void write_speedup_plots(const std::string& dir, const std::vector<ConfigAnalysis>& results) {
-    const int command = 4;
     for (const ConfigAnalysis& base : results) {
         if (base.config.threads != 1) continue;
         std::vector<SpeedupSeries> series;
@@ -1015,7 +1014,7 @@ void write_speedup_plots(const std::string& dir, const std::vector<ConfigAnalysi
             if (a.config.threads == 1 || config_tag(one_thread(a.config)) != config_tag(base.config)) continue;
             for (const StageRow& row : a.rows)
                 for (SpeedupSeries& s : series)
-                    if (row.stage == command && row.speedup && s.variant == row.variant)
+                    if (row.stage == command_stage && row.speedup && s.variant == row.variant)
                         s.points.push_back({a.config.threads, row.speedup->ratio, row.speedup->low, row.speedup->high});
         }
         std::erase_if(series, [](const SpeedupSeries& s) { return s.points.size() < 2; });
