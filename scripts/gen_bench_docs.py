@@ -189,7 +189,7 @@ def threads_goals(rows, teapots):
             met &= low >= THREADS_THROUGHPUT_GOAL
             cells.append(f"{n}: {1 / float(x['ratio_to_ref']):.3f} (lower bound {low:.3f})")
         out.append(f"Goal: vkrc-mt's recording throughput at least {THREADS_THROUGHPUT_GOAL}x raw-direct's at every "
-                   f"thread count (throughput ratio, lower 95 % bound in brackets): {'; '.join(cells)}: "
+                   f"thread count (throughput ratio and its lower 95 % bound): {'; '.join(cells)}: "
                    f"**{'met' if met else 'not met'}**.")
     goal_teapots, goal_threads, goal_speedup = THREADS_SPEEDUP_GOAL
     mt, raw = get.get((goal_threads, "vkrc-mt")), get.get((goal_threads, "raw-direct"))
