@@ -14,6 +14,7 @@
 # (with alloc built, bench/alloc_run.sh runs too: the allocation results).
 # NAME: the results' file prefix (default: the date and a device slug).
 # FRAMES_25 / FRAMES_2500 (environment) override the frames per run (2500 / 400).
+# THREADS_RUN=1 adds the --threads run (below).
 set -euo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: bench/device_run.sh BUILD_DIR OUT [NAME]" >&2
@@ -50,6 +51,12 @@ run() {  # run FILE-SUFFIX teapot-args...
 
 run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
 run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"
+# THREADS_RUN=1: also the recording-thread scaling of issue 17, 25 000 draws
+# on 1, 2, 4, 8 and 16 threads (TEAPOTS_THREADS / FRAMES_THREADS override).
+if [ "${THREADS_RUN:-0}" = 1 ]; then
+  run "threads-t${TEAPOTS_THREADS:-25000}" --teapots "${TEAPOTS_THREADS:-25000}" --threads 1,2,4,8,16 \
+    --frames "${FRAMES_THREADS:-400}"
+fi
 
 if [ -x "$build/bench/alloc" ]; then
   "$source_dir/bench/alloc_run.sh" "$build" "$out" ${name:+"$name"}

@@ -103,12 +103,23 @@ def table(result):
     return out
 
 
-def results(pattern, kind="median_us"):
+def threads(row):
+    # Files from before issue 17 have no threads column: one recording thread.
+    return int(row.get("threads") or 1)
+
+
+def is_threaded(result):
+    return any(threads(x) > 1 for x in result["rows"])
+
+
+def results(pattern, kind="median_us", threaded=False):
     # kind: a column that tells the CSV's kind (median_us: a timed run;
-    # instructions_per_call: bench/instructions.sh).
+    # instructions_per_call: bench/instructions.sh). Timed runs with several
+    # recording threads (teapot --threads) have their own tables.
     files = sorted(glob.glob(os.path.join(ROOT, "docs", "results", "*.csv")))
     return [r for r in map(load, files)
-            if r["rows"] and kind in r["rows"][0] and re.search(pattern, r["meta"].get("device", ""), re.I)]
+            if r["rows"] and kind in r["rows"][0] and re.search(pattern, r["meta"].get("device", ""), re.I)
+            and (kind != "median_us" or is_threaded(r) == threaded)]
 
 
 def instructions(pattern, pending):
@@ -153,6 +164,93 @@ def section(pattern, pending):
     out = []
     for r in sorted(found, key=lambda r: (int(r["rows"][0]["teapots"]), r["path"])):
         out += table(r) + [""]
+    return out[:-1]
+
+
+THREADS_THROUGHPUT_GOAL = 0.97  # vkrc-mt's recording throughput against raw-direct's, every thread count
+THREADS_SPEEDUP_GOAL = (25000, 8, 6.0)  # teapots, threads, speed-up (or raw-direct's, if it falls short)
+
+
+def fmt_speedup(r):
+    if not r.get("speedup"):
+        return "1 (the baseline)" if threads(r) == 1 else ""
+    return f"{float(r['speedup']):.2f} [{float(r['speedup_ci_low']):.2f}, {float(r['speedup_ci_high']):.2f}]"
+
+
+def threads_goals(rows, teapots):
+    """The goals of issue 17 read off one configuration's command rows."""
+    get = {(threads(x), x["variant"]): x for x in rows}
+    counts = sorted({threads(x) for x in rows})
+    out = []
+    if any((n, "vkrc-mt") in get for n in counts):
+        cells, met = [], True
+        for n in counts:
+            x = get.get((n, "vkrc-mt"))
+            if not x:
+                continue
+            # Throughput is the inverse of time: the ratio's upper bound gives the lower bound.
+            low = 1 / float(x["ref_ci_high"])
+            met &= low >= THREADS_THROUGHPUT_GOAL
+            cells.append(f"{n}: {1 / float(x['ratio_to_ref']):.3f} (lower bound {low:.3f})")
+        out.append(f"Goal: vkrc-mt's recording throughput at least {THREADS_THROUGHPUT_GOAL}x raw-direct's at every "
+                   f"thread count (throughput ratio and its lower 95 % bound): {'; '.join(cells)}: "
+                   f"**{'met' if met else 'not met'}**.")
+    goal_teapots, goal_threads, goal_speedup = THREADS_SPEEDUP_GOAL
+    mt, raw = get.get((goal_threads, "vkrc-mt")), get.get((goal_threads, "raw-direct"))
+    if teapots == goal_teapots and mt and raw and mt.get("speedup") and raw.get("speedup"):
+        target = min(goal_speedup, float(raw["speedup"]))
+        out.append(f"Goal: at {goal_threads} threads and {goal_teapots} draws, vkrc-mt's speed-up at least "
+                   f"{target:.2f} ({goal_speedup} or raw-direct's {float(raw['speedup']):.2f}, whichever is lower): "
+                   f"{fmt_speedup(mt)}: **{'met' if float(mt['speedup']) >= target else 'not met'}**.")
+    return out
+
+
+def threads_table(result):
+    rows, m = result["rows"], result["meta"]
+    out = []
+    key = lambda x: (x["teapots"], x["frames_in_flight"], x["uniform_writes"], x["tessellation"])
+    for config in sorted({key(x) for x in rows}, key=lambda k: tuple(map(int, k))):
+        mine = [x for x in rows if key(x) == config]
+        if max(map(threads, mine)) == 1:
+            continue  # a sweep's other settings: the single-thread tables' business
+        command = sorted((x for x in mine if x["stage"] == "command"), key=threads)
+        first = command[0] if command else mine[0]
+        per_run = int(first["frames"]) // max(1, int(first["runs"]))
+        out += [f"#### {config[0]} teapots on 1 to {max(map(threads, mine))} recording threads, {per_run} frames per "
+                f"variant and thread count in each of {first['runs']} runs (tessellation {config[3]}, {config[1]} "
+                f"frames in flight, {config[2]} uniform write(s))", "",
+                f"Device: {m.get('device', '?')}; driver: {m.get('driver', '?')}; date: {m.get('date', '?')}; "
+                f"git: {m.get('git', '?')}; host: {m.get('host', '?')}. Data: `{result['path']}`.", "",
+                f"    {m.get('command', '?')}", "",
+                "Command stage per frame. Speed-up: the 1-thread run's block medians over this thread count's "
+                "(block b with block b of the same run; the thread counts run one after the other), ratio: "
+                "block-wise to raw-direct at the same thread count; 95 % intervals over blocks and runs.", "",
+                "| threads | variant | median (µs) | speed-up against 1 thread [95 % CI] | ratio to raw-direct [95 % CI] |",
+                "|---:|---|---:|---|---|"]
+        for x in command:
+            out.append(f"| {threads(x)} | {x['variant']} | {float(x['median_us']):.3f} | {fmt_speedup(x)} | "
+                       f"{fmt_ratio(x)} |")
+        control = [f"{threads(x)}: {fmt_ratio(x)}" for x in command if x["variant"] == "raw-direct-control"]
+        out += ["", "A/A control (raw-direct against itself, command): " + "; ".join(control) + "."]
+        goals = threads_goals(command, int(config[0]))
+        if goals:
+            out += [""] + goals
+        images = [x for x in mine if x["stage"] == "image"]
+        bad = sorted({f"{x['variant']} at {threads(x)}" for x in images if float(x["median_us"]) != 0})
+        out += ["", f"Image check: **{', '.join(bad)} differed**." if bad else
+                "Image check: at every thread count, every variant's last timed frames and reference frame are "
+                "byte-identical to raw-direct's at that count, and every threaded reference frame to the 1-thread "
+                "raw-direct's.", ""]
+    return out
+
+
+def threads_section(pattern, pending):
+    found = results(pattern, threaded=True)
+    if not found:
+        return [pending]
+    out = []
+    for r in sorted(found, key=lambda r: r["path"]):
+        out += threads_table(r)
     return out[:-1]
 
 
@@ -591,6 +689,11 @@ BLOCKS = {
         "old method (frame-wise intervals, `raw` as the reference, unequal setup) and cannot be re-derived from "
         "committed data, so they are removed. `bench/device_run.sh` produces the CSVs; committed under "
         "docs/results/, they appear here."),
+    "teapot-threads-lavapipe": lambda: threads_section(
+        "llvmpipe", "No lavapipe `--threads` results in docs/results/ yet."),
+    "teapot-threads-h200": lambda: threads_section(
+        "H200", "**Pending:** no H200 `--threads` run is committed yet (the commands are above); committed under "
+        "docs/results/, it appears here."),
     "readme-teapot": readme_row,
     "teapot-instructions": lambda: instructions("", "No instruction counts in docs/results/ yet."),
     "alloc-lavapipe": lambda: alloc_section("llvmpipe", "No lavapipe allocation results in docs/results/ yet."),

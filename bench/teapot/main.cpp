@@ -11,6 +11,7 @@
 // files), analyse the pooled blocks, report (table, CSV, plots), exit status.
 #include "harness/plot.hpp"
 #include "harness/stats.hpp"
+#include "harness/thread_pool.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
@@ -51,6 +52,7 @@ constexpr const char* stage_names[] = {"preinit", "acquire", "uniform", "command
                                        "present", "wait",    "update",  "frame",   "floor"};
 constexpr int stage_count = 10;            // preinit, the seven per-frame stages, their sum, the floor
 constexpr int frame_stages = 7;            // acquire .. update
+constexpr int command_stage = 3;           // what --threads spreads over threads
 constexpr int frame_stage = 8;             // the sum of the seven
 constexpr int floor_stage = 9;             // an empty timed region, measured every frame
 constexpr double frame_step = 1.0 / 60.0;  // simulated seconds per frame
@@ -77,6 +79,7 @@ struct Options {
     int runs = 3;
     std::vector<std::string> variants;
     Config config;
+    std::vector<int> threads{1};  // --threads: one configuration per count
     bool sweep = false;
     bool instructions = false;
     std::string csv;
@@ -101,7 +104,7 @@ std::string default_out_dir() {
                  "usage: teapot [--frames N] [--runs N] [--seed N] [--variants a,b,...] [--teapots N]\n"
                  "              [--frames-in-flight N] [--uniform-writes N] [--tessellation N] [--sweep]\n"
                  "              [--csv PATH] [--out-dir DIR] [--size WxH] [--validation] [--window]\n"
-                 "              [--instructions]\n"
+                 "              [--instructions] [--threads N[,N...]]\n"
                  "--runs N: N fresh processes (default 3), their blocks pooled; --seed fixes the shuffles\n"
                  "--out-dir: plots, frames and the CSV (default: teapot_out next to this executable);\n"
                  "           --png-dir is the old name\n"
@@ -109,6 +112,10 @@ std::string default_out_dir() {
                  "          e.g. tests/with_xvfb.sh); the default renders headless into a ring of images\n"
                  "--instructions: for callgrind (bench/instructions.sh): --frames calls of each stage per\n"
                  "          variant, each stage collected on its own and dumped\n"
+                 "--threads N: the command stage records the draws on N threads into secondary command\n"
+                 "          buffers (harness/variant.hpp); a list runs one configuration per count, and\n"
+                 "          each count's speed-up is against the 1-thread one. vkrc-st runs at 1 thread\n"
+                 "          only (its rule: one thread per instance at a time); --sweep adds 1,2,4,8,16\n"
                  "variants (raw-direct, the reference, and its A/A control always run):",
                  problem.c_str());
     for (const auto& entry : variant_registry()) std::fprintf(stderr, " %s", std::string(entry.name).c_str());
@@ -155,7 +162,15 @@ Options parse(int argc, char** argv) {
         else if (a == "--frames-in-flight") o.config.frames_in_flight = positive(a, value());
         else if (a == "--uniform-writes") o.config.uniform_writes = positive(a, value());
         else if (a == "--tessellation") o.config.tessellation = positive(a, value());
-        else if (a == "--sweep") o.sweep = true;
+        else if (a == "--threads") {
+            o.threads.clear();
+            std::stringstream list(value());
+            for (std::string count; std::getline(list, count, ',');) {
+                const int n = int(integer(a, count, 1, 64));
+                if (std::find(o.threads.begin(), o.threads.end(), n) == o.threads.end()) o.threads.push_back(n);
+            }
+            if (o.threads.empty()) usage("--threads is empty");
+        } else if (a == "--sweep") o.sweep = true;
         else if (a == "--instructions") o.instructions = true;
         else if (a == "--csv") o.csv = value();
         else if (a == "--out-dir" || a == "--png-dir") o.out_dir = value();
@@ -180,6 +195,8 @@ Options parse(int argc, char** argv) {
     std::erase(o.variants, std::string(control_name));
     if (!o.instructions) o.variants.insert(o.variants.begin(), control_name);
     o.variants.insert(o.variants.begin(), reference_name);
+    if (o.instructions && o.threads.size() > 1) usage("--instructions takes one --threads count");
+    o.config.threads = o.threads.front();
     if (o.out_dir.empty()) o.out_dir = default_out_dir();
     if (o.csv.empty()) o.csv = o.out_dir + "/teapot.csv";
     return o;
@@ -188,7 +205,26 @@ Options parse(int argc, char** argv) {
 std::string config_tag(const Config& c) {
     char tag[64];
     std::snprintf(tag, sizeof tag, "t%d_f%d_u%d_s%d", c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation);
+    if (c.threads != 1) return tag + std::string("_n") + std::to_string(c.threads);  // 1 thread: the old names
     return tag;
+}
+
+// A configuration's 1-thread counterpart: its speed-up's denominator.
+Config one_thread(Config c) {
+    c.threads = 1;
+    return c;
+}
+
+// vkrc::st's rule (docs/guide.md, "Thread policies"): all the vkrc objects of
+// one instance on one thread at a time, so its variants record on one thread.
+bool single_thread_only(const std::string& variant) { return variant.starts_with("vkrc-st"); }
+
+// The variants a configuration runs: those of single_thread_only() sit out
+// the threaded ones.
+std::vector<std::string> variants_for(const Options& options, const Config& c) {
+    std::vector<std::string> names = options.variants;
+    if (c.threads > 1) std::erase_if(names, single_thread_only);
+    return names;
 }
 
 // ---- The data one process measures -------------------------------------
@@ -273,7 +309,12 @@ private:
 // time from the given one. Larger scenes get proportionally fewer frames (at
 // least 40) so a sweep stays within minutes.
 std::vector<PlannedConfig> plan(const Options& options) {
-    std::vector<PlannedConfig> configs{{options.config, options.frames}};
+    std::vector<PlannedConfig> configs;
+    for (int threads : options.threads) {
+        Config c = options.config;
+        c.threads = threads;
+        configs.push_back({c, options.frames});
+    }
     if (!options.sweep) return configs;
     auto add = [&](Config c) {
         for (const PlannedConfig& existing : configs)
@@ -292,6 +333,7 @@ std::vector<PlannedConfig> plan(const Options& options) {
     vary(&Config::frames_in_flight, {1, 2});
     vary(&Config::uniform_writes, {1, 1000});
     vary(&Config::tessellation, {2, 4, 8, 16, 32});
+    vary(&Config::threads, {1, 2, 4, 8, 16});
     return configs;
 }
 
@@ -352,14 +394,19 @@ ConfigRun measure_configuration(const Options& options, const PlannedConfig& pla
     auto mesh_it = meshes.find(config.tessellation);
     if (mesh_it == meshes.end())
         mesh_it = meshes.emplace(config.tessellation, tessellate(newell_teapot(), config.tessellation)).first;
-    SceneData scene{&mesh_it->second, camera(config.teapots, config.width, config.height)};
+    // The recording threads, shared by the variants (destroyed after them).
+    std::optional<ThreadPool> recorders;
+    if (config.threads > 1) recorders.emplace(config.threads);
+    SceneData scene{&mesh_it->second, camera(config.teapots, config.width, config.height),
+                    recorders ? &*recorders : nullptr};
 
     ConfigRun result;
     result.config = config;
     result.frames = planned.frames;
-    const std::size_t n = options.variants.size();
+    const std::vector<std::string> names = variants_for(options, config);
+    const std::size_t n = names.size();
     std::vector<std::unique_ptr<Variant>> variants(n);
-    for (const std::string& name : options.variants) result.variants.push_back({.name = name});
+    for (const std::string& name : names) result.variants.push_back({.name = name});
 
     // preinit: an untimed round first (the process's first instance pays for
     // loading the driver), then preinit_rounds timed ones, each in a
@@ -367,7 +414,7 @@ ConfigRun measure_configuration(const Options& options, const PlannedConfig& pla
     for (int round = 0; round <= preinit_rounds; ++round)
         for (std::size_t v : shuffled_order(n, rng)) {
             variants[v].reset();
-            variants[v] = make_variant(options.variants[v]);
+            variants[v] = make_variant(names[v]);
             auto start = std::chrono::steady_clock::now();
             variants[v]->init(config, scene);
             double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
@@ -453,6 +500,27 @@ void write_frames(const std::string& dir, const ConfigRun& r) {
                   v.image);
 }
 
+// The image check across thread counts: every variant's reference frame in a
+// threaded configuration must also be the 1-thread raw-direct's (the check
+// within a configuration compares with raw-direct at the same thread count,
+// which records threaded too). Counted as one more compared frame.
+void check_threaded_images(RunData& data) {
+    for (ConfigRun& r : data.configs) {
+        if (r.config.threads == 1) continue;
+        auto base = std::find_if(data.configs.begin(), data.configs.end(), [&](const ConfigRun& other) {
+            return config_tag(other.config) == config_tag(one_thread(r.config));
+        });
+        if (base == data.configs.end()) continue;
+        for (VariantRun& v : r.variants) {
+            auto [differing, channel] = compare_images(v.image, base->variants.at(0).image);
+            ++v.image_blocks;
+            if (differing) ++v.image_mismatch_blocks;
+            v.worst_pixels = std::max(v.worst_pixels, differing);
+            v.worst_channel = std::max(v.worst_channel, channel);
+        }
+    }
+}
+
 // Every configuration in this process, with the sweep's image error (each
 // level's reference frame against the finest level's).
 RunData measure(const Options& options, const std::vector<PlannedConfig>& configs, std::uint64_t seed) {
@@ -476,6 +544,7 @@ RunData measure(const Options& options, const std::vector<PlannedConfig>& config
         r.image_error_pixels = differing;
         r.image_error_channel = channel;
     }
+    check_threaded_images(data);
     if (options.worker_index == 0) {
         std::filesystem::create_directories(options.out_dir);
         for (const ConfigRun& r : data.configs) write_frames(options.out_dir, r);
@@ -492,8 +561,8 @@ void save(const RunData& data, const std::string& path) {
         const Config& c = r.config;
         out << "config " << c.teapots << ' ' << c.frames_in_flight << ' ' << c.uniform_writes << ' ' << c.tessellation
             << ' ' << c.width << ' ' << c.height << ' ' << r.frames << ' '
-            << (r.image_error_pixels ? std::int64_t(*r.image_error_pixels) : -1) << ' ' << r.image_error_channel
-            << "\n";
+            << (r.image_error_pixels ? std::int64_t(*r.image_error_pixels) : -1) << ' ' << r.image_error_channel << ' '
+            << c.threads << "\n";
         for (const VariantRun& v : r.variants) {
             out << "variant " << v.name << ' ' << v.image_blocks << ' ' << v.image_mismatch_blocks << ' '
                 << v.worst_pixels << ' ' << v.worst_channel << "\npresentation " << v.presentation << "\n";
@@ -530,7 +599,7 @@ RunData load(const std::string& path, const Config& base) {
             std::int64_t image_error = -1;
             fields >> r.config.teapots >> r.config.frames_in_flight >> r.config.uniform_writes >>
                 r.config.tessellation >> r.config.width >> r.config.height >> r.frames >> image_error >>
-                r.image_error_channel;
+                r.image_error_channel >> r.config.threads;
             if (image_error >= 0) r.image_error_pixels = std::size_t(image_error);
             data.configs.push_back(std::move(r));
         } else if (key == "variant") {
@@ -607,6 +676,7 @@ struct StageRow {
     Summary summary;
     Ratio to_ref;
     std::optional<Ratio> to_raw;
+    std::optional<Ratio> speedup;  // threads > 1: the 1-thread configuration's time over this one's
     double floor_us = 0;
     std::optional<double> above_floor_ns;
     std::optional<double> target;
@@ -637,23 +707,50 @@ struct ConfigAnalysis {
 
 double median_of(const Block& block) { return quantile(block, 0.5); }
 
-// ratios[run][block]: a variant's block median over the neighbouring (same
-// round) block median of `against`.
-std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, std::size_t config, std::size_t v,
-                                              std::size_t against, int stage) {
+// One variant's blocks in one configuration (indices into RunData).
+struct BlockSource {
+    std::size_t config = 0, variant = 0;
+};
+
+// ratios[run][block]: the block medians of numerator over those of
+// denominator, block b with block b. Within one configuration these are neighbours (the
+// same round); across configurations (the speed-up) they are the same
+// round's blocks of configurations run one after the other in that run.
+std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, BlockSource numerator,
+                                              BlockSource denominator, int stage) {
     std::vector<std::vector<double>> ratios;
     for (const RunData& run : runs) {
-        const ConfigRun& r = run.configs.at(config);
-        const auto& mine = r.variants.at(v).blocks[stage];
-        const auto& theirs = r.variants.at(against).blocks[stage];
+        const auto& mine = run.configs.at(numerator.config).variants.at(numerator.variant).blocks[stage];
+        const auto& theirs = run.configs.at(denominator.config).variants.at(denominator.variant).blocks[stage];
         std::vector<double> per_block;
         for (std::size_t b = 0; b < std::min(mine.size(), theirs.size()); ++b) {
-            double denominator = median_of(theirs[b]);
-            if (denominator > 0) per_block.push_back(median_of(mine[b]) / denominator);
+            const double reference = median_of(theirs[b]);
+            if (reference > 0) per_block.push_back(median_of(mine[b]) / reference);
         }
         ratios.push_back(std::move(per_block));
     }
     return ratios;
+}
+
+// The speed-up of every row of a threaded configuration whose 1-thread
+// configuration ran too: that one's block medians over this one's.
+void add_speedups(const std::vector<RunData>& runs, std::vector<ConfigAnalysis>& results) {
+    for (std::size_t c = 0; c < results.size(); ++c) {
+        ConfigAnalysis& a = results[c];
+        if (a.config.threads == 1) continue;
+        auto base = std::find_if(results.begin(), results.end(), [&](const ConfigAnalysis& other) {
+            return config_tag(other.config) == config_tag(one_thread(a.config));
+        });
+        if (base == results.end()) continue;
+        for (StageRow& row : a.rows) {
+            auto v = std::find(a.variants.begin(), a.variants.end(), row.variant);
+            auto b = std::find(base->variants.begin(), base->variants.end(), row.variant);
+            if (b == base->variants.end()) continue;
+            row.speedup = block_bootstrap_ratio(
+                block_ratios(runs, {std::size_t(base - results.begin()), std::size_t(b - base->variants.begin())},
+                             {c, std::size_t(v - a.variants.begin())}, row.stage));
+        }
+    }
 }
 
 std::vector<ConfigAnalysis> analyse(const std::vector<RunData>& runs, const Options& options) {
@@ -698,10 +795,10 @@ std::vector<ConfigAnalysis> analyse(const std::vector<RunData>& runs, const Opti
                 row.stage = s;
                 row.samples = a.samples[s][v].size();
                 row.summary = summarize(a.samples[s][v]);
-                auto ref_ratios = block_ratios(runs, c, v, 0, s);
+                auto ref_ratios = block_ratios(runs, {c, v}, {c, 0}, s);
                 for (const auto& run : ref_ratios) row.blocks += run.size();
                 row.to_ref = block_bootstrap_ratio(ref_ratios);
-                if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, c, v, *raw, s));
+                if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, {c, v}, {c, *raw}, s));
                 row.floor_us = floor_us;
                 if (s >= 1 && s <= frame_stages) row.above_floor_ns = (row.summary.median - floor_us) * 1000.0;
                 row.target = target_ratio(row.variant, s);
@@ -719,13 +816,14 @@ std::vector<ConfigAnalysis> analyse(const std::vector<RunData>& runs, const Opti
         }
         if (a.config.teapots == options.config.teapots &&
             a.config.frames_in_flight == options.config.frames_in_flight &&
-            a.config.uniform_writes == options.config.uniform_writes) {
+            a.config.uniform_writes == options.config.uniform_writes && a.config.threads == options.config.threads) {
             auto it = meshes.emplace(a.config.tessellation, tessellate(newell_teapot(), a.config.tessellation)).first;
             a.geometric = geometric_error(newell_teapot(), it->second);
             a.error_pixels = a.geometric->max * pixels_per_unit(a.config);
         }
         out.push_back(std::move(a));
     }
+    add_speedups(runs, out);
     return out;
 }
 
@@ -740,10 +838,10 @@ std::string format_ratio(const Ratio& r) {
 void print_table(const ConfigAnalysis& a) {
     const Config& c = a.config;
     std::printf(
-        "\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %ux%u, "
-        "%d frames per variant per run, %d runs\n",
+        "\nteapots %d, frames in flight %d, uniform writes %d, tessellation %d (%zu triangles), %d recording "
+        "thread(s), %ux%u, %d frames per variant per run, %d runs\n",
         c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation,
-        std::size_t(2) * 32 * c.tessellation * c.tessellation, c.width, c.height, a.frames, a.runs);
+        std::size_t(2) * 32 * c.tessellation * c.tessellation, c.threads, c.width, c.height, a.frames, a.runs);
     std::printf("presentation: %s\n", a.presentations[0].c_str());
     for (std::size_t v = 0; v < a.variants.size(); ++v)
         if (a.presentations[v] != a.presentations[0])
@@ -769,6 +867,29 @@ void print_table(const ConfigAnalysis& a) {
     if (a.geometric)
         std::printf("geometric error: max %.3g, rms %.3g model units; max %.3g pixels at the nearest teapot\n",
                     a.geometric->max, a.geometric->rms, a.error_pixels);
+}
+
+// The threaded configurations' command stage next to their 1-thread one's.
+void print_threads(const std::vector<ConfigAnalysis>& results) {
+    std::printf(
+        "\ncommand stage by recording threads: speed-up is the 1-thread configuration's block medians over this "
+        "one's,\nratio is to %s at the same thread count; 95%% CI over blocks and runs\n",
+        reference_name);
+    std::printf("%-28s %7s %-18s %11s %-26s %s\n", "configuration", "threads", "variant", "median_us",
+                "speed-up [95% CI]", "ratio [95% CI]");
+    for (const ConfigAnalysis& a : results) {
+        const bool has_threaded = std::any_of(results.begin(), results.end(), [&](const ConfigAnalysis& other) {
+            return other.config.threads > 1 && config_tag(one_thread(other.config)) == config_tag(a.config);
+        });
+        if (a.config.threads == 1 && !has_threaded) continue;
+        for (const StageRow& row : a.rows) {
+            if (row.stage != command_stage) continue;
+            std::printf("%-28s %7d %-18s %11.3f %-26s %s\n", config_tag(one_thread(a.config)).c_str(), a.config.threads,
+                        row.variant.c_str(), row.summary.median,
+                        row.speedup ? format_ratio(*row.speedup).c_str() : (a.config.threads == 1 ? "1" : "-"),
+                        format_ratio(row.to_ref).c_str());
+        }
+    }
 }
 
 void print_sweep(const std::vector<ConfigAnalysis>& results, const Options& options) {
@@ -804,7 +925,10 @@ void print_sweep(const std::vector<ConfigAnalysis>& results, const Options& opti
 
 // One row per variant and stage, then an image row per variant (median_us
 // holds the number of last frames that differed). frames is the number of
-// samples behind the row, blocks the number of block ratios.
+// samples behind the row, blocks the number of block ratios. threads is the
+// recording threads (the last columns, so that older files, which lack them,
+// read as 1 thread); speedup and its interval are filled for threads > 1 when
+// the 1-thread configuration ran too.
 void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& results) {
     std::filesystem::path parent = std::filesystem::path(path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
@@ -813,7 +937,7 @@ void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& resul
     out << "variant,stage,teapots,frames_in_flight,uniform_writes,tessellation,frames,median_us,p5_us,p95_us,"
            "reference,ratio_to_ref,ref_ci_low,ref_ci_high,ratio_to_raw,ratio_ci_low,ratio_ci_high,floor_ns,"
            "above_floor_ns,target,verdict,runs,blocks,geometric_max_error,geometric_rms_error,geometric_max_error_px,"
-           "image_error_pixels,image_error_max_channel\n";
+           "image_error_pixels,image_error_max_channel,threads,speedup,speedup_ci_low,speedup_ci_high\n";
     char line[768];
     for (const ConfigAnalysis& r : results) {
         const Config& c = r.config;
@@ -844,13 +968,20 @@ void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& resul
                 c.tessellation, row.samples, row.summary.median, row.summary.p5, row.summary.p95, reference_name,
                 row.to_ref.ratio, row.to_ref.low, row.to_ref.high, raw.c_str(), row.floor_us * 1000.0, above.c_str(),
                 target.c_str(), row.verdict.c_str(), r.runs, row.blocks);
-            out << line << extra << "\n";
+            const std::string line_start = line;
+            std::string speedup = ",,";
+            if (row.speedup) {
+                std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f", row.speedup->ratio, row.speedup->low,
+                              row.speedup->high);
+                speedup = line;
+            }
+            out << line_start << extra << "," << c.threads << "," << speedup << "\n";
         }
         for (const VariantImages& image : r.images) {
             std::snprintf(line, sizeof line, "%s,image,%d,%d,%d,%d,%d,%d,,,%s,,,,,,,,,,,%d,%d,", image.name.c_str(),
                           c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation, image.blocks,
                           image.mismatches, reference_name, r.runs, image.blocks);
-            out << line << extra << "\n";
+            out << line << extra << "," << c.threads << ",,,\n";
         }
     }
 }
@@ -872,15 +1003,43 @@ void write_plots(const std::string& dir, const ConfigAnalysis& a) {
                     a.variants, bars);
 }
 
+// Per 1-thread configuration that has threaded ones: the command stage's
+// speed-up against threads, one line per variant.
+void write_speedup_plots(const std::string& dir, const std::vector<ConfigAnalysis>& results) {
+    for (const ConfigAnalysis& base : results) {
+        if (base.config.threads != 1) continue;
+        std::vector<SpeedupSeries> series;
+        for (const std::string& variant : base.variants) series.push_back({variant, {{1, 1, 1, 1}}});
+        for (const ConfigAnalysis& a : results) {
+            if (a.config.threads == 1 || config_tag(one_thread(a.config)) != config_tag(base.config)) continue;
+            for (const StageRow& row : a.rows)
+                for (SpeedupSeries& s : series)
+                    if (row.stage == command_stage && row.speedup && s.variant == row.variant)
+                        s.points.push_back({a.config.threads, row.speedup->ratio, row.speedup->low, row.speedup->high});
+        }
+        std::erase_if(series, [](const SpeedupSeries& s) { return s.points.size() < 2; });
+        if (series.empty()) continue;
+        for (SpeedupSeries& s : series)
+            std::sort(s.points.begin(), s.points.end(),
+                      [](const SpeedupPoint& x, const SpeedupPoint& y) { return x.threads < y.threads; });
+        const std::string tag = config_tag(base.config);
+        write_speedup_png(dir + "/speedup_" + tag + "_command.png",
+                          "command stage speed-up vs 1 thread (95% CI), " + tag, series);
+    }
+}
+
 void report(const std::vector<ConfigAnalysis>& results, const Options& options, const std::string& device,
             std::uint64_t seed) {
     std::printf("device: %s\nseed: %llu (--seed %llu repeats the shuffles)\n", device.c_str(), (unsigned long long)seed,
                 (unsigned long long)seed);
     for (const ConfigAnalysis& r : results) print_table(r);
+    if (std::any_of(results.begin(), results.end(), [](const ConfigAnalysis& a) { return a.config.threads > 1; }))
+        print_threads(results);
     if (options.sweep) print_sweep(results, options);
     write_csv(options.csv, results);
     std::filesystem::create_directories(options.out_dir);
     for (const ConfigAnalysis& r : results) write_plots(options.out_dir, r);
+    write_speedup_plots(options.out_dir, results);
     std::printf("\nplots and frames in %s, CSV in %s\n", options.out_dir.c_str(), options.csv.c_str());
 }
 
@@ -922,11 +1081,14 @@ int count_instructions(const Options& options) {
         std::fprintf(stderr, "teapot: --instructions outside valgrind counts nothing (bench/instructions.sh)\n");
     const Config& config = options.config;
     Mesh mesh = tessellate(newell_teapot(), config.tessellation);
-    SceneData scene{&mesh, camera(config.teapots, config.width, config.height)};
-    for (const std::string& name : options.variants) {
+    std::optional<ThreadPool> recorders;
+    if (config.threads > 1) recorders.emplace(config.threads);
+    SceneData scene{&mesh, camera(config.teapots, config.width, config.height), recorders ? &*recorders : nullptr};
+    const std::vector<std::string> names = variants_for(options, config);
+    for (const std::string& name : names) {
         std::unique_ptr<Variant> variant = make_variant(name);
         variant->init(config, scene);
-        if (name == options.variants.front()) std::printf("device: %s\n", variant->device_name().c_str());
+        if (name == names.front()) std::printf("device: %s\n", variant->device_name().c_str());
         double t = 0;
         variant->update(t);
         for (int f = 0; f < warmup_frames; ++f) timed_frame(*variant, t += frame_step);

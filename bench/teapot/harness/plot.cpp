@@ -40,6 +40,14 @@ public:
     void vline(int x, int y0, int y1, Colour c, int thick = 1) {
         fill(x, std::min(y0, y1), x + thick, std::max(y0, y1) + 1, c);
     }
+    // A straight segment, stepping along its longer axis.
+    void line(int x0, int y0, int x1, int y1, Colour c, int thick = 1) {
+        const int steps = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
+        for (int i = 0; i <= steps; ++i) {
+            const int x = x0 + (x1 - x0) * i / steps, y = y0 + (y1 - y0) * i / steps;
+            fill(x, y, x + thick, y + thick, c);
+        }
+    }
 
     // Text at twice stb_easy_font's size, top-left at (x, y).
     void text(int x, int y, const std::string& s, Colour c) {
@@ -171,6 +179,54 @@ void write_ratio_png(const std::string& path, const std::string& title, const st
         int lx = left + 10 + int(v) * 160, ly = height - 22;
         canvas.fill(lx, ly + 2, lx + 14, ly + 12, palette[v % std::size(palette)]);
         canvas.text(lx + 20, ly, variants[v], black);
+    }
+    canvas.save(path);
+}
+
+void write_speedup_png(const std::string& path, const std::string& title, const std::vector<SpeedupSeries>& series) {
+    const int width = 1000, height = 560, left = 60, right = 240, top = 50, bottom = 60;
+    Canvas canvas(width, height);
+    int max_threads = 2;
+    double top_value = 2;
+    for (const SpeedupSeries& s : series)
+        for (const SpeedupPoint& p : s.points) {
+            max_threads = std::max(max_threads, p.threads);
+            top_value = std::max(top_value, p.high * 1.1);
+        }
+    top_value = std::min(top_value, double(max_threads) * 1.2);  // the ideal bounds what is worth showing
+    const int plot_w = width - left - right, plot_h = height - top - bottom;
+    const double log_max = std::log2(double(max_threads));
+    auto x_of = [&](int threads) { return left + int(std::log2(double(threads)) / log_max * plot_w); };
+    auto y_of = [&](double v) { return top + plot_h - int(std::clamp(v / top_value, 0.0, 1.0) * plot_h); };
+    canvas.text(left, 12, title, black);
+    for (int t = 0; t <= 4; ++t) {
+        const double v = top_value * t / 4;
+        canvas.hline(left, left + plot_w, y_of(v), grey);
+        canvas.text(4, y_of(v) - 7, number(v), black);
+    }
+    for (int n = 1; n <= max_threads; n *= 2) {
+        canvas.vline(x_of(n), top + plot_h, top + plot_h + 5, black);
+        canvas.text(x_of(n) - Canvas::text_width(std::to_string(n)) / 2, top + plot_h + 10, std::to_string(n), black);
+    }
+    canvas.text(left + plot_w / 2 - 30, height - 22, "threads", black);
+    canvas.hline(left, left + plot_w, top + plot_h, black);
+    canvas.vline(left, top, top + plot_h, black);
+    for (int n = 1; n < max_threads; n *= 2)  // the ideal, speed-up = threads
+        canvas.line(x_of(n), y_of(n), x_of(2 * n), y_of(std::min(2 * n, max_threads)), grey, 2);
+    for (std::size_t s = 0; s < series.size(); ++s) {
+        const Colour c = palette[s % std::size(palette)];
+        const std::vector<SpeedupPoint>& points = series[s].points;
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const int x = x_of(points[i].threads) + int(s) * 3 - int(series.size());  // whiskers side by side
+            canvas.vline(x, y_of(points[i].high), y_of(points[i].low), c);
+            canvas.fill(x - 3, y_of(points[i].ratio) - 3, x + 4, y_of(points[i].ratio) + 4, c);
+            if (i)
+                canvas.line(x_of(points[i - 1].threads), y_of(points[i - 1].ratio), x_of(points[i].threads),
+                            y_of(points[i].ratio), c, 2);
+        }
+        const int lx = width - right + 20, ly = top + 4 + int(s) * 18;
+        canvas.fill(lx, ly + 2, lx + 14, ly + 12, c);
+        canvas.text(lx + 20, ly, series[s].variant, black);
     }
     canvas.save(path);
 }

@@ -30,4 +30,16 @@ struct RatioBar {
 void write_ratio_png(const std::string& path, const std::string& title, const std::vector<std::string>& variants,
                      const std::vector<RatioBar>& bars);
 
+struct SpeedupPoint {
+    int threads = 1;
+    double ratio = 1, low = 1, high = 1;
+};
+struct SpeedupSeries {
+    std::string variant;
+    std::vector<SpeedupPoint> points;  // by increasing thread count
+};
+// Speed-up against thread count (log2 axis), one line per variant with CI
+// whiskers, and the ideal (speed-up = threads) in grey.
+void write_speedup_png(const std::string& path, const std::string& title, const std::vector<SpeedupSeries>& series);
+
 }  // namespace teapot

@@ -55,6 +55,20 @@
 //     16-bit index buffer, then per teapot vkCmdPushConstants (80 bytes) +
 //     vkCmdDrawIndexed; end rendering, barrier colour -> TRANSFER_SRC_OPTIMAL
 //     headless, PRESENT_SRC_KHR windowed (destination stage NONE), end.
+//     With --threads N > 1 (Config::threads) the draws are recorded on N
+//     threads into secondaries: each slot also has N command pools
+//     (TRANSIENT), one per thread, each with one secondary command buffer.
+//     The primary is recorded as above up to the rendering, which begins
+//     with VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT; then
+//     SceneData::recorders runs thread i = 0 .. N-1 (0 is the calling
+//     thread): vkResetCommandPool on its pool, begin its secondary
+//     (ONE_TIME_SUBMIT | RENDER_PASS_CONTINUE, inheriting the dynamic
+//     rendering: the colour format, D32_SFLOAT, one sample), bind pipeline,
+//     set viewport and scissor, bind the descriptor set, vertex and index
+//     buffers (secondaries inherit no state), the push constants and draws of
+//     draw_range(i, N), end. Then one vkCmdExecuteCommands of the N
+//     secondaries in thread order (so the draw order is the 1-thread one) and
+//     the primary ends as above. --threads 1 records the primary directly.
 //   * submit: one vkQueueSubmit2 of the command buffer, signalling the slot's
 //     fence. Headless: no semaphores. Windowed: waits on the slot's acquire
 //     semaphore at COLOR_ATTACHMENT_OUTPUT and signals the image's render-done
@@ -109,6 +123,7 @@
 namespace teapot {
 
 class BenchWindow;  // harness/window.hpp
+class ThreadPool;   // harness/thread_pool.hpp
 
 struct Config {
     int teapots = 25;
@@ -119,6 +134,7 @@ struct Config {
     std::uint32_t height = 600;
     bool validation = false;
     bool window = false;  // --window: present to a window instead of the headless ring
+    int threads = 1;      // --threads: recording threads of the command stage (the convention's "threads")
 };
 
 // What every variant draws: the mesh (shared, built once per tessellation)
@@ -126,6 +142,8 @@ struct Config {
 struct SceneData {
     const Mesh* mesh = nullptr;
     CameraUniforms camera{};
+    // Config::threads > 1: the recording threads, shared by every variant.
+    ThreadPool* recorders = nullptr;
 };
 
 inline constexpr VkFormat colour_format = VK_FORMAT_R8G8B8A8_UNORM;

@@ -1,7 +1,5 @@
 #include "harness/variant.hpp"
 
-#include <cstdio>
-
 namespace teapot {
 
 const std::vector<VariantEntry>& variant_registry() {
@@ -23,16 +21,6 @@ const std::vector<VariantEntry>& variant_registry() {
 #endif
     };
     return registry;
-}
-
-VKAPI_ATTR VkBool32 VKAPI_CALL validation_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                                   VkDebugUtilsMessageTypeFlagsEXT,
-                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
-    ++validation_messages;
-    std::fprintf(stderr, "validation %s: %s\n",
-                 severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
-                 data && data->pMessage ? data->pMessage : "(no message)");
-    return VK_FALSE;
 }
 
 }  // namespace teapot

@@ -4,6 +4,7 @@
 // trampolines (the floor for any wrapper). One template, Direct selects the
 // dispatch at compile time so `raw` keeps plain direct calls. Windowed
 // (--window), both present with their own VkSurfaceKHR/VkSwapchainKHR code.
+#include "harness/thread_pool.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
@@ -42,6 +43,7 @@ void check(VkResult result, const char* call) {
     X(vkCmdPipelineBarrier2) X(vkCmdBeginRendering) X(vkCmdEndRendering) X(vkCmdBindPipeline)                     \
     X(vkCmdSetViewport) X(vkCmdSetScissor) X(vkCmdBindDescriptorSets) X(vkCmdBindVertexBuffers)                   \
     X(vkCmdBindIndexBuffer) X(vkCmdPushConstants) X(vkCmdDrawIndexed) X(vkCmdCopyImageToBuffer) X(vkCmdCopyBuffer) \
+    X(vkCmdExecuteCommands)                                                                                      \
     X(vkCreateSemaphore) X(vkDestroySemaphore) X(vkCreateSwapchainKHR) X(vkDestroySwapchainKHR)                   \
     X(vkGetSwapchainImagesKHR) X(vkAcquireNextImageKHR) X(vkQueuePresentKHR)
 // clang-format on
@@ -135,11 +137,13 @@ void submit_and_wait(const DeviceFunctions& fn, VkDevice device, VkQueue queue, 
 
 template <bool Direct>
 class RawVariant final : public Variant {
+    struct Frame;  // per frame slot, below
 public:
     ~RawVariant() override { destroy(); }
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
+        recorders_ = config.threads > 1 ? scene.recorders : nullptr;
         draws_.resize(config.teapots);
         mesh_.index_count = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
@@ -193,7 +197,15 @@ public:
         VkCommandBuffer cmd = f.cmd;
         check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(cmd, &begin),
               "vkBeginCommandBuffer");
+        const bool threaded = !f.secondaries.empty();
+        begin_target(cmd, threaded ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0);
+        if (threaded) record_on_threads(f);
+        else record_draws(cmd, f, {0, draws_.size()});
+        end_target(cmd);
+    }
 
+    // The barriers into the attachment layouts and the rendering's begin.
+    void begin_target(VkCommandBuffer cmd, VkRenderingFlags flags) const {
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_render[2] = {
@@ -220,13 +232,18 @@ public:
         depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
         depth.clearValue.depthStencil = {1.0f, 0};
         VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+        rendering.flags = flags;
         rendering.renderArea = {{0, 0}, target_.extent};
         rendering.layerCount = 1;
         rendering.colorAttachmentCount = 1;
         rendering.pColorAttachments = &colour;
         rendering.pDepthAttachment = &depth;
         call(&DeviceFunctions::vkCmdBeginRendering, ::vkCmdBeginRendering)(cmd, &rendering);
+    }
 
+    // The state every draw needs, then the draws of range: into the primary,
+    // or one thread's slice into its secondary (which inherits no state).
+    void record_draws(VkCommandBuffer cmd, const Frame& f, DrawRange range) const {
         call(&DeviceFunctions::vkCmdBindPipeline, ::vkCmdBindPipeline)(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
         VkViewport viewport{0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1};
         call(&DeviceFunctions::vkCmdSetViewport, ::vkCmdSetViewport)(cmd, 0, 1, &viewport);
@@ -241,12 +258,46 @@ public:
                                                                              VK_INDEX_TYPE_UINT16);
         auto push = call(&DeviceFunctions::vkCmdPushConstants, ::vkCmdPushConstants);
         auto draw = call(&DeviceFunctions::vkCmdDrawIndexed, ::vkCmdDrawIndexed);
-        for (const PushConstants& d : draws_) {
-            push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof d, &d);
+        for (std::size_t i = range.first; i < range.last; ++i) {
+            push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants), &draws_[i]);
             draw(cmd, mesh_.index_count, 1, 0, 0, 0);
         }
-        call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
+    }
 
+    // --threads N: thread i records its slice into the secondary of its own
+    // pool; the primary executes them in thread order.
+    void record_on_threads(const Frame& f) const {
+        const int threads = int(f.secondaries.size());
+        auto record = [&](int i) {
+            const auto t = std::size_t(i);
+            check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.thread_pools[t], 0),
+                  "vkResetCommandPool");
+            VkCommandBufferInheritanceRenderingInfo rendering{
+                VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO};
+            rendering.colorAttachmentCount = 1;
+            rendering.pColorAttachmentFormats = &colour_format_;
+            rendering.depthAttachmentFormat = depth_format;
+            rendering.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+            VkCommandBufferInheritanceInfo inheritance{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
+            inheritance.pNext = &rendering;
+            VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+            begin.flags =
+                VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT | VK_COMMAND_BUFFER_USAGE_RENDER_PASS_CONTINUE_BIT;
+            begin.pInheritanceInfo = &inheritance;
+            VkCommandBuffer secondary = f.secondaries[t];
+            check(call(&DeviceFunctions::vkBeginCommandBuffer, ::vkBeginCommandBuffer)(secondary, &begin),
+                  "vkBeginCommandBuffer");
+            record_draws(secondary, f, draw_range(i, threads, draws_.size()));
+            check(call(&DeviceFunctions::vkEndCommandBuffer, ::vkEndCommandBuffer)(secondary), "vkEndCommandBuffer");
+        };
+        recorders_->run(record);
+        call(&DeviceFunctions::vkCmdExecuteCommands, ::vkCmdExecuteCommands)(
+            f.cmd, static_cast<std::uint32_t>(f.secondaries.size()), f.secondaries.data());
+    }
+
+    // The rendering's end, the barrier to the presentation layout and the end.
+    void end_target(VkCommandBuffer cmd) const {
+        call(&DeviceFunctions::vkCmdEndRendering, ::vkCmdEndRendering)(cmd);
         const VkImageMemoryBarrier2 to_present =
             image_barrier(target_.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           target_.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
@@ -413,6 +464,9 @@ private:
         VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
         VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
         bool submitted = false;
+        // --threads N > 1: per thread, a pool and its secondary.
+        std::vector<VkCommandPool> thread_pools;
+        std::vector<VkCommandBuffer> secondaries;
     };
     // The mesh: three device-local buffers filled by a staging upload.
     struct MeshBuffers {
@@ -931,6 +985,16 @@ private:
         check(result, "vkCreateGraphicsPipelines");
     }
 
+    VkCommandBuffer create_command_buffer(VkCommandPool pool, VkCommandBufferLevel level) {
+        VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+        allocate.commandPool = pool;
+        allocate.level = level;
+        allocate.commandBufferCount = 1;
+        VkCommandBuffer cmd = VK_NULL_HANDLE;
+        check(fn_.vkAllocateCommandBuffers(device_, &allocate, &cmd), "vkAllocateCommandBuffers");
+        return cmd;
+    }
+
     void create_frames() {
         auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
         VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
@@ -947,11 +1011,14 @@ private:
             pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
             pool_info.queueFamilyIndex = queue_family_;
             check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &f.pool), "vkCreateCommandPool");
-            VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-            allocate.commandPool = f.pool;
-            allocate.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-            allocate.commandBufferCount = 1;
-            check(fn_.vkAllocateCommandBuffers(device_, &allocate, &f.cmd), "vkAllocateCommandBuffers");
+            f.cmd = create_command_buffer(f.pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+            for (int t = 0; recorders_ && t < recorders_->size(); ++t) {
+                f.thread_pools.push_back(VK_NULL_HANDLE);
+                check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &f.thread_pools.back()),
+                      "vkCreateCommandPool");
+                f.secondaries.push_back(
+                    create_command_buffer(f.thread_pools.back(), VK_COMMAND_BUFFER_LEVEL_SECONDARY));
+            }
             VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
             check(fn_.vkCreateFence(device_, &fence, nullptr, &f.fence), "vkCreateFence");
             if (config_.window) {
@@ -981,6 +1048,7 @@ private:
                 fn_.vkDestroySemaphore(device_, f.acquire_semaphore, nullptr);
                 fn_.vkDestroyFence(device_, f.fence, nullptr);
                 fn_.vkDestroyCommandPool(device_, f.pool, nullptr);
+                for (VkCommandPool pool : f.thread_pools) fn_.vkDestroyCommandPool(device_, pool, nullptr);
             }
             fn_.vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
             fn_.vkDestroyPipeline(device_, pipeline_, nullptr);
@@ -1012,6 +1080,7 @@ private:
     Config config_;
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
+    ThreadPool* recorders_ = nullptr;  // --threads N > 1
 
     BenchWindow window_;  // windowed only; outlives the surface (destroy() runs first)
     VkInstance instance_ = VK_NULL_HANDLE;

@@ -1,6 +1,7 @@
 // The Vulkan-Hpp variant: vk::raii from Debian's headers, written the way
 // its samples do (its own translation unit: the header compiles slowly).
 // Windowed (--window), it presents through vk::raii::SurfaceKHR/SwapchainKHR.
+#include "harness/thread_pool.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
@@ -21,6 +22,7 @@ namespace teapot {
 namespace {
 
 class VkhppVariant final : public Variant {
+    struct Frame;  // per frame slot, below
 public:
     ~VkhppVariant() override {
         if (device_) device_->waitIdle();
@@ -28,6 +30,7 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
+        recorders_ = config.threads > 1 ? scene.recorders : nullptr;
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
@@ -74,6 +77,15 @@ public:
         f.pool.reset();
         const vk::raii::CommandBuffer& cmd = f.cmd;
         cmd.begin({vk::CommandBufferUsageFlagBits::eOneTimeSubmit});
+        const bool threaded = !f.secondaries.empty();
+        begin_target(cmd, threaded ? vk::RenderingFlagBits::eContentsSecondaryCommandBuffers : vk::RenderingFlags{});
+        if (threaded) record_on_threads(f);
+        else record_draws(cmd, f, {0, draws_.size()});
+        end_target(cmd);
+    }
+
+    // The barriers into the attachment layouts and the rendering's begin.
+    void begin_target(const vk::raii::CommandBuffer& cmd, vk::RenderingFlags flags) const {
         std::array<vk::ImageMemoryBarrier2, 2> to_render{
             vk::ImageMemoryBarrier2(
                 vk::PipelineStageFlagBits2::eColorAttachmentOutput, {},
@@ -96,17 +108,49 @@ public:
         vk::RenderingAttachmentInfo depth(*depth_.view, vk::ImageLayout::eDepthAttachmentOptimal, {}, {}, {},
                                           vk::AttachmentLoadOp::eClear, vk::AttachmentStoreOp::eDontCare,
                                           vk::ClearDepthStencilValue(1.0f, 0));
-        cmd.beginRendering(vk::RenderingInfo({}, {{0, 0}, target_.extent}, 1, 0, colour, &depth));
+        cmd.beginRendering(vk::RenderingInfo(flags, {{0, 0}, target_.extent}, 1, 0, colour, &depth));
+    }
+
+    // The state every draw needs, then the draws of range: into the primary,
+    // or one thread's slice into its secondary (which inherits no state).
+    void record_draws(const vk::raii::CommandBuffer& cmd, const Frame& f, DrawRange range) const {
         cmd.bindPipeline(vk::PipelineBindPoint::eGraphics, *pipeline_);
         cmd.setViewport(0, vk::Viewport(0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1));
         cmd.setScissor(0, vk::Rect2D({0, 0}, target_.extent));
         cmd.bindDescriptorSets(vk::PipelineBindPoint::eGraphics, *pipeline_layout_, 0, *f.descriptor_set, {});
         cmd.bindVertexBuffers(0, {*positions_.buffer, *normals_.buffer}, {0, 0});
         cmd.bindIndexBuffer(*indices_.buffer, 0, vk::IndexType::eUint16);
-        for (const PushConstants& d : draws_) {
-            cmd.pushConstants<PushConstants>(*pipeline_layout_, vk::ShaderStageFlagBits::eVertex, 0, d);
+        for (std::size_t i = range.first; i < range.last; ++i) {
+            cmd.pushConstants<PushConstants>(*pipeline_layout_, vk::ShaderStageFlagBits::eVertex, 0, draws_[i]);
             cmd.drawIndexed(index_count_, 1, 0, 0, 0);
         }
+    }
+
+    // --threads N: thread i records its slice into the secondary of its own
+    // pool; the primary executes them in thread order.
+    void record_on_threads(const Frame& f) const {
+        const int threads = int(f.secondaries.size());
+        auto record = [&](int i) {
+            const auto t = std::size_t(i);
+            f.thread_pools[t].reset();
+            const vk::raii::CommandBuffer& secondary = f.secondaries[t];
+            const vk::Format format = colour_format_;
+            vk::StructureChain<vk::CommandBufferInheritanceInfo, vk::CommandBufferInheritanceRenderingInfo> inheritance(
+                vk::CommandBufferInheritanceInfo(),
+                vk::CommandBufferInheritanceRenderingInfo({}, 0, format, vk::Format(depth_format), {},
+                                                          vk::SampleCountFlagBits::e1));
+            secondary.begin(vk::CommandBufferBeginInfo(
+                vk::CommandBufferUsageFlagBits::eOneTimeSubmit | vk::CommandBufferUsageFlagBits::eRenderPassContinue,
+                &inheritance.get<vk::CommandBufferInheritanceInfo>()));
+            record_draws(secondary, f, draw_range(i, threads, draws_.size()));
+            secondary.end();
+        };
+        recorders_->run(record);
+        f.cmd.executeCommands(f.secondary_handles);
+    }
+
+    // The rendering's end, the barrier to the presentation layout and the end.
+    void end_target(const vk::raii::CommandBuffer& cmd) const {
         cmd.endRendering();
         vk::ImageMemoryBarrier2 to_present(
             vk::PipelineStageFlagBits2::eColorAttachmentOutput, vk::AccessFlagBits2::eColorAttachmentWrite,
@@ -298,6 +342,11 @@ private:
         vk::raii::DescriptorSet descriptor_set = nullptr;
         vk::raii::Semaphore acquire_semaphore = nullptr;  // windowed only
         bool submitted = false;
+        // --threads N > 1: per thread, a pool and its secondary (and the
+        // secondaries' handles, as vkCmdExecuteCommands takes them).
+        std::vector<vk::raii::CommandPool> thread_pools;
+        std::vector<vk::raii::CommandBuffer> secondaries;
+        std::vector<vk::CommandBuffer> secondary_handles;
     };
     // What this frame renders into: a ring image or a swapchain image.
     struct Target {
@@ -575,6 +624,14 @@ private:
                 *device_, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eTransient, queue_family_));
             f.cmd = std::move(vk::raii::CommandBuffers(
                 *device_, vk::CommandBufferAllocateInfo(*f.pool, vk::CommandBufferLevel::ePrimary, 1))[0]);
+            for (int t = 0; recorders_ && t < recorders_->size(); ++t) {
+                f.thread_pools.emplace_back(
+                    *device_, vk::CommandPoolCreateInfo(vk::CommandPoolCreateFlagBits::eTransient, queue_family_));
+                f.secondaries.push_back(std::move(vk::raii::CommandBuffers(
+                    *device_,
+                    vk::CommandBufferAllocateInfo(*f.thread_pools.back(), vk::CommandBufferLevel::eSecondary, 1))[0]));
+                f.secondary_handles.push_back(*f.secondaries.back());
+            }
             f.fence = vk::raii::Fence(*device_, vk::FenceCreateInfo());
             if (config_.window) f.acquire_semaphore = vk::raii::Semaphore(*device_, vk::SemaphoreCreateInfo());
             f.descriptor_set = std::move(
@@ -589,6 +646,7 @@ private:
     Config config_;
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
+    ThreadPool* recorders_ = nullptr;  // --threads N > 1
     std::uint32_t index_count_ = 0;
     std::string device_name_;
     vk::DeviceSize uniform_alignment_ = 1;

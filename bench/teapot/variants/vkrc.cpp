@@ -23,6 +23,7 @@
 //     from this loop's fence waits; otherwise it waits on the queue's
 //     timeline). present also takes the queue's mutex (no-op under vkrc-st)
 //     and records the queue's last submission number.
+#include "harness/thread_pool.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
 
@@ -46,6 +47,7 @@ namespace teapot {
 namespace {
 
 class VkrcVariant final : public Variant {
+    struct Frame;  // per frame slot, below
 public:
     ~VkrcVariant() override {
         // The members release themselves; with the device idle first, each
@@ -56,6 +58,14 @@ public:
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
+        recorders_ = config.threads > 1 ? scene.recorders : nullptr;
+#if !(defined(VKRC_MULTI_THREAD) && VKRC_MULTI_THREAD)
+        // vkrc::st's rule (docs/guide.md, "Thread policies"): all the vkrc
+        // objects of one instance on one thread at a time. Each recording
+        // thread's reset, begin and end update the device's bookkeeping of
+        // open command buffers, which vkrc::st does not lock.
+        if (recorders_) throw std::runtime_error("vkrc-st records on one thread only (--threads 1)");
+#endif
         draws_.resize(config.teapots);
         index_count_ = static_cast<std::uint32_t>(scene.mesh->indices.size());
         create_device();
@@ -102,7 +112,15 @@ public:
         f.pool.reset_commands();
         const vkrc::CommandBuffer& cmd = f.cmd;
         cmd.begin();
+        const bool threaded = !f.secondaries.empty();
+        begin_target(cmd, threaded ? VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT : 0);
+        if (threaded) record_on_threads(f);
+        else record_draws(cmd, f, {0, draws_.size()});
+        end_target(cmd);
+    }
 
+    // The barriers into the attachment layouts and the rendering's begin.
+    void begin_target(const vkrc::CommandBuffer& cmd, VkRenderingFlags flags) {
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_render[2] = {
@@ -123,9 +141,17 @@ public:
         vkrc::RenderingAttachment depth{depth_view_.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                                         VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
         depth.clear_value.depthStencil = {1.0f, 0};
-        cmd.begin_rendering(
-            {.render_area = {{0, 0}, frame_.extent}, .color_attachments = {&colour, 1}, .depth_attachment = &depth});
+        cmd.begin_rendering({.render_area = {{0, 0}, frame_.extent},
+                             .color_attachments = {&colour, 1},
+                             .depth_attachment = &depth,
+                             .flags = flags});
+    }
 
+    // The state every draw needs, then the draws of range: the whole
+    // command stage's draws into the primary, or one thread's slice into its
+    // secondary (which inherits no state). Only reads shared members, so
+    // that threads may run it at once (no handle is copied).
+    void record_draws(const vkrc::CommandBuffer& cmd, const Frame& f, DrawRange range) const {
         cmd.bind_pipeline(pipeline_);
         cmd.set_viewport_and_scissor(frame_.extent);
         cmd.bind_descriptor_set(pipeline_, 0, f.set);
@@ -134,12 +160,31 @@ public:
         cmd.bind_vertex_buffers(0, vertex_buffers, offsets);
         cmd.bind_index_buffer(indices_, 0, VK_INDEX_TYPE_UINT16);
         const vkrc::PipelineLayout& layout = pipeline_.layout();
-        for (const PushConstants& d : draws_) {
-            cmd.push_constants(layout, VK_SHADER_STAGE_VERTEX_BIT, d);
+        for (std::size_t i = range.first; i < range.last; ++i) {
+            cmd.push_constants(layout, VK_SHADER_STAGE_VERTEX_BIT, draws_[i]);
             cmd.draw_indexed(index_count_);
         }
-        cmd.end_rendering();
+    }
 
+    // --threads N: thread i records its slice into its own pool's secondary
+    // (the pool is used by that thread only, as vkrc::CommandPool requires);
+    // the primary executes them in thread order.
+    void record_on_threads(const Frame& f) {
+        const int threads = int(f.secondaries.size());
+        auto record = [&](int i) {
+            const vkrc::CommandBuffer& secondary = f.secondaries[std::size_t(i)];
+            f.thread_pools[std::size_t(i)].reset_commands();
+            secondary.begin_secondary({.color_formats = {&colour_format_, 1}, .depth_format = depth_format});
+            record_draws(secondary, f, draw_range(i, threads, draws_.size()));
+            secondary.end();
+        };
+        recorders_->run(record);
+        f.cmd.execute_commands(f.secondaries);
+    }
+
+    // The rendering's end, the barrier to the presentation layout and the end.
+    void end_target(const vkrc::CommandBuffer& cmd) {
+        cmd.end_rendering();
         // PRESENT_SRC_KHR for a swapchain, TRANSFER_SRC_OPTIMAL headless.
         const VkImageMemoryBarrier2 to_present =
             vkrc::image_barrier(frame_.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, frame_.present_layout,
@@ -284,6 +329,9 @@ private:
         vkrc::Fence fence;
         vkrc::DescriptorSet set;
         bool submitted = false;
+        // --threads N > 1: per thread, a pool and its secondary.
+        std::vector<vkrc::CommandPool> thread_pools;
+        std::vector<vkrc::CommandBuffer> secondaries;
     };
 
     void create_device() {
@@ -418,6 +466,12 @@ private:
             f.set = descriptor_pool_.allocate(set_layout_);
             f.set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_, i * uniform_stride_,
                                sizeof(CameraUniforms));
+            for (int t = 0; recorders_ && t < recorders_->size(); ++t) {
+                f.thread_pools.push_back(vkrc::CommandPool::create(
+                    device_,
+                    {.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT, .queue_family_index = queue_.family_index()}));
+                f.secondaries.push_back(f.thread_pools.back().allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY));
+            }
         }
     }
 
@@ -426,6 +480,7 @@ private:
     std::vector<PushConstants> draws_;
     std::uint32_t index_count_ = 0;
     VkFormat colour_format_ = colour_format;  // the presenter's
+    ThreadPool* recorders_ = nullptr;         // --threads N > 1
 
     BenchWindow window_;  // windowed only; destroyed last, after the surface
     vkrc::Surface surface_;
