@@ -14,7 +14,7 @@
 # (with alloc built, bench/alloc_run.sh runs too: the allocation results).
 # NAME: the results' file prefix (default: the date and a device slug).
 # FRAMES_25 / FRAMES_2500 (environment) override the frames per run (2500 / 400).
-# THREADS_RUN=1 adds the --threads run (below).
+# CONFIGS (below) picks which runs.
 set -euo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: bench/device_run.sh BUILD_DIR OUT [NAME]" >&2
@@ -49,17 +49,20 @@ run() {  # run FILE-SUFFIX teapot-args...
   echo "wrote $out/$prefix-$suffix.csv" >&2
 }
 
-run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
-run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"
-# THREADS_RUN=1: also the recording-thread scaling of issue 17, 25 000 draws
-# on 1, 2, 4, 8 and 16 threads (TEAPOTS_THREADS / FRAMES_THREADS override).
-if [ "${THREADS_RUN:-0}" = 1 ]; then
+# CONFIGS (environment) picks the runs: t25, t2500, threads (the
+# recording-thread scaling of issue 17: 25 000 draws on 1, 2, 4, 8 and 16
+# threads; TEAPOTS_THREADS / FRAMES_THREADS override), alloc. Default: all.
+configs=" ${CONFIGS:-t25 t2500 threads alloc} "
+[[ $configs == *" t25 "* ]] && run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
+[[ $configs == *" t2500 "* ]] && run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"
+if [[ $configs == *" threads "* ]]; then
   run "threads-t${TEAPOTS_THREADS:-25000}" --teapots "${TEAPOTS_THREADS:-25000}" --threads 1,2,4,8,16 \
     --frames "${FRAMES_THREADS:-400}"
 fi
-
-if [ -x "$build/bench/alloc" ]; then
-  "$source_dir/bench/alloc_run.sh" "$build" "$out" ${name:+"$name"}
-else
-  echo "device_run.sh: no $build/bench/alloc: the allocation run is skipped" >&2
+if [[ $configs == *" alloc "* ]]; then
+  if [ -x "$build/bench/alloc" ]; then
+    "$source_dir/bench/alloc_run.sh" "$build" "$out" ${name:+"$name"}
+  else
+    echo "device_run.sh: no $build/bench/alloc: the allocation run is skipped" >&2
+  fi
 fi
