@@ -4,6 +4,7 @@
 #include <bit>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 VKRC_BEGIN_NAMESPACE
@@ -35,6 +36,7 @@ struct Node {
 };
 
 struct Pool;
+struct Shard;
 
 struct Block {
     VkDeviceMemory memory = VK_NULL_HANDLE;
@@ -60,6 +62,7 @@ inline void size_class(VkDeviceSize size, std::uint32_t& fl, std::uint32_t& sl) 
 // The blocks of one memory type (and, with a large bufferImageGranularity, of
 // one tiling class), allocated with or without DEVICE_ADDRESS, and its TLSF index.
 struct Pool {
+    Shard* shard = nullptr;  // the owner; free() locks it
     std::uint32_t memory_type = 0;
     bool device_address = false;  // blocks allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
     std::vector<Block*> blocks;
@@ -170,12 +173,10 @@ void merge_next_into(Node* node, NodeStore& nodes) noexcept {
     nodes.recycle(next);
 }
 
-}  // namespace
-
-struct PoolAllocator::Impl {
-    PoolAllocatorCreateInfo info;
-    mutable Mutex mutex;
-    detail::DeviceState* device = nullptr;  // the device served; null until first use
+// An independent part of a PoolAllocator: its own lock, pools (so blocks and
+// spares) and nodes. Its statistics are summed by statistics().
+struct alignas(64) Shard {  // apart in cache: threads on different shards share no line
+    Mutex mutex;
     // Index: memory type * 4 + 2 * (device-address blocks) + (optimal-tiling
     // pool when kept apart). Device-address blocks are kept apart so that
     // only buffers that ask pay for the flag (drivers may place such memory
@@ -183,7 +184,53 @@ struct PoolAllocator::Impl {
     std::unique_ptr<Pool> pools[VK_MAX_MEMORY_TYPES * 4];
     NodeStore nodes;
     AllocatorStatistics stats;
-    std::uint32_t memory_objects = 0;  // blocks and dedicated allocations
+};
+
+// Unlocks a shard locked by PoolAllocator::Impl::lock_shard.
+class ShardLock {
+public:
+    explicit ShardLock(Shard& shard) noexcept : shard_(shard) {}
+    ShardLock(const ShardLock&) = delete;
+    ShardLock& operator=(const ShardLock&) = delete;
+    ~ShardLock() { shard_.mutex.unlock(); }
+
+private:
+    Shard& shard_;
+};
+
+#if VKRC_IS_MULTI_THREAD
+// Threads take home shards round-robin, in the order of their first allocation.
+detail::Atomic<std::uint32_t> next_thread{0};
+thread_local std::uint32_t thread_ticket = 0;  // 0: none yet; else 1 + the thread's number
+
+std::uint32_t thread_number() noexcept {
+    if (thread_ticket == 0) thread_ticket = next_thread.fetch_add(1, __ATOMIC_RELAXED) + 1;
+    return thread_ticket - 1;
+}
+#endif
+
+std::uint32_t resolve_shards(std::uint32_t wanted) noexcept {
+#if VKRC_IS_MULTI_THREAD
+    if (wanted != 0) return wanted;
+    return std::clamp<std::uint32_t>(std::thread::hardware_concurrency(), 1, 8);
+#else
+    (void)wanted;
+    return 1;  // one thread at a time gains nothing from more
+#endif
+}
+
+}  // namespace
+
+struct PoolAllocator::Impl {
+    PoolAllocatorCreateInfo info;
+    std::unique_ptr<Shard[]> shards;
+    std::uint32_t shard_count = 1;
+    // The device served; null until first use. Set once under bind_mutex;
+    // the limits below are written before it and read after it.
+    detail::Atomic<detail::DeviceState*> device{nullptr};
+    Mutex bind_mutex;
+    // Blocks and dedicated allocations of all shards, against maxMemoryAllocationCount.
+    detail::Atomic<std::uint32_t> memory_objects{0};
 
     VkDeviceSize granularity = 1;
     VkDeviceSize atom = 1;
@@ -194,15 +241,19 @@ struct PoolAllocator::Impl {
     static constexpr VkDeviceSize max_rounded_granularity = 4096;
 
     void bind(DeviceView d, const char* who);
-    Block& new_block(DeviceView d, Pool& pool, VkDeviceSize at_least);
-    void free_block(DeviceView d, Pool& pool, Block& block) noexcept;
-    HeapStatistics& heap(std::uint32_t type) noexcept { return stats.heaps[heap_of[type]]; }
+    Shard& lock_shard() noexcept;
+    void count_memory_object(DeviceView d);
+    Block& new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least);
+    void free_block(DeviceView d, Shard& shard, Pool& pool, Block& block) noexcept;
+    HeapStatistics& heap(Shard& shard, std::uint32_t type) noexcept { return shard.stats.heaps[heap_of[type]]; }
 };
 
 void PoolAllocator::Impl::bind(DeviceView d, const char* who) {
-    if (device == &d.state()) return;
-    if (device) throw UsageError(std::string(who) + ": this PoolAllocator serves another device");
-    device = &d.state();
+    if (device.load(__ATOMIC_ACQUIRE) == &d.state()) return;
+    LockGuard lock(bind_mutex);
+    detail::DeviceState* now = device.load(__ATOMIC_ACQUIRE);
+    if (now == &d.state()) return;
+    if (now) throw UsageError(std::string(who) + ": this PoolAllocator serves another device");
     granularity = std::max<VkDeviceSize>(1, d.limits().bufferImageGranularity);
     atom = std::max<VkDeviceSize>(1, d.limits().nonCoherentAtomSize);
     const auto& props = d.memory_properties();
@@ -218,9 +269,36 @@ void PoolAllocator::Impl::bind(DeviceView d, const char* who) {
         units[t] = u;
         heap_of[t] = props.memoryTypes[t].heapIndex;
     }
+    device.store(&d.state(), __ATOMIC_RELEASE);
 }
 
-Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_least) {
+// The calling thread's home shard if its lock is free, else the next free
+// one, else (all busy) the home shard once it is free. Returned locked.
+Shard& PoolAllocator::Impl::lock_shard() noexcept {
+#if VKRC_IS_MULTI_THREAD
+    if (shard_count > 1) {
+        const std::uint32_t home = thread_number() % shard_count;
+        for (std::uint32_t i = 0; i < shard_count; ++i) {
+            Shard& s = shards[(home + i) % shard_count];
+            if (s.mutex.try_lock()) return s;
+        }
+        shards[home].mutex.lock();
+        return shards[home];
+    }
+#endif
+    shards[0].mutex.lock();
+    return shards[0];
+}
+
+// Counts one more VkDeviceMemory, or throws when the device allows no more.
+void PoolAllocator::Impl::count_memory_object(DeviceView d) {
+    if (memory_objects.fetch_add(1, __ATOMIC_RELAXED) >= d.limits().maxMemoryAllocationCount) {
+        memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
+        throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
+    }
+}
+
+Block& PoolAllocator::Impl::new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least) {
     const auto& props = d.memory_properties();
     const VkDeviceSize heap_size = props.memoryHeaps[heap_of[pool.memory_type]].size;
     // Small heaps get blocks of at most an eighth of the heap.
@@ -233,11 +311,11 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
     VkDeviceSize size = std::min(info.min_block_size, max_size);
     while (size < max_size && size * 2 <= reserved / 4) size *= 2;
     size = std::max(size, at_least);
-    if (memory_objects >= d.limits().maxMemoryAllocationCount)
-        throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
     auto block = std::make_unique<Block>();
-    Node* node = nodes.make();
+    count_memory_object(d);
+    Node* node = nullptr;
     try {
+        node = shard.nodes.make();
         pool.blocks.reserve(pool.blocks.size() + 1);
         try {
             block->memory = detail::allocate_device_memory(d, size, pool.memory_type, VK_NULL_HANDLE, VK_NULL_HANDLE,
@@ -253,10 +331,11 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
                                                            pool.device_address, &block->mapped);
         }
     } catch (...) {
-        nodes.recycle(node);
+        if (node) shard.nodes.recycle(node);
+        memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
         throw;
     }
-    stats.vk_allocate_calls += 1;
+    shard.stats.vk_allocate_calls += 1;
     block->size = size;
     block->pool = &pool;
     node->size = size;
@@ -264,21 +343,20 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Pool& pool, VkDeviceSize at_
     block->first = node;
     pool.insert_free(node);
     pool.blocks.push_back(block.get());
-    memory_objects += 1;
-    detail::add_block(heap(pool.memory_type), size);
+    detail::add_block(heap(shard, pool.memory_type), size);
     return *block.release();
 }
 
-void PoolAllocator::Impl::free_block(DeviceView d, Pool& pool, Block& block) noexcept {
+void PoolAllocator::Impl::free_block(DeviceView d, Shard& shard, Pool& pool, Block& block) noexcept {
     for (Node* n = block.first; n;) {
         Node* next = n->next_phys;
         if (n->free) pool.remove_free(n);
-        nodes.recycle(n);
+        shard.nodes.recycle(n);
         n = next;
     }
     d.fn().vkFreeMemory(d.vk(), block.memory, nullptr);
-    detail::remove_block(heap(pool.memory_type), block.size);
-    memory_objects -= 1;
+    detail::remove_block(heap(shard, pool.memory_type), block.size);
+    memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
     std::erase(pool.blocks, &block);
     delete &block;
 }
@@ -287,15 +365,24 @@ PoolAllocator::PoolAllocator(const PoolAllocatorCreateInfo& info) : impl_(nullpt
     if (info.min_block_size == 0 || info.max_block_size < info.min_block_size) {
         throw UsageError("vkrc::PoolAllocator: min_block_size must be non-zero and at most max_block_size");
     }
-    impl_ = new Impl;  // nothing below throws
-    impl_->info = info;
-    if (impl_->info.dedicated_threshold == 0) impl_->info.dedicated_threshold = info.max_block_size / 2;
+    if (info.shards > max_pool_shards) {
+        throw UsageError("vkrc::PoolAllocator: shards is " + std::to_string(info.shards) + ", more than " +
+                         std::to_string(max_pool_shards));
+    }
+    auto impl = std::make_unique<Impl>();
+    impl->info = info;
+    if (impl->info.dedicated_threshold == 0) impl->info.dedicated_threshold = info.max_block_size / 2;
+    impl->shard_count = resolve_shards(info.shards);
+    impl->shards = std::make_unique<Shard[]>(impl->shard_count);
+    impl_ = impl.release();
 }
 
 PoolAllocator::~PoolAllocator() {
-    if (impl_->device) release(DeviceView(*impl_->device));
+    if (detail::DeviceState* d = impl_->device.load(__ATOMIC_ACQUIRE)) release(DeviceView(*d));
     delete impl_;
 }
+
+std::uint32_t PoolAllocator::shard_count() const noexcept { return impl_->shard_count; }
 
 AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& request) {
     constexpr const char* who = "vkrc::PoolAllocator::allocate";
@@ -303,7 +390,6 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     const std::uint32_t type = choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, who);
     detail::check_request(d, request, type, who);
     auto& m = *impl_;
-    LockGuard lock(m.mutex);
     m.bind(d, who);
 
     AllocationInfo info;
@@ -314,27 +400,36 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     const bool dedicated = request.requires_dedicated || request.prefers_dedicated || request.intent.dedicated ||
                            request.requirements.size > m.info.dedicated_threshold;
     if (dedicated) {
-        if (m.memory_objects >= d.limits().maxMemoryAllocationCount) {
-            throw Error(VK_ERROR_TOO_MANY_OBJECTS, "vkAllocateMemory");
+        // No shard's lock is held while the driver allocates.
+        m.count_memory_object(d);
+        try {
+            info.memory = detail::allocate_device_memory(d, info.size, type, request.dedicated_buffer,
+                                                         request.dedicated_image, request.device_address, &info.mapped);
+        } catch (...) {
+            m.memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
+            throw;
         }
-        info.memory = detail::allocate_device_memory(d, info.size, type, request.dedicated_buffer,
-                                                     request.dedicated_image, request.device_address, &info.mapped);
         info.memory_size = info.size;
         info.dedicated = true;
-        m.stats.vk_allocate_calls += 1;
-        m.memory_objects += 1;
-        detail::add_block(m.heap(type), info.size);
-        detail::add_range(m.heap(type), info.size);
+        Shard& shard = m.lock_shard();
+        ShardLock lock(shard);
+        info.allocator_data = &shard;  // whose statistics count it
+        shard.stats.vk_allocate_calls += 1;
+        detail::add_block(m.heap(shard, type), info.size);
+        detail::add_range(m.heap(shard, type), info.size);
         return info;
     }
 
+    Shard& shard = m.lock_shard();
+    ShardLock lock(shard);
     const VkDeviceSize unit = m.units[type];
     const VkDeviceSize size = detail::align_up(request.requirements.size, unit);
     const VkDeviceSize alignment = std::max<VkDeviceSize>(request.requirements.alignment, unit);
     const bool separate = m.granularity > Impl::max_rounded_granularity && !request.linear;
-    auto& slot = m.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
+    auto& slot = shard.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
     if (!slot) {
         slot = std::make_unique<Pool>();
+        slot->shard = &shard;
         slot->memory_type = type;
         slot->device_address = request.device_address;
     }
@@ -345,19 +440,19 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     const VkDeviceSize padded = size + (alignment - unit);
     Node* node = pool.find_in_class(size, alignment);
     if (!node) node = pool.find(padded);
-    if (!node) node = m.new_block(d, pool, padded).first;
+    if (!node) node = m.new_block(d, shard, pool, padded).first;
     // Take the nodes the split needs first, so nothing changes if that throws.
     Node* front = nullptr;
     Node* back = nullptr;
     const VkDeviceSize start = detail::align_up(node->offset, alignment);
     const VkDeviceSize front_size = start - node->offset;
     const VkDeviceSize back_size = node->size - front_size - size;
-    if (front_size) front = m.nodes.make();
+    if (front_size) front = shard.nodes.make();
     if (back_size) {
         try {
-            back = m.nodes.make();
+            back = shard.nodes.make();
         } catch (...) {
-            if (front) m.nodes.recycle(front);
+            if (front) shard.nodes.recycle(front);
             throw;
         }
     }
@@ -394,7 +489,7 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
     info.memory_size = block.size;
     info.mapped = block.mapped ? block.mapped + start : nullptr;
     info.allocator_data = node;
-    detail::add_range(m.heap(type), size);
+    detail::add_range(m.heap(shard, type), size);
     return info;
 }
 
@@ -403,31 +498,38 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
         throw UsageError("vkrc::PoolAllocator::free: the allocation was made by another allocator");
     }
     auto& m = *impl_;
-    LockGuard lock(m.mutex);
-    if (m.device != &d.state()) throw UsageError("vkrc::PoolAllocator::free: this PoolAllocator serves another device");
-    auto& h = m.heap(allocation.memory_type);
+    if (m.device.load(__ATOMIC_ACQUIRE) != &d.state()) {
+        throw UsageError("vkrc::PoolAllocator::free: this PoolAllocator serves another device");
+    }
     if (allocation.dedicated) {
         d.fn().vkFreeMemory(d.vk(), allocation.memory, nullptr);
+        m.memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
+        Shard& shard = *static_cast<Shard*>(allocation.allocator_data);
+        LockGuard lock(shard.mutex);
+        auto& h = m.heap(shard, allocation.memory_type);
         detail::remove_block(h, allocation.size);
         detail::remove_range(h, allocation.size);
-        m.memory_objects -= 1;
         return;
     }
+    // The range's node and block do not change while it is allocated, so
+    // its shard can be read before taking that shard's lock.
     Node* node = static_cast<Node*>(allocation.allocator_data);
     Block& block = *node->block;
     Pool& pool = *block.pool;
-    detail::remove_range(h, node->size);
+    Shard& shard = *pool.shard;
+    LockGuard lock(shard.mutex);
+    detail::remove_range(m.heap(shard, allocation.memory_type), node->size);
     block.allocations -= 1;
 
     // Merge with the free neighbours on both sides.
     if (Node* prev = node->prev_phys; prev && prev->free) {
         pool.remove_free(prev);
-        merge_next_into(prev, m.nodes);
+        merge_next_into(prev, shard.nodes);
         node = prev;
     }
     if (Node* next = node->next_phys; next && next->free) {
         pool.remove_free(next);
-        merge_next_into(node, m.nodes);
+        merge_next_into(node, shard.nodes);
     }
     pool.insert_free(node);
 
@@ -435,7 +537,7 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
         // Keep one empty block per pool as a spare; release any other (the smaller).
         for (Block* other : pool.blocks) {
             if (other != &block && other->allocations == 0) {
-                m.free_block(d, pool, other->size <= block.size ? *other : block);
+                m.free_block(d, shard, pool, other->size <= block.size ? *other : block);
                 break;
             }
         }
@@ -444,23 +546,36 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
 
 void PoolAllocator::release(DeviceView d) noexcept {
     auto& m = *impl_;
-    LockGuard lock(m.mutex);
-    if (m.device != &d.state()) return;
-    for (auto& pool : m.pools) {
-        if (!pool) continue;
-        while (!pool->blocks.empty()) m.free_block(d, *pool, *pool->blocks.back());
-        pool.reset();
+    LockGuard bind_lock(m.bind_mutex);
+    if (m.device.load(__ATOMIC_ACQUIRE) != &d.state()) return;
+    for (std::uint32_t i = 0; i < m.shard_count; ++i) {
+        Shard& shard = m.shards[i];
+        LockGuard lock(shard.mutex);
+        for (auto& pool : shard.pools) {
+            if (!pool) continue;
+            while (!pool->blocks.empty()) m.free_block(d, shard, *pool, *pool->blocks.back());
+            pool.reset();
+        }
+        shard.stats = {};
     }
-    m.stats = {};
-    m.memory_objects = 0;
-    m.device = nullptr;
+    m.memory_objects.store(0, __ATOMIC_RELAXED);
+    m.device.store(nullptr, __ATOMIC_RELEASE);
 }
 
 AllocatorStatistics PoolAllocator::statistics(DeviceView d) const {
     AllocatorStatistics stats;
-    {
-        LockGuard lock(impl_->mutex);
-        stats = impl_->stats;
+    for (std::uint32_t i = 0; i < impl_->shard_count; ++i) {
+        Shard& shard = impl_->shards[i];
+        LockGuard lock(shard.mutex);
+        stats.vk_allocate_calls += shard.stats.vk_allocate_calls;
+        for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h) {
+            const HeapStatistics& from = shard.stats.heaps[h];
+            HeapStatistics& to = stats.heaps[h];
+            to.block_bytes += from.block_bytes;
+            to.allocation_bytes += from.allocation_bytes;
+            to.block_count += from.block_count;
+            to.allocation_count += from.allocation_count;
+        }
     }
     fill_budget(d, stats);
     return stats;

@@ -4,11 +4,14 @@
 
 #include <vkrc/upload.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <latch>
 #include <limits>
 #include <memory>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -709,12 +712,133 @@ TEST_F(PoolTest, AdoptedBuffersAndImages) {
     EXPECT_THROW(vkrc::Image::adopt(device, VK_NULL_HANDLE, info, vkrc::Ownership::borrowed), vkrc::UsageError);
 }
 
+TEST_F(PoolTest, ShardsAreCheckedAndResolved) {
+    vkrc::PoolAllocatorCreateInfo info;
+    info.shards = vkrc::max_pool_shards + 1;
+    try {
+        vkrc::PoolAllocator pool(info);
+        ADD_FAILURE() << "no throw";
+    } catch (const vkrc::UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("shards"), std::string::npos) << e.what();
+    }
+    info.shards = 3;
+    EXPECT_EQ(vkrc::PoolAllocator(info).shard_count(), VKRC_IS_MULTI_THREAD ? 3u : 1u);
+    info.shards = 0;
+    const auto resolved = vkrc::PoolAllocator(info).shard_count();
+    EXPECT_GE(resolved, 1u);
+    EXPECT_LE(resolved, VKRC_IS_MULTI_THREAD ? 8u : 1u);
+}
+
 #if VKRC_IS_MULTI_THREAD
+// Runs body(t) on thread_count threads at once.
+template <class Body>
+void on_threads(int thread_count, Body body) {
+    std::vector<std::thread> threads;
+    for (int t = 0; t < thread_count; ++t) threads.emplace_back(body, t);
+    for (auto& th : threads) th.join();
+}
+
+// Eight threads allocate and free at once through a pool of four shards,
+// then each frees another's ranges; the statistics must count exactly the
+// live ranges throughout, and only one spare block per shard may remain.
+TEST_F(PoolTest, ShardedConcurrentAllocateAndFree) {
+    auto info = small_blocks();
+    info.shards = 4;
+    vkrc::PoolAllocator pool(info);
+    ASSERT_EQ(pool.shard_count(), 4u);
+    constexpr int thread_count = 8;
+    std::vector<std::vector<vkrc::AllocationInfo>> live(thread_count);
+    on_threads(thread_count, [&](int t) {
+        std::mt19937 rng(static_cast<unsigned>(t));
+        auto& mine = live[static_cast<std::size_t>(t)];
+        for (int i = 0; i < 1000; ++i) {
+            if (mine.size() < 24 && (rng() % 3 != 0 || mine.empty())) {
+                // Now and then one above dedicated_threshold.
+                const VkDeviceSize size = rng() % 40 == 0 ? 2 * MiB : 64 + rng() % 100000;
+                mine.push_back(pool.allocate(view(), request(size, VkDeviceSize{1} << (rng() % 10))));
+            } else {
+                const auto k = static_cast<std::ptrdiff_t>(rng() % mine.size());
+                pool.free(view(), mine[static_cast<std::size_t>(k)]);
+                mine.erase(mine.begin() + k);
+            }
+        }
+    });
+    std::vector<vkrc::AllocationInfo> all;
+    for (auto& mine : live) all.insert(all.end(), mine.begin(), mine.end());
+    std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) {
+        return x.memory != y.memory ? x.memory < y.memory : x.offset < y.offset;
+    });
+    VkDeviceSize bytes = 0;
+    std::set<VkDeviceMemory> memories;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+        bytes += all[i].size;
+        memories.insert(all[i].memory);
+        if (i > 0 && all[i].memory == all[i - 1].memory) {
+            EXPECT_LE(all[i - 1].offset + all[i - 1].size, all[i].offset) << "overlapping ranges";
+        }
+    }
+    auto total = pool.statistics(view()).total();
+    EXPECT_EQ(total.allocation_count, all.size());
+    EXPECT_GE(total.allocation_bytes, bytes);
+    // Every block in use holds a live range; a spare per shard may be empty.
+    EXPECT_GE(total.block_count, memories.size());
+    EXPECT_LE(total.block_count, memories.size() + pool.shard_count());
+
+    on_threads(thread_count, [&](int t) {
+        for (auto& a : live[static_cast<std::size_t>((t + 1) % thread_count)]) pool.free(view(), a);
+    });
+    total = pool.statistics(view()).total();
+    EXPECT_EQ(total.allocation_count, 0u);
+    EXPECT_EQ(total.allocation_bytes, 0u);
+    EXPECT_LE(total.block_count, pool.shard_count());
+    EXPECT_EQ(total.block_bytes, total.block_count * MiB);
+    EXPECT_GE(pool.statistics(view()).vk_allocate_calls, memories.size());
+    pool.release(view());
+    EXPECT_EQ(pool.statistics(view()).total().block_count, 0u);
+}
+
+// A range freed by another thread goes back to the shard that made it: the
+// maker's next range is the same one, and the other thread's shard has a
+// block of its own.
+TEST_F(PoolTest, FreeFromAnotherThreadGoesBackToItsShard) {
+    auto info = small_blocks();
+    info.shards = 2;
+    vkrc::PoolAllocator pool(info);
+    vkrc::AllocationInfo a, b, again;
+    std::latch a_made(1), a_freed(1);
+    std::thread maker([&] {
+        a = pool.allocate(view(), request(4096));
+        a_made.count_down();
+        a_freed.wait();
+        again = pool.allocate(view(), request(4096));
+    });
+    a_made.wait();
+    // The next thread to allocate gets the other home shard.
+    std::thread other([&] {
+        b = pool.allocate(view(), request(4096));
+        pool.free(view(), a);
+    });
+    other.join();
+    a_freed.count_down();
+    maker.join();
+    EXPECT_NE(b.memory, a.memory);
+    EXPECT_EQ(again.memory, a.memory);
+    EXPECT_EQ(again.offset, a.offset);
+    const auto stats = pool.statistics(view());
+    EXPECT_EQ(stats.vk_allocate_calls, 2u);
+    EXPECT_EQ(stats.total().block_count, 2u);
+    EXPECT_EQ(stats.total().allocation_count, 2u);
+    pool.free(view(), again);
+    pool.free(view(), b);
+    pool.release(view());
+}
+
 // Eight threads allocate and free at once through one pool (run under TSan).
 TEST_F(PoolTest, ConcurrentAllocateAndFree) {
     vkrc::PoolAllocatorCreateInfo info;
     info.min_block_size = 1 * MiB;
     info.max_block_size = 4 * MiB;
+    info.shards = 4;
     auto pool = vkrc::make_allocator<vkrc::PoolAllocator>(info);
     std::vector<std::thread> threads;
     for (int t = 0; t < 8; ++t) {
@@ -737,7 +861,7 @@ TEST_F(PoolTest, ConcurrentAllocateAndFree) {
     for (auto& th : threads) th.join();
     const auto total = pool->statistics(view()).total();
     EXPECT_EQ(total.allocation_count, 0u);
-    EXPECT_LE(total.block_count, 1u);
+    EXPECT_LE(total.block_count, pool->shard_count());  // a spare per shard at most
 }
 #endif
 

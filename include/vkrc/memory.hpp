@@ -177,14 +177,31 @@ struct PoolAllocatorCreateInfo {
     VkDeviceSize max_block_size = VkDeviceSize{256} << 20;
     // Requests larger than this get their own VkDeviceMemory; 0: max_block_size / 2.
     VkDeviceSize dedicated_threshold = 0;
+    // Independent parts (each with its own lock, blocks and spare block) that
+    // threads allocating at once spread over, so that they do not queue on
+    // one lock. 0: min(8, hardware threads) under the multi-thread policy;
+    // 1: one lock for everything (the least memory reserved). At most
+    // max_pool_shards. The single-thread policy always has one.
+    std::uint32_t shards = 0;
 };
+
+inline constexpr std::uint32_t max_pool_shards = 64;
 
 // Sub-allocates from large blocks per memory type with TLSF (constant-time
 // good fit, freed neighbours merged); host-visible blocks stay mapped;
-// empty blocks are released keeping at most one spare per memory type; its
-// own VkDeviceMemory count stays within maxMemoryAllocationCount. The
-// device's default allocator. Serves one device at a time; used directly
+// empty blocks are released keeping at most one spare per memory type and
+// shard; its own VkDeviceMemory count stays within maxMemoryAllocationCount.
+// The device's default allocator. Serves one device at a time; used directly
 // (not through Allocation), call release() before that device goes.
+//
+// Under the multi-thread policy it is split into shards (see
+// PoolAllocatorCreateInfo::shards). Each thread has a home shard; allocate()
+// takes the first free lock starting there, waiting on the home shard only
+// when all are held, and free() goes back to the shard that made the range,
+// from any thread. Shards share no blocks, so the memory trade-off is: with
+// threads allocating at once, up to shard count x block size may be
+// reserved per memory type (a partly used block and a spare in each shard)
+// where one shard would reserve one block's worth.
 class PoolAllocator final : public DeviceAllocator {
 public:
     explicit PoolAllocator(const PoolAllocatorCreateInfo& info = {});
@@ -196,6 +213,8 @@ public:
     void free(DeviceView device, const AllocationInfo& allocation) override;
     void release(DeviceView device) noexcept override;
     AllocatorStatistics statistics(DeviceView device) const override;
+    // The number of shards in use (PoolAllocatorCreateInfo::shards resolved).
+    std::uint32_t shard_count() const noexcept;
 
     struct Impl;
 
