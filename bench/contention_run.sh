@@ -25,28 +25,8 @@ name=${3:-}
 processes=${4:-3}
 shift $(($# < 4 ? $# : 4))
 args=("$@")
-contention="$build/bench/contention"
-[ -x "$contention" ] || { echo "contention_run.sh: no $contention (build the contention target first)" >&2; exit 1; }
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
 bench_start "$build" "$out"
-
-command="bench/contention${args[*]:+ ${args[*]}} --csv FILE"
-body="$out/tmp-contention-body.csv"
-: >"$body"
-device=""
-for p in $(seq 1 "$processes"); do
-  echo "== $command (process $p of $processes)" >&2
-  "$contention" "${args[@]}" --csv "$out/tmp-contention.csv" | tee "$out/tmp-contention.log"
-  [ -n "$device" ] || device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$out/tmp-contention.log" | head -1)
-  [ -s "$body" ] || head -1 "$out/tmp-contention.csv" | sed 's/^/process,/' >"$body"
-  tail -n +2 "$out/tmp-contention.csv" | sed "s/^/$p,/" >>"$body"
-done
-prefix=$(bench_prefix "$name" "$device")
-{
-  bench_csv_header "$device" "$command, $processes processes (Release build)"
-  cat "$body"
-} >"$out/$prefix-contention.csv"
-rm -f "$body" "$out/tmp-contention.csv" "$out/tmp-contention.log"
-echo "wrote $out/$prefix-contention.csv" >&2
+bench_processes "$build" "$out" "$name" contention "$processes" "${args[@]}"

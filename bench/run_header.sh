@@ -55,3 +55,31 @@ bench_csv_header() {
   echo "# git: $revision"
   echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 }
+
+# Runs PROGRAM (BUILD/bench/KIND) PROCESSES times with ARGS, each time into a
+# CSV whose rows get a leading process column, and writes them as one results
+# file OUT/PREFIX-KIND.csv headed by bench_csv_header. Needs bench_start first.
+#   bench_processes BUILD OUT NAME KIND PROCESSES ARGS...
+bench_processes() {
+  local build=$1 out=$2 name=$3 kind=$4 processes=$5
+  shift 5
+  local program="$build/bench/$kind" command="bench/$kind${*:+ $*} --csv FILE"
+  [ -x "$program" ] || { echo "$kind: no $program (build the $kind target first)" >&2; exit 1; }
+  local body="$out/tmp-$kind-body.csv" csv="$out/tmp-$kind.csv" log="$out/tmp-$kind.log" device="" p
+  : >"$body"
+  for p in $(seq 1 "$processes"); do
+    echo "== $command (process $p of $processes)" >&2
+    "$program" "$@" --csv "$csv" | tee "$log"
+    [ -n "$device" ] || device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$log" | head -1)
+    [ -s "$body" ] || head -1 "$csv" | sed 's/^/process,/' >"$body"
+    tail -n +2 "$csv" | sed "s/^/$p,/" >>"$body"
+  done
+  local prefix
+  prefix=$(bench_prefix "$name" "$device")
+  {
+    bench_csv_header "$device" "$command, $processes processes (Release build)"
+    cat "$body"
+  } >"$out/$prefix-$kind.csv"
+  rm -f "$body" "$csv" "$log"
+  echo "wrote $out/$prefix-$kind.csv" >&2
+}

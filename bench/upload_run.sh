@@ -25,27 +25,8 @@ processes=${4:-3}
 shift $(($# < 4 ? $# : 4))
 args=("$@")
 [ ${#args[@]} -gt 0 ] || args=(--blocks 3 --reps 1000)
-upload="$build/bench/upload"
-[ -x "$upload" ] || { echo "upload_run.sh: no $upload (build the upload target first)" >&2; exit 1; }
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
 bench_start "$build" "$out"
-
-body="$out/tmp-upload-body.csv"
-: >"$body"
-device=""
-for p in $(seq 1 "$processes"); do
-  echo "== bench/upload ${args[*]} --csv FILE (process $p of $processes)" >&2
-  "$upload" "${args[@]}" --csv "$out/tmp-upload.csv" | tee "$out/tmp-upload.log"
-  [ -n "$device" ] || device=$(sed -n 's/^device: \([^;]*\);.*/\1/p' "$out/tmp-upload.log" | head -1)
-  [ -s "$body" ] || head -1 "$out/tmp-upload.csv" | sed 's/^/process,/' >"$body"
-  tail -n +2 "$out/tmp-upload.csv" | sed "s/^/$p,/" >>"$body"
-done
-prefix=$(bench_prefix "$name" "$device")
-{
-  bench_csv_header "$device" "bench/upload ${args[*]} --csv FILE, $processes processes (Release build)"
-  cat "$body"
-} >"$out/$prefix-upload.csv"
-rm -f "$body" "$out/tmp-upload.csv" "$out/tmp-upload.log"
-echo "wrote $out/$prefix-upload.csv" >&2
+bench_processes "$build" "$out" "$name" upload "$processes" "${args[@]}"
