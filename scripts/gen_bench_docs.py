@@ -19,6 +19,7 @@ import argparse
 import csv
 import glob
 import io
+import math
 import os
 import re
 import sys
@@ -182,6 +183,11 @@ def verdict(low, high, goal):
     return "met" if low >= goal else "not met" if high < goal else "not resolved"
 
 
+def overall_verdict(verdicts):
+    """Several cells of one goal: not met if any is, met if all are, else not resolved."""
+    return "not met" if "not met" in verdicts else "met" if set(verdicts) == {"met"} else "not resolved"
+
+
 def threads_goals(rows, teapots):
     """The goals of issue 17 read off one configuration's command rows."""
     get = {(threads(x), x["variant"]): x for x in rows}
@@ -197,7 +203,7 @@ def threads_goals(rows, teapots):
             low, high = 1 / float(x["ref_ci_high"]), 1 / float(x["ref_ci_low"])
             verdicts.append(verdict(low, high, THREADS_THROUGHPUT_GOAL))
             cells.append(f"{n}: {1 / float(x['ratio_to_ref']):.3f} [{low:.3f}, {high:.3f}] {verdicts[-1]}")
-        overall = ("not met" if "not met" in verdicts else "met" if set(verdicts) == {"met"} else "not resolved")
+        overall = overall_verdict(verdicts)
         out.append(f"Goal: vkrc-mt's recording throughput at least {THREADS_THROUGHPUT_GOAL}x raw-direct's at every "
                    f"thread count (throughput ratio [95 % CI], met or not met only when the interval clears the "
                    f"goal): {'; '.join(cells)}: **{overall}**.")
@@ -459,12 +465,21 @@ def upload_stats(rows, upload, variant, column):
     return median, values[0], values[-1], n
 
 
-def upload_ratio(rows, upload, a, b):
-    # Per (process, block) ratio of throughputs: the variants of a block run back to back.
+def upload_ratios(rows, upload, a, b):
+    """Per (process, block) ratios of throughputs, sorted: the variants of a block run back to back."""
     get = {(x["process"], x["block"], x["variant"]): float(x["gb_per_s"]) for x in rows if x["upload"] == upload}
-    ratios = sorted(get[(p, k, a)] / get[(p, k, b)] for (p, k, v) in get if v == a and (p, k, b) in get)
-    n = len(ratios)
-    return (ratios[n // 2] if n % 2 else (ratios[n // 2 - 1] + ratios[n // 2]) / 2), ratios[0], ratios[-1]
+    return sorted(get[(p, k, a)] / get[(p, k, b)] for (p, k, v) in get if v == a and (p, k, b) in get)
+
+
+def upload_ratio(rows, upload, a, b):
+    ratios = upload_ratios(rows, upload, a, b)
+    return median(ratios), ratios[0], ratios[-1]
+
+
+def upload_goal(rows, upload, a, b, goal):
+    """'median [95 % CI]: verdict' of a ratio goal over the blocks of every process."""
+    m, low, high = median_ci(upload_ratios(rows, upload, a, b))
+    return f"{m:.3f} [{low:.3f}, {high:.3f}]", verdict(low, high, goal)
 
 
 def upload_section(pattern, pending):
@@ -500,12 +515,14 @@ def upload_section(pattern, pending):
             out.append(f"| {u} | {raw[0]:.3f} [{raw[1]:.3f}, {raw[2]:.3f}] | "
                        f"{blocking[0]:.2f} [{blocking[1]:.2f}, {blocking[2]:.2f}] |" +
                        (f" {aa[0]:.3f} [{aa[1]:.3f}, {aa[2]:.3f}] |" if control else ""))
-        raw_all = [upload_ratio(rows, u, "vkrc-stream", "raw-stream")[0] for u in uploads]
-        small = upload_ratio(rows, uploads[0], "vkrc-stream", "vkrc-blocking")[0]
-        out += ["", f"Goals: vkrc-stream at least {UPLOAD_RAW_GOAL}x raw-stream's throughput (median ratios "
-                f"{', '.join(f'{v:.3f}' for v in raw_all)}: **{'met' if min(raw_all) >= UPLOAD_RAW_GOAL else 'not met'}**"
-                f"); at least {UPLOAD_BLOCKING_GOAL:.0f}x vkrc-blocking for {uploads[0]} ({small:.2f}x: "
-                f"**{'met' if small >= UPLOAD_BLOCKING_GOAL else 'not met'}**).", ""]
+        raw = [upload_goal(rows, u, "vkrc-stream", "raw-stream", UPLOAD_RAW_GOAL) for u in uploads]
+        small = upload_goal(rows, uploads[0], "vkrc-stream", "vkrc-blocking", UPLOAD_BLOCKING_GOAL)
+        out += ["", "Goals (the median ratio of the blocks with its 95 % confidence interval, order statistics over "
+                "the blocks of every process; met or not met only when the interval clears the goal): vkrc-stream "
+                f"at least {UPLOAD_RAW_GOAL}x raw-stream's throughput ("
+                f"{'; '.join(f'{u}: {text} {v}' for u, (text, v) in zip(uploads, raw))}: "
+                f"**{overall_verdict([v for _, v in raw])}**); at least {UPLOAD_BLOCKING_GOAL:.0f}x vkrc-blocking "
+                f"for {uploads[0]} ({small[0]}: **{small[1]}**).", ""]
     return out[:-1]
 
 
@@ -518,6 +535,22 @@ def median(values):
     v = sorted(values)
     n = len(v)
     return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
+
+
+def median_ci(values, confidence=0.95):
+    """The median and a distribution-free confidence interval for it: the order statistics k and n + 1 - k
+    (1-based) with k the largest rank whose binomial tail P(Bin(n, 1/2) < k) stays within (1 - confidence) / 2.
+    Below 6 values no such k exists and the interval is the whole range."""
+    v = sorted(values)
+    n = len(v)
+    k, tail = 0, 0.0
+    while True:
+        tail += math.comb(n, k) / 2 ** n
+        if tail > (1 - confidence) / 2:
+            break
+        k += 1
+    k = max(k, 1)
+    return median(v), v[k - 1], v[n - k]
 
 
 def contention_runs(pattern):
@@ -548,17 +581,16 @@ def contention_goal(r):
     ratios = contention_ratios(rows, CONTENTION_GOAL_CASE, str(CONTENTION_GOAL_THREADS))
     if not ratios:
         return f"not measured ({CONTENTION_GOAL_THREADS} threads or {CONTENTION_GOAL_CASE} missing)"
-    text = f"{CONTENTION_GOAL_CASE} at {CONTENTION_GOAL_THREADS} threads: {interval(ratios)}x the 1-thread rate"
+    m, low, high = median_ci(ratios)
+    text = (f"{CONTENTION_GOAL_CASE} at {CONTENTION_GOAL_THREADS} threads: {m:.2f}x the 1-thread rate (95 % "
+            f"confidence interval of the median over the blocks [{low:.2f}, {high:.2f}]; range {ratios[0]:.2f} to "
+            f"{ratios[-1]:.2f})")
     cpus = host_cpus(r)
-    if ratios[0] >= CONTENTION_GOAL:
-        verdict = "met"
-    elif ratios[-1] < CONTENTION_GOAL:
-        verdict = "not met"
-    else:
-        verdict = "not resolved (the interval straddles the goal)"
+    v = verdict(low, high, CONTENTION_GOAL)
+    verdict_text = v + (" (the interval straddles the goal)" if v == "not resolved" else "")
     note = (f" This host has {cpus} CPUs: {CONTENTION_GOAL_THREADS} threads cannot all run at once, so it cannot "
             "show the goal whatever the allocator does." if 0 < cpus < CONTENTION_GOAL_THREADS else "")
-    return f"{text}: **{verdict}** here.{note}"
+    return f"{text}: **{verdict_text}** here.{note}"
 
 
 def contention_lock(r):
