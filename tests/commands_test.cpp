@@ -16,7 +16,7 @@ namespace {
 
 using vkrc_test::VulkanTest;
 using OneShot = vkrc_test::OneShotCommands;
-using Rgba = std::array<std::uint8_t, 4>;
+using vkrc_test::Rgba;
 constexpr VkFormat rgba8 = VK_FORMAT_R8G8B8A8_UNORM;
 
 struct RectPush {

@@ -21,7 +21,7 @@ using vkrc_test::VulkanTest;
 constexpr std::uint32_t size = 64;
 constexpr VkFormat color_format = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;
-using Rgba = std::array<std::uint8_t, 4>;
+using vkrc_test::Rgba;
 
 std::uint32_t pattern(std::uint32_t i, std::uint32_t seed) { return (i * 2654435761u) ^ seed; }
 

@@ -7,6 +7,18 @@
 
 namespace vkrc_test {
 
+::testing::AssertionResult within_one(const Rgba& actual, const Rgba& expected) {
+    for (std::size_t c = 0; c < actual.size(); ++c) {
+        if (std::abs(int(actual[c]) - int(expected[c])) > 1) {
+            return ::testing::AssertionFailure()
+                   << "pixel {" << int(actual[0]) << ", " << int(actual[1]) << ", " << int(actual[2]) << ", "
+                   << int(actual[3]) << "} differs by more than one in channel " << c << " from {" << int(expected[0])
+                   << ", " << int(expected[1]) << ", " << int(expected[2]) << ", " << int(expected[3]) << "}";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
 std::size_t ValidationLog::take_expected(const std::string& id) {
     std::lock_guard lock(mutex_);
     std::size_t before = messages_.size();

@@ -6,12 +6,22 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
 
 namespace vkrc_test {
+
+// One RGBA8 pixel as read back from an image.
+using Rgba = std::array<std::uint8_t, 4>;
+
+// Whether every channel of actual is within one of expected: a blend or a
+// conversion whose exact result is halfway (0.5 of 255) may round either way
+// (NVIDIA gives 127 where lavapipe gives 128).
+::testing::AssertionResult within_one(const Rgba& actual, const Rgba& expected);
 
 // Collects validation messages from any thread.
 class ValidationLog {
