@@ -9,10 +9,14 @@ vary run to run by a few percent, so only the part outside it is compared).
   absolute stages (--absolute): the extra instructions per call, at most ABS.
 
 One --budget VARIANT:PCT:ABS per variant checked (the issue's targets). A
-stage that does not meet its target yet is held at a measured limit with
---hold VARIANT:STAGE:LIMIT (same unit as its target), so a regression still
-fails; every held stage is printed as "target not met". Exits 1 listing
-every stage over its limit, 0 when all are within."""
+stage that does not meet its target yet is held with --hold
+VARIANT:STAGE:EXTRA: its extra instructions per call outside the driver may
+not exceed EXTRA, so a regression still fails; every held stage is printed as
+"target not met". A hold counts instructions, not a percentage, because a
+relative stage's denominator (raw-direct's whole stage) includes the driver,
+whose count moves between machines and runs (lavapipe's submit read 868 and
+1 000 for the same calls) while the extra instructions do not. Exits 1
+listing every stage over its limit, 0 when all are within."""
 import argparse
 import csv
 import sys
@@ -20,7 +24,7 @@ import sys
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("csv")
 parser.add_argument("--budget", action="append", required=True, help="VARIANT:PCT:ABS, e.g. vkrc-st:1:8")
-parser.add_argument("--hold", action="append", default=[], help="VARIANT:STAGE:LIMIT for a target not met yet")
+parser.add_argument("--hold", action="append", default=[], help="VARIANT:STAGE:EXTRA (instructions per call) for a target not met yet")
 parser.add_argument("--relative", default="command,submit,wait")
 parser.add_argument("--absolute", default="acquire,uniform,present")
 parser.add_argument("--reference", default="raw-direct")
@@ -50,12 +54,17 @@ for budget in args.budget:
                 value, target, unit = 100 * extra / ref[0], float(pct), "% of the stage"
             else:
                 value, target, unit = extra, float(absolute), " instructions/call"
-            limit = holds.get((variant, stage), target)
-            verdict = "ok" if value <= target else ("target not met, held" if value <= limit else "OVER")
+            hold = holds.get((variant, stage))
+            if value <= target:
+                verdict = "ok"
+            elif hold is not None and extra <= hold:
+                verdict = f"target not met, held at {hold:g} extra/call"
+            else:
+                verdict = "OVER"
+                failures.append(f"{variant} {stage}: {value:.2f}{unit} > {target:g}" +
+                                (f" and {extra:.1f} extra/call > the hold {hold:g}" if hold is not None else ""))
             lines.append(f"{variant:10} {stage:8} extra {extra:8.1f}/call = {value:7.2f}{unit} "
-                         f"(target {target:g}, limit {limit:g}) {verdict}")
-            if value > limit:
-                failures.append(f"{variant} {stage}: {value:.2f}{unit} > {limit:g}")
+                         f"(target {target:g}) {verdict}")
 print("\n".join(lines))
 if failures:
     print("instruction budget FAILED:\n  " + "\n  ".join(failures), file=sys.stderr)
