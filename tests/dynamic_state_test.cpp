@@ -11,8 +11,8 @@
 
 namespace {
 
-using vkrc_test::VulkanTest;
 using vkrc_test::Rgba;
+using vkrc_test::VulkanTest;
 constexpr VkFormat rgba8 = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr std::uint32_t size = 8;
 
@@ -170,9 +170,9 @@ TEST_F(VulkanTest, DynamicStateEveryCoreSetter) {
         return pixels.allocation().read_value<Rgba>((y * size + x) * 4);
     };
     const Rgba black{0, 0, 0, 255}, blended{128, 64, 255, 255}, white{255, 255, 255, 255};
-    EXPECT_EQ(at(1, 1), black);    // culled
+    EXPECT_EQ(at(1, 1), black);                             // culled
     EXPECT_TRUE(vkrc_test::within_one(at(6, 1), blended));  // drawn after the front-face change
-    EXPECT_EQ(at(3, 5), black);    // discarded
+    EXPECT_EQ(at(3, 5), black);                             // discarded
     EXPECT_TRUE(vkrc_test::within_one(at(6, 6), blended));
     EXPECT_EQ(at(0, 7), white);  // the with-count scissor's corner
     EXPECT_EQ(at(3, 7), black);

@@ -21,8 +21,8 @@
 
 namespace {
 
-using vkrc_test::VulkanTest;
 using vkrc_test::Rgba;
+using vkrc_test::VulkanTest;
 constexpr VkFormat rgba8 = VK_FORMAT_R8G8B8A8_UNORM;
 constexpr std::uint32_t size = 8;
 constexpr Rgba black{0, 0, 0, 255};
@@ -334,7 +334,7 @@ TEST_F(VulkanTest, PipelineStatePerAttachmentBlendAndStaticViewports) {
         targets.end(cmd);
     });
     EXPECT_TRUE(vkrc_test::within_one(targets.at(0, 4, 1), Rgba{128, 64, 0, 255}));  // 0.5 blended
-    EXPECT_EQ(targets.at(0, 4, 6), black);  // scissored
+    EXPECT_EQ(targets.at(0, 4, 6), black);                                           // scissored
     EXPECT_EQ(targets.at(1, 4, 1), (Rgba{0, 0, 255, 255}));
 }
 
