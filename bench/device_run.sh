@@ -14,7 +14,8 @@
 # (with alloc built, bench/alloc_run.sh runs too: the allocation results).
 # NAME: the results' file prefix (default: the date and a device slug).
 # FRAMES_25 / FRAMES_2500 (environment) override the frames per run (2500 / 400).
-# CONFIGS (below) picks which runs.
+# CONFIGS (below) picks which runs; VARIANTS (a,b,...) runs only those variants;
+# EXTRA adds teapot arguments to every run (e.g. --size 64x64).
 set -euo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: bench/device_run.sh BUILD_DIR OUT [NAME]" >&2
@@ -34,9 +35,10 @@ run() {  # run FILE-SUFFIX teapot-args...
   local suffix=$1
   shift
   local csv="$out/tmp-$suffix.csv" log="$out/tmp-$suffix.log"
-  local command="bench/teapot --runs ${RUNS:-3} $*"
+  set -- "$@" ${EXTRA:-}
+  local command="bench/teapot --runs ${RUNS:-3}${VARIANTS:+ --variants $VARIANTS} $*"
   echo "== $command" >&2
-  "$teapot" --runs "${RUNS:-3}" "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
+  "$teapot" --runs "${RUNS:-3}" ${VARIANTS:+--variants "$VARIANTS"} "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
   local device
   device=$(awk -F': ' '/^device: / {print $2; exit}' "$log")
   local prefix
@@ -51,12 +53,12 @@ run() {  # run FILE-SUFFIX teapot-args...
 
 # CONFIGS (environment) picks the runs: t25, t2500, threads (the
 # recording-thread scaling of issue 17: 25 000 draws on 1, 2, 4, 8 and 16
-# threads; TEAPOTS_THREADS / FRAMES_THREADS override), alloc. Default: all.
+# threads; TEAPOTS_THREADS / FRAMES_THREADS / THREADS override), alloc. Default: all.
 configs=" ${CONFIGS:-t25 t2500 threads alloc} "
 [[ $configs == *" t25 "* ]] && run t25 --teapots 25 --frames "${FRAMES_25:-2500}"
 [[ $configs == *" t2500 "* ]] && run t2500 --teapots 2500 --frames "${FRAMES_2500:-400}"
 if [[ $configs == *" threads "* ]]; then
-  run "threads-t${TEAPOTS_THREADS:-25000}" --teapots "${TEAPOTS_THREADS:-25000}" --threads 1,2,4,8,16 \
+  run "threads-t${TEAPOTS_THREADS:-25000}" --teapots "${TEAPOTS_THREADS:-25000}" --threads "${THREADS:-1,2,4,8,16}" \
     --frames "${FRAMES_THREADS:-400}"
 fi
 if [[ $configs == *" alloc "* ]]; then
