@@ -252,6 +252,10 @@ TEST_F(VulkanTest, AdoptedCommandBufferRecordsAndIsSubmitted) {
     ASSERT_EQ(fn.vkCreateCommandPool(device.vk(), &info, nullptr, &raw_pool), VK_SUCCESS);
     auto pool = vkrc::CommandPool::adopt(device, raw_pool, queue.family_index(), vkrc::Ownership::borrowed);
     auto target = fill_target(device);
+    const VkCommandBuffer spare = allocate_raw(device, raw_pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    EXPECT_THROW(vkrc::CommandBuffer::adopt(pool, spare, VK_COMMAND_BUFFER_LEVEL_MAX_ENUM, vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    fn.vkFreeCommandBuffers(device.vk(), raw_pool, 1, &spare);
     std::uint32_t value = 0x1000;
     for (const auto ownership : {vkrc::Ownership::owned, vkrc::Ownership::borrowed}) {
         const VkCommandBuffer raw_primary = allocate_raw(device, raw_pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
