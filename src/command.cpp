@@ -35,6 +35,7 @@ CommandBufferState::~CommandBufferState() {
     // Closed first: it holds nothing once gone, but a primary it was
     // executed in may still hold it.
     device.commands.remove(device, window);
+    if (ownership == Ownership::borrowed) return;
     LockGuard lock(p.mutex);
     p.pending.push(device, cmd, serial());
 }
@@ -88,6 +89,29 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
         s->cmd = VK_NULL_HANDLE;
         throw;
     }
+    return CommandBuffer(std::move(s));
+}
+
+CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
+                                   Ownership ownership) {
+    constexpr const char* who = "vkrc::CommandBuffer::adopt";
+    if (!pool) throw UsageError(std::string(who) + ": the CommandPool handle is empty");
+    if (command_buffer == VK_NULL_HANDLE)
+        throw UsageError(std::string(who) + ": the VkCommandBuffer is VK_NULL_HANDLE");
+    if (level != VK_COMMAND_BUFFER_LEVEL_PRIMARY && level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
+        throw UsageError(std::string(who) + ": level " + std::to_string(static_cast<int>(level)) +
+                         " is neither PRIMARY nor SECONDARY");
+    }
+    auto& p = *pool.state();
+    detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
+    s->fn = &p.device.fn();
+    s->pool = pool;
+    s->level = level;
+    s->ownership = ownership;
+    s->window.pool = &p;
+    // Registered like an allocated one, so that drops during its recording are held.
+    p.device.state()->commands.add(s->window);
+    s->cmd = command_buffer;
     return CommandBuffer(std::move(s));
 }
 

@@ -7,6 +7,7 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
+    if (ownership == Ownership::borrowed) return;
     // A push template may be referred to by an open command buffer: the serial holds the drop.
     defer_destroy<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>(*device.state(), update_template, serial());
 }
@@ -15,10 +16,11 @@ DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
 
 namespace {
 
-void check_template_info(const Device& device, const DescriptorUpdateTemplateCreateInfo& info) {
-    constexpr const char* who = "vkrc::DescriptorUpdateTemplate::create";
+// adopt() passes need_entries false: the template exists, its entries are not read.
+void check_template_info(const Device& device, const DescriptorUpdateTemplateCreateInfo& info, const char* who,
+                         bool need_entries) {
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
-    if (info.entries.empty()) throw UsageError(std::string(who) + ": entries is empty");
+    if (need_entries && info.entries.empty()) throw UsageError(std::string(who) + ": entries is empty");
     if (!info.descriptor_set_layout) throw UsageError(std::string(who) + ": descriptor_set_layout is empty");
     if (!(info.descriptor_set_layout.device() == device)) {
         throw UsageError(std::string(who) + ": descriptor_set_layout belongs to another device");
@@ -38,7 +40,7 @@ void check_template_info(const Device& device, const DescriptorUpdateTemplateCre
 
 DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
                                                           const DescriptorUpdateTemplateCreateInfo& info) {
-    check_template_info(device, info);
+    check_template_info(device, info, "vkrc::DescriptorUpdateTemplate::create", true);
     const bool push = info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR;
     VkDescriptorUpdateTemplateCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_UPDATE_TEMPLATE_CREATE_INFO, info.next};
     ci.flags = info.flags;
@@ -61,6 +63,28 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
     }
     check(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &s->update_template),
           "vkCreateDescriptorUpdateTemplate");
+    return DescriptorUpdateTemplate(std::move(s));
+}
+
+DescriptorUpdateTemplate DescriptorUpdateTemplate::adopt(const Device& device,
+                                                         VkDescriptorUpdateTemplate update_template,
+                                                         const DescriptorUpdateTemplateCreateInfo& info,
+                                                         Ownership ownership) {
+    constexpr const char* who = "vkrc::DescriptorUpdateTemplate::adopt";
+    check_template_info(device, info, who, false);
+    if (update_template == VK_NULL_HANDLE) {
+        throw UsageError(std::string(who) + ": the VkDescriptorUpdateTemplate is VK_NULL_HANDLE");
+    }
+    detail::Ref<detail::DescriptorUpdateTemplateState> s(new detail::DescriptorUpdateTemplateState);
+    s->device = device;
+    s->update_template = update_template;
+    s->ownership = ownership;
+    s->type = info.template_type;
+    s->set_layout = info.descriptor_set_layout;
+    if (info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) {
+        s->pipeline_layout = info.pipeline_layout;
+        s->set = info.set;
+    }
     return DescriptorUpdateTemplate(std::move(s));
 }
 

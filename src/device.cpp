@@ -372,6 +372,7 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
                              " queues; asked for " + std::to_string(r.queue_priorities.size()));
         }
         VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        q.pNext = r.next;
         q.queueFamilyIndex = r.queue_family_index;
         q.queueCount = static_cast<std::uint32_t>(r.queue_priorities.size());
         q.pQueuePriorities = r.queue_priorities.data();

@@ -253,6 +253,7 @@ void check_usage_supported(const VkSurfaceCapabilitiesKHR& caps, VkImageUsageFla
 VkSwapchainCreateInfoKHR swapchain_create_info(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR& caps,
                                                VkExtent2D extent) {
     VkSwapchainCreateInfoKHR ci{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+    ci.pNext = s.info.next;
     ci.surface = s.surface.vk();
     ci.minImageCount = choose_image_count(caps, s.info.min_image_count);
     ci.imageFormat = s.surface_format.format;

@@ -217,6 +217,113 @@ TEST_F(VulkanTest, AdoptedCommandPoolAllocatesAndRecords) {
     EXPECT_THROW(vkrc::CommandPool::adopt(device, VK_NULL_HANDLE, 0, vkrc::Ownership::owned), vkrc::UsageError);
 }
 
+// A buffer that transfers fill and the host reads back.
+vkrc::Buffer fill_target(const vkrc::Device& device) {
+    return vkrc::Buffer::create(
+        device,
+        {.size = 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+}
+
+VkMemoryBarrier2 transfer_to_host() {
+    return vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+VkCommandBuffer allocate_raw(const vkrc::Device& device, VkCommandPool pool, VkCommandBufferLevel level) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool;
+    ai.level = level;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer raw = VK_NULL_HANDLE;
+    EXPECT_EQ(device.fn().vkAllocateCommandBuffers(device.vk(), &ai, &raw), VK_SUCCESS);
+    return raw;
+}
+
+// Command buffers allocated with the raw API from a pool made elsewhere: a
+// primary and a secondary record through vkrc and are submitted. Owned, they
+// go back to the pool when dropped; borrowed, their maker frees them (a
+// double free would be reported by the layer).
+TEST_F(VulkanTest, AdoptedCommandBufferRecordsAndIsSubmitted) {
+    const auto& fn = device.fn();
+    VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    info.queueFamilyIndex = queue.family_index();
+    VkCommandPool raw_pool = VK_NULL_HANDLE;
+    ASSERT_EQ(fn.vkCreateCommandPool(device.vk(), &info, nullptr, &raw_pool), VK_SUCCESS);
+    auto pool = vkrc::CommandPool::adopt(device, raw_pool, queue.family_index(), vkrc::Ownership::borrowed);
+    auto target = fill_target(device);
+    const VkCommandBuffer spare = allocate_raw(device, raw_pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    EXPECT_THROW(vkrc::CommandBuffer::adopt(pool, spare, VK_COMMAND_BUFFER_LEVEL_MAX_ENUM, vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    fn.vkFreeCommandBuffers(device.vk(), raw_pool, 1, &spare);
+    std::uint32_t value = 0x1000;
+    for (const auto ownership : {vkrc::Ownership::owned, vkrc::Ownership::borrowed}) {
+        const VkCommandBuffer raw_primary = allocate_raw(device, raw_pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+        const VkCommandBuffer raw_secondary = allocate_raw(device, raw_pool, VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        ++value;
+        {
+            auto cmd = vkrc::CommandBuffer::adopt(pool, raw_primary, VK_COMMAND_BUFFER_LEVEL_PRIMARY, ownership);
+            auto secondary =
+                vkrc::CommandBuffer::adopt(pool, raw_secondary, VK_COMMAND_BUFFER_LEVEL_SECONDARY, ownership);
+            EXPECT_EQ(cmd.vk(), raw_primary);
+            EXPECT_EQ(cmd.level(), VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+            EXPECT_EQ(cmd.pool().vk(), raw_pool);
+            EXPECT_THROW(secondary.begin(), vkrc::UsageError) << "a secondary needs begin_secondary";
+            secondary.begin_secondary();
+            secondary.fill_buffer(target, 8, 8, value + 1);
+            secondary.end();
+            cmd.begin();
+            cmd.fill_buffer(target, 0, 8, value);
+            cmd.execute_commands(std::span(&secondary, 1));
+            const auto to_host = transfer_to_host();
+            cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+            cmd.end();
+            auto fence = vkrc::Fence::create(device);
+            vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+            ASSERT_EQ(fence.wait(), VK_SUCCESS);
+            EXPECT_EQ(target.allocation().read_value<std::uint32_t>(4), value);
+            EXPECT_EQ(target.allocation().read_value<std::uint32_t>(12), value + 1);
+        }
+        if (ownership == vkrc::Ownership::owned) {
+            EXPECT_EQ(pool.pending_free_count(), 2u) << "both dropped, to be freed once the GPU is done";
+            device.wait_idle();
+            pool.reset_commands();  // frees the completed ones
+        } else {
+            const VkCommandBuffer both[] = {raw_primary, raw_secondary};
+            fn.vkFreeCommandBuffers(device.vk(), raw_pool, 2, both);
+        }
+        EXPECT_EQ(pool.pending_free_count(), 0u);
+    }
+    pool.reset();
+    device.wait_idle();
+    fn.vkDestroyCommandPool(device.vk(), raw_pool, nullptr);
+}
+
+// Secondaries recorded entirely by other code run inside a vkrc primary.
+TEST_F(VulkanTest, RawInteropExecutesRawSecondaries) {
+    const auto& fn = device.fn();
+    auto target = fill_target(device);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    VkCommandBuffer raw[2] = {};
+    for (std::uint32_t i = 0; i < 2; ++i) {
+        raw[i] = allocate_raw(device, pool.vk(), VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        VkCommandBufferInheritanceInfo inheritance{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
+        VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+        begin.pInheritanceInfo = &inheritance;
+        ASSERT_EQ(fn.vkBeginCommandBuffer(raw[i], &begin), VK_SUCCESS);
+        fn.vkCmdFillBuffer(raw[i], target.vk(), 8 * i, 8, 0xabc0 + i);
+        ASSERT_EQ(fn.vkEndCommandBuffer(raw[i]), VK_SUCCESS);
+    }
+    run(queue, [&](const vkrc::CommandBuffer& cmd) {
+        cmd.execute_commands(std::span<const VkCommandBuffer>(raw));
+        const auto to_host = transfer_to_host();
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    });
+    EXPECT_EQ(target.allocation().read_value<std::uint32_t>(0), 0xabc0u);
+    EXPECT_EQ(target.allocation().read_value<std::uint32_t>(8), 0xabc1u);
+    fn.vkFreeCommandBuffers(device.vk(), pool.vk(), 2, raw);
+}
+
 // RawInterop: the recording methods that take query pools, events, render
 // passes and framebuffers also take their raw handles.
 TEST_F(VulkanTest, RawInteropQueriesAndEventsByRawHandle) {
@@ -347,6 +454,16 @@ TEST_F(VulkanTest, AdoptRejectsNullHandles) {
     EXPECT_THROW(vkrc::DescriptorPool::adopt(device, VK_NULL_HANDLE, 0, vkrc::Ownership::owned), vkrc::UsageError);
     auto layout = vkrc::DescriptorSetLayout::create(device, {});
     EXPECT_THROW(vkrc::DescriptorSet::adopt(vkrc::DescriptorPool(), layout, VK_NULL_HANDLE, vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    EXPECT_THROW(vkrc::CommandBuffer::adopt(vkrc::CommandPool(), VK_NULL_HANDLE, VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+                                            vkrc::Ownership::owned),
+                 vkrc::UsageError);
+    EXPECT_THROW(
+        vkrc::CommandBuffer::adopt(pool, VK_NULL_HANDLE, VK_COMMAND_BUFFER_LEVEL_PRIMARY, vkrc::Ownership::owned),
+        vkrc::UsageError);
+    EXPECT_THROW(vkrc::DescriptorUpdateTemplate::adopt(device, VK_NULL_HANDLE, {.descriptor_set_layout = layout},
+                                                       vkrc::Ownership::owned),
                  vkrc::UsageError);
 }
 

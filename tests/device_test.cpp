@@ -91,6 +91,16 @@ TEST_F(VulkanTest, BadQueueRequestsNameTheProblem) {
     }
 }
 
+// QueueRequest::next reaches VkDeviceQueueCreateInfo: a struct that does not
+// extend it, chained on purpose, is reported by the validation layer
+// (drivers skip structs they do not expect, as the spec requires).
+TEST_F(VulkanTest, RawInteropQueueRequestNextReachesVulkan) {
+    const VkFenceCreateInfo foreign{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    auto other = vkrc::Device::create(
+        physical_device, {.queue_requests = {{.queue_family_index = queue.family_index(), .next = &foreign}}});
+    EXPECT_GE(log->take_expected("VUID-VkDeviceQueueCreateInfo-pNext-pNext"), 1u);
+}
+
 TEST_F(VulkanTest, FunctionTableReachesUnwrappedFunctions) {
     ASSERT_NE(device.fn().vkCmdDraw, nullptr);
     ASSERT_NE(device.fn().vkQueueSubmit2, nullptr);

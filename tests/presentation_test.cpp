@@ -188,6 +188,17 @@ TEST_F(PresentationTest, RendersTenFramesAndLogsItsChoices) {
     renderer.wait();
 }
 
+// SwapchainCreateInfo::next reaches VkSwapchainCreateInfoKHR, at creation
+// and again at a re-creation: a struct that does not extend it, chained on
+// purpose, is reported by the validation layer each time (drivers skip it).
+TEST_F(PresentationTest, RawInteropSwapchainNextReachesVulkan) {
+    const VkFenceCreateInfo foreign{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    auto swapchain = vkrc::Swapchain::create(queue, window.surface, {.next = &foreign});
+    EXPECT_GE(log->take_expected("VUID-VkSwapchainCreateInfoKHR-pNext-pNext"), 1u);
+    EXPECT_EQ(swapchain.recreate(), vkrc::PresentStatus::success);
+    EXPECT_GE(log->take_expected("VUID-VkSwapchainCreateInfoKHR-pNext-pNext"), 1u);
+}
+
 TEST_F(PresentationTest, ResizedHundredTimesWhileRendering) {
     auto swapchain = make_swapchain();
     Renderer renderer(queue, swapchain.format());

@@ -168,4 +168,122 @@ TEST_F(PushDescriptorTest, UpdateTemplatePushedAndDroppedWhileRecorded) {
     EXPECT_EQ(device.deferred_count(), 0u) << "destroyed once the work completed";
 }
 
+// A template made with the raw API for set_layout (and, for push templates,
+// set 0 of pipeline_layout), as another library would.
+VkDescriptorUpdateTemplate make_raw_template(const vkrc::Device& device, VkDescriptorUpdateTemplateType type,
+                                             VkDescriptorSetLayout set_layout, VkPipelineLayout pipeline_layout) {
+    const VkDescriptorUpdateTemplateEntry entry{
+        0, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0, sizeof(VkDescriptorBufferInfo)};
+    VkDescriptorUpdateTemplateCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_UPDATE_TEMPLATE_CREATE_INFO};
+    ci.descriptorUpdateEntryCount = 1;
+    ci.pDescriptorUpdateEntries = &entry;
+    ci.templateType = type;
+    ci.descriptorSetLayout = set_layout;
+    ci.pipelineBindPoint = VK_PIPELINE_BIND_POINT_COMPUTE;
+    ci.pipelineLayout = pipeline_layout;
+    ci.set = 0;
+    VkDescriptorUpdateTemplate raw = VK_NULL_HANDLE;
+    EXPECT_EQ(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &raw), VK_SUCCESS);
+    return raw;
+}
+
+// A template made elsewhere updates a set through vkrc. Owned, vkrc destroys
+// it (the layer reports a leak otherwise); borrowed, its maker does (a double
+// destroy would be reported).
+TEST_F(VulkanTest, AdoptedUpdateTemplateWritesASet) {
+    auto set_layout = storage_layout(device, 0);
+    FillPipeline fill(set_layout);
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto set = pool.allocate(set_layout);
+    std::uint32_t seed = 50;
+    for (const auto ownership : {vkrc::Ownership::owned, vkrc::Ownership::borrowed}) {
+        const VkDescriptorUpdateTemplate raw = make_raw_template(
+            device, VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET, set_layout.vk(), VK_NULL_HANDLE);
+        auto out = output_buffer(device);
+        {
+            auto update =
+                vkrc::DescriptorUpdateTemplate::adopt(device, raw, {.descriptor_set_layout = set_layout}, ownership);
+            EXPECT_EQ(update.vk(), raw);
+            EXPECT_EQ(update.template_type(), VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET);
+            EXPECT_EQ(update.descriptor_set_layout(), set_layout);
+            const VkDescriptorBufferInfo data{out.vk(), 0, VK_WHOLE_SIZE};
+            set.update_with_template(update, &data);
+        }
+        vkrc_test::OneShotCommands s(queue);
+        s.cmd.bind_pipeline(fill.pipeline);
+        s.cmd.bind_descriptor_set(fill.pipeline, 0, set);
+        fill.dispatch(s.cmd, ++seed);
+        const auto to_host = vkrc_test::compute_to_host();
+        s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        s.run(queue);
+        EXPECT_TRUE(holds_pattern(out, seed));
+        device.wait_idle();  // runs any deferred destruction before the raw one
+        if (ownership == vkrc::Ownership::borrowed)
+            device.fn().vkDestroyDescriptorUpdateTemplate(device.vk(), raw, nullptr);
+    }
+    EXPECT_THROW(vkrc::DescriptorUpdateTemplate::adopt(device, VK_NULL_HANDLE, {.descriptor_set_layout = set_layout},
+                                                       vkrc::Ownership::owned),
+                 vkrc::UsageError);
+}
+
+// Push descriptors by raw handles: a pipeline layout and a push template made
+// by other code (here read out of vkrc objects and made raw).
+TEST_F(PushDescriptorTest, RawInteropPushDescriptorsByRawHandles) {
+    auto set_layout = storage_layout(device, VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR);
+    FillPipeline fill(set_layout);
+    const VkPipelineLayout raw_layout = fill.layout.vk();
+    const VkDescriptorUpdateTemplate raw_template =
+        make_raw_template(device, VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR, set_layout.vk(), raw_layout);
+    auto a = output_buffer(device);
+    auto b = output_buffer(device);
+    vkrc_test::OneShotCommands s(queue);
+    s.cmd.bind_pipeline(VK_PIPELINE_BIND_POINT_COMPUTE, fill.pipeline.vk());
+    const VkDescriptorBufferInfo info{a.vk(), 0, VK_WHOLE_SIZE};
+    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstBinding = 0;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    write.pBufferInfo = &info;
+    s.cmd.push_descriptor_set(VK_PIPELINE_BIND_POINT_COMPUTE, raw_layout, 0, std::span(&write, 1));
+    fill.dispatch(s.cmd, 61);
+    const VkDescriptorBufferInfo data{b.vk(), 0, VK_WHOLE_SIZE};
+    s.cmd.push_descriptor_set_with_template(raw_template, raw_layout, 0, &data);
+    fill.dispatch(s.cmd, 62);
+    const auto to_host = vkrc_test::compute_to_host();
+    s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    s.run(queue);
+    EXPECT_TRUE(holds_pattern(a, 61));
+    EXPECT_TRUE(holds_pattern(b, 62));
+    device.fn().vkDestroyDescriptorUpdateTemplate(device.vk(), raw_template, nullptr);
+}
+
+// An adopted push template pushes through the typed overload, to the layout
+// and set it was described with.
+TEST_F(PushDescriptorTest, AdoptedPushTemplatePushes) {
+    auto set_layout = storage_layout(device, VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR);
+    FillPipeline fill(set_layout);
+    auto push = vkrc::DescriptorUpdateTemplate::adopt(
+        device,
+        make_raw_template(device, VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR, set_layout.vk(),
+                          fill.layout.vk()),
+        {.template_type = VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR,
+         .descriptor_set_layout = set_layout,
+         .pipeline_bind_point = VK_PIPELINE_BIND_POINT_COMPUTE,
+         .pipeline_layout = fill.layout,
+         .set = 0},
+        vkrc::Ownership::owned);
+    EXPECT_EQ(push.pipeline_layout(), fill.layout);
+    auto out = output_buffer(device);
+    vkrc_test::OneShotCommands s(queue);
+    s.cmd.bind_pipeline(fill.pipeline);
+    const VkDescriptorBufferInfo data{out.vk(), 0, VK_WHOLE_SIZE};
+    s.cmd.push_descriptor_set_with_template(push, &data);
+    fill.dispatch(s.cmd, 71);
+    const auto to_host = vkrc_test::compute_to_host();
+    s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    s.run(queue);
+    EXPECT_TRUE(holds_pattern(out, 71));
+}
+
 }  // namespace

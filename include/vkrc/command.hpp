@@ -126,6 +126,14 @@ struct RenderingInfo {
 class CommandBuffer : public Handle<detail::CommandBufferState> {
 public:
     CommandBuffer() noexcept = default;
+    // A command buffer of level allocated by other code from pool's Vulkan
+    // pool, not recording (vkrc tracks recording from its begin()). Owned:
+    // dropping it frees it back to the pool like an allocated one (once the
+    // work submitted through vkrc is done); borrowed: vkrc never frees it, and
+    // its maker frees it after every vkrc handle to it has gone. Work its
+    // maker submitted outside vkrc must be complete before an owned one is dropped.
+    static CommandBuffer adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
+                               Ownership ownership);
 
     VkCommandBuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
     const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
@@ -187,10 +195,20 @@ public:
     // device: the function is called as loaded). Writes set `set` of layout,
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
     void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
+                             std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
+        push_descriptor_set(bind_point, layout.vk(), set, writes);
+    }
+    void push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t set,
                              std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
     // The same through a PUSH_DESCRIPTORS_KHR template, to its pipeline layout and set.
     void push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
-                                           const void* data) const VKRC_UNCHECKED_NOEXCEPT;
+                                           const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+        push_descriptor_set_with_template(update_template.vk(), update_template.pipeline_layout().vk(),
+                                          update_template.set(), data);
+    }
+    // Raw: layout and set must be those the template was created with (Vulkan's rule).
+    void push_descriptor_set_with_template(VkDescriptorUpdateTemplate update_template, VkPipelineLayout layout,
+                                           std::uint32_t set, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
     template <class T>
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
@@ -250,6 +268,8 @@ public:
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
     void execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
+    // Raw secondaries (recorded by other code): passed as they are, in one call.
+    void execute_commands(std::span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Queries
     void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
@@ -559,7 +579,8 @@ public:
     const DeviceFunctions* fn = nullptr;
     CommandPool pool;
     VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    RecordingWindow window;  // registered with the device's OpenCommandBuffers
+    Ownership ownership = Ownership::owned;  // borrowed (adopted): never freed by vkrc
+    RecordingWindow window;                  // registered with the device's OpenCommandBuffers
 };
 
 }  // namespace detail
@@ -705,18 +726,18 @@ inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShader
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
     fn_->vkCmdPushConstants(cmd_, layout.vk(), stages, offset, size, data);
 }
-inline void CommandBuffer::push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout,
+inline void CommandBuffer::push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
                                                std::uint32_t set, std::span<const VkWriteDescriptorSet> writes) const
     VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
-    fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout.vk(), set, static_cast<std::uint32_t>(writes.size()),
+    fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout, set, static_cast<std::uint32_t>(writes.size()),
                                    writes.data());
 }
-inline void CommandBuffer::push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
+inline void CommandBuffer::push_descriptor_set_with_template(VkDescriptorUpdateTemplate update_template,
+                                                             VkPipelineLayout layout, std::uint32_t set,
                                                              const void* data) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set_with_template");
-    fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template.vk(), update_template.pipeline_layout().vk(),
-                                               update_template.set(), data);
+    fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template, layout, set, data);
 }
 inline void CommandBuffer::set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
@@ -814,6 +835,11 @@ inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secon
         for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
         fn_->vkCmdExecuteCommands(cmd_, n, raw);
     }
+}
+inline void CommandBuffer::execute_commands(std::span<const VkCommandBuffer> secondaries) const
+    VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+    fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
 }
 
 inline void CommandBuffer::reset_query_pool(VkQueryPool pool, std::uint32_t first_query,

@@ -43,6 +43,13 @@ public:
     // without a pipeline layout or without VK_KHR_push_descriptor, or
     // layouts of another device.
     static DescriptorUpdateTemplate create(const Device& device, const DescriptorUpdateTemplateCreateInfo& info);
+    // A template made by other code; info describes it as its creation did
+    // (its type, layouts and set are kept, and checked as create() checks
+    // them; entries, flags and next are ignored). Owned: vkrc destroys it
+    // after the GPU is done; borrowed: its maker does, after every vkrc
+    // handle to it has gone.
+    static DescriptorUpdateTemplate adopt(const Device& device, VkDescriptorUpdateTemplate update_template,
+                                          const DescriptorUpdateTemplateCreateInfo& info, Ownership ownership);
 
     VkDescriptorUpdateTemplate vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
@@ -63,6 +70,7 @@ public:
     ~DescriptorUpdateTemplateState() override;
     Device device;
     VkDescriptorUpdateTemplate update_template = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
     VkDescriptorUpdateTemplateType type = VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET;
     DescriptorSetLayout set_layout;
     PipelineLayout pipeline_layout;

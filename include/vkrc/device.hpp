@@ -21,6 +21,9 @@ struct QueueRequest {
     std::uint32_t queue_family_index = 0;
     // One per queue, 1 to the family's queueCount (default one queue, priority 1).
     List<float> queue_priorities = {1.0f};
+    // Optional pNext chain of VkDeviceQueueCreateInfo (e.g. a global
+    // priority); read during Device::create only. Ignored by Device::adopt.
+    const void* next = nullptr;
 };
 
 // What a queue is for. Every device has a queue for each role: one it was

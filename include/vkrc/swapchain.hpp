@@ -154,6 +154,10 @@ struct SwapchainCreateInfo {
     // Copied into the Swapchain: what it refers to must outlive the Swapchain. The text lives
     // for the call only.
     Function<void(const char*)> log{};
+    // Optional pNext chain of VkSwapchainCreateInfoKHR (e.g. full-screen
+    // exclusive, present-mode lists). Read at creation and at every
+    // re-creation: what it points to must outlive the Swapchain.
+    const void* next = nullptr;
 };
 
 // A swapchain for one Surface, re-created in place. Keeps its Surface,

@@ -99,3 +99,12 @@ void hot_push_descriptor_set(const Cmd& c, const vkrc::PipelineLayout& l, std::s
 void hot_push_descriptor_set_with_template(const Cmd& c, const vkrc::DescriptorUpdateTemplate& t, const void* d) {
     c.push_descriptor_set_with_template(t, d);
 }
+// Raw twins, for pipelines, layouts, templates and secondaries made by other code.
+void hot_push_descriptor_set_raw(const Cmd& c, VkPipelineLayout l, std::span<const VkWriteDescriptorSet> w) {
+    c.push_descriptor_set(VK_PIPELINE_BIND_POINT_COMPUTE, l, 0, w);
+}
+void hot_push_descriptor_set_with_template_raw(const Cmd& c, VkDescriptorUpdateTemplate t, VkPipelineLayout l,
+                                               const void* d) {
+    c.push_descriptor_set_with_template(t, l, 0, d);
+}
+void hot_execute_commands_raw(const Cmd& c, std::span<const VkCommandBuffer> s) { c.execute_commands(s); }
