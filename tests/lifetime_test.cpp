@@ -4,6 +4,7 @@
 #include "support/vk_test.hpp"
 
 #include "shaders/fill_pattern.comp.h"
+#include "shaders/sample_texels.comp.h"
 
 #include <algorithm>
 #include <atomic>
@@ -69,6 +70,139 @@ void submit_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd) {
     ASSERT_EQ(fence.wait(), VK_SUCCESS);
 }
 
+// Images are side x side RGBA8; each recorded operation of a test copies
+// its result (texels words, one per texel) into its own slot of readback.
+constexpr std::uint32_t side = 8;
+constexpr std::uint32_t texels = side * side;
+constexpr int slots = static_cast<int>(words / texels);
+constexpr VkDeviceSize slot_bytes = texels * sizeof(std::uint32_t);
+constexpr VkImageSubresourceRange color_range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+
+// A clear color whose RGBA8 encoding is exact, and that encoding as a copy
+// to a buffer (and the sampling shader's packUnorm4x8) writes it.
+struct Color {
+    VkClearColorValue clear;
+    std::uint32_t packed;
+};
+
+Color make_color(std::uint32_t packed) {
+    Color c{{}, packed};
+    for (int i = 0; i < 4; ++i) c.clear.float32[i] = static_cast<float>((packed >> (8 * i)) & 0xffu) / 255.0f;
+    return c;
+}
+
+bool slot_holds(const vkrc::Buffer& readback, int slot, std::uint32_t value) {
+    auto v = read_all(readback);
+    const auto first = v.begin() + static_cast<std::ptrdiff_t>(slot) * texels;
+    return std::all_of(first, first + texels, [&](std::uint32_t x) { return x == value; });
+}
+
+vkrc::Image make_image(const vkrc::Device& device) {
+    return vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                        .extent = {side, side, 1},
+                                        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+}
+
+// What the tests may make, record and drop. The descriptor set points at
+// view + sampler (binding 0) and storage (binding 1), which the pipeline
+// (sample_texels.comp) reads and writes.
+struct Objects {
+    vkrc::Instance instance;
+    vkrc::Device device;
+    vkrc::Queue queue;
+    vkrc::CommandPool pool;
+    vkrc::CommandBuffer cmd;
+    vkrc::CommandBuffer secondary;
+    vkrc::Fence fence;
+    vkrc::Buffer readback;
+    vkrc::Buffer source;  // filled, then copied
+    vkrc::Buffer storage;
+    vkrc::Image image;  // cleared, then copied or sampled
+    vkrc::ImageView view;
+    vkrc::Sampler sampler;
+    vkrc::DescriptorSetLayout set_layout;
+    vkrc::DescriptorPool descriptor_pool;
+    vkrc::DescriptorSet set;
+    vkrc::PipelineLayout layout;
+    vkrc::ComputePipeline pipeline;
+};
+
+// The view, sampler, storage buffer, descriptor objects and pipeline over o.image.
+void make_sampling_objects(Objects& o, const vkrc::Device& device) {
+    o.view = vkrc::ImageView::create(o.image);
+    o.sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
+    o.storage = vkrc::Buffer::create(
+        device, {.size = slot_bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+    o.set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+                              {.binding = 1,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    o.descriptor_pool = vkrc::DescriptorPool::create(
+        device,
+        {.max_sets = 1,
+         .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    o.set = o.descriptor_pool.allocate(o.set_layout);
+    o.set.write_image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, o.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      o.sampler);
+    o.set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, o.storage);
+    o.layout = vkrc::PipelineLayout::create(
+        device, {.set_layouts = {o.set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 16}}});
+    o.pipeline =
+        vkrc::ComputePipeline::create(o.layout, vkrc::ShaderModule::create(device, vkrc_shaders::sample_texels_comp));
+}
+
+// Clears image to color (whatever it held before) and leaves it in layout
+// for the stage and access that read it next.
+void record_clear(const vkrc::CommandBuffer& cmd, const vkrc::Image& image, const VkClearColorValue& color,
+                  VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+    auto to_dst = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                      VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_dst, 1));
+    cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&color_range, 1));
+    auto to_use =
+        vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout,
+                            VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, stage, access);
+    cmd.pipeline_barrier({}, {}, std::span(&to_use, 1));
+}
+
+// Clears the image to color and copies it into readback's slot.
+void record_clear_copy(const vkrc::CommandBuffer& cmd, const vkrc::Image& image, const VkClearColorValue& color,
+                       int slot, const vkrc::Buffer& readback) {
+    record_clear(cmd, image, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                 VK_ACCESS_2_TRANSFER_READ_BIT);
+    VkBufferImageCopy region{};
+    region.bufferOffset = static_cast<VkDeviceSize>(slot) * slot_bytes;
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {side, side, 1};
+    cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, std::span(&region, 1));
+    transfer_barrier(cmd);
+}
+
+// Clears o's image to color, samples every texel through o.set (view and
+// sampler) into o.storage with o.pipeline, and copies that into readback's
+// slot. The image is reached through the view, which keeps it alive, and
+// the pipeline layout through the pipeline when o.layout was dropped.
+void record_sample(const vkrc::CommandBuffer& cmd, const Objects& o, const VkClearColorValue& color, int slot,
+                   const vkrc::Buffer& readback) {
+    record_clear(cmd, o.view.image(), color, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    cmd.bind_pipeline(o.pipeline);
+    cmd.bind_descriptor_set(o.pipeline, 0, o.set);
+    const std::uint32_t params[4] = {0, side, side, 0};  // level, width, height, base
+    cmd.push_constants(o.layout ? o.layout : o.pipeline.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(params),
+                       params);
+    cmd.dispatch(1, 1);
+    transfer_barrier(cmd);
+    VkBufferCopy region{0, static_cast<VkDeviceSize>(slot) * slot_bytes, slot_bytes};
+    cmd.copy_buffer(o.storage, readback, std::span(&region, 1));
+    transfer_barrier(cmd);
+}
+
 // The snippet, with a copy into a buffer that stays alive.
 TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
@@ -101,48 +235,29 @@ TEST_F(VulkanTest, BufferDroppedWhileRecording) {
     EXPECT_TRUE(all_equal(readback, 7));
 }
 
-// An image, its view, a sampler, a descriptor set pointing at a storage
-// buffer, the set's layout, the pipeline layout, the pipeline and the
-// buffer itself, all dropped between recording and submission.
+// Every kind the recorded work uses: an image cleared and then sampled
+// through its view and a sampler, a descriptor set pointing at them and at
+// a storage buffer the dispatch writes, the set's layout and pool, the
+// pipeline layout and the compute pipeline. All dropped between recording
+// and submission; the texels must still arrive in readback.
 TEST_F(VulkanTest, EveryKindDroppedBetweenRecordAndSubmit) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto readback = make_readback(device);
     auto cmd = pool.allocate();
+    const auto color = make_color(0x11c0407f);
     {
-        auto storage = make_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-        auto image = vkrc::Image::create(
-            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
-        auto view = vkrc::ImageView::create(image);
-        auto sampler = vkrc::Sampler::create(device);
-        auto set_layout = vkrc::DescriptorSetLayout::create(
-            device, {.bindings = {{.binding = 0,
-                                   .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                   .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
-        auto layout = vkrc::PipelineLayout::create(
-            device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
-        auto descriptors = vkrc::DescriptorPool::create(
-            device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
-        auto set = descriptors.allocate(set_layout);
-        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage);
-        auto pipeline =
-            vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
+        Objects o;
+        o.image = make_image(device);
+        make_sampling_objects(o, device);
         cmd.begin();
-        cmd.bind_pipeline(pipeline);
-        cmd.bind_descriptor_set(pipeline, 0, set);
-        const std::uint32_t params[2] = {static_cast<std::uint32_t>(words), 0};
-        cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(params), params);
-        cmd.dispatch(static_cast<std::uint32_t>(words / 64));
-        transfer_barrier(cmd);
-        VkBufferCopy region{0, 0, bytes};
-        cmd.copy_buffer(storage, readback, std::span(&region, 1));
-        auto to_general = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL,
-                                              VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
-        cmd.pipeline_barrier({}, {}, std::span(&to_general, 1));
+        record_sample(cmd, o, color.clear, 0, readback);
         cmd.end();
+        const auto before = device.deferred_count();
+        o = Objects{};
+        EXPECT_GE(device.deferred_count(), before + 9);  // held, not destroyed
     }
     submit_and_wait(queue, cmd);
-    auto v = read_all(readback);
-    for (std::uint32_t i = 0; i < words; ++i) ASSERT_EQ(v[i], i * 2654435761u) << i;
+    EXPECT_TRUE(slot_holds(readback, 0, color.packed));
     EXPECT_EQ(device.deferred_count(), 0u);
 }
 
