@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -417,114 +418,219 @@ TEST(EmptyHandle, AccessorsAndRecordingThrowUsageError) {
 
 // ---------------------------------------------------------------- randomized
 
-enum class DropPoint { before_begin, while_recording, after_end, after_submit, after_wait, never };
-constexpr int drop_points = 6;
+enum class DropPoint { before_begin, while_recording, after_end, after_submit, after_wait };
+constexpr int drop_points = 5;
 
-// One round: a handful of objects, some recorded into one command buffer,
-// each dropped at a random point in a random order; the device's own
-// handles (and, in some rounds, the instance's) too.
+// What the rounds of one test recorded, to show that each kind of work ran.
+struct Coverage {
+    int fills = 0;
+    int image_copies = 0;
+    int dispatches = 0;
+    int secondaries = 0;
+    int fresh_devices = 0;
+    int unwaited = 0;
+    int drops[drop_points] = {};
+};
+
+// One round: random objects, one command buffer (its work possibly in a
+// secondary) recording random operations on those still alive, and every
+// handle, the round's instance, device and queue included, dropped at a
+// random point in a random order. A round that waits checks each
+// operation's result in its slot of readback; one that does not drops
+// everything with the work in flight.
 struct Round {
     std::mt19937& rng;
-    vkrc::Device device;
-    vkrc::Queue queue;
+    Coverage& coverage;
+    Objects o;
 
     int pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); }
+    DropPoint point_in(DropPoint first, DropPoint last) {
+        return static_cast<DropPoint>(static_cast<int>(first) +
+                                      pick(static_cast<int>(last) - static_cast<int>(first) + 1));
+    }
 
-    void run(bool drop_device_handles) {
-        auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
-        auto readback = make_readback(device);
+    void run(bool wait) {
+        auto& device = o.device;
+        o.pool = vkrc::CommandPool::create(device, {.queue_family_index = o.queue.family_index()});
+        o.cmd = o.pool.allocate();
+        o.fence = vkrc::Fence::create(device);
+        o.readback = make_readback(device);
+        if (pick(4) != 0) {
+            o.source = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        }
+        if (pick(5) != 0) {
+            o.image = make_image(device);
+            if (pick(8) != 0) make_sampling_objects(o, device);
+        }
+        if (pick(4) == 0) o.secondary = o.pool.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
+        const int ops = 1 + pick(slots);
+
+        // Each handle's drop: a point, and for while_recording the operation
+        // it comes before (ops: after the last, before end()).
         struct Item {
             std::function<void()> drop;
             DropPoint point;
+            int before_op;
         };
         std::vector<Item> items;
-        std::vector<vkrc::Buffer> buffers;
-        const int count = 1 + pick(4);
-        for (int i = 0; i < count; ++i) {
-            buffers.push_back(make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT));
-        }
-        auto image = vkrc::Image::create(
-            device, {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
-        auto view = vkrc::ImageView::create(image);
-        auto sampler = vkrc::Sampler::create(device);
-        auto secondary = pool.allocate(VK_COMMAND_BUFFER_LEVEL_SECONDARY);
-        const bool use_secondary = pick(2) == 0;
-        auto point = [&] { return static_cast<DropPoint>(pick(drop_points)); };
-        for (auto& b : buffers) items.push_back({[&b] { b.reset(); }, point()});
-        items.push_back({[&] { image.reset(); }, point()});
-        items.push_back({[&] { view.reset(); }, point()});
-        items.push_back({[&] { sampler.reset(); }, point()});
-        items.push_back({[&] { secondary.reset(); }, use_secondary ? point() : DropPoint::before_begin});
-        items.push_back({[&] { pool.reset(); }, point()});
-        if (drop_device_handles) {
-            items.push_back({[&] { device.reset(); }, point()});
-            items.push_back({[&] { queue = {}; }, static_cast<DropPoint>(2 + pick(drop_points - 2))});
+        auto add = [&](auto& handle, DropPoint first, DropPoint last) {
+            if (!handle) return;
+            const auto point = point_in(first, last);
+            items.push_back(
+                {[&handle] { handle = {}; }, point, point == DropPoint::while_recording ? pick(ops + 1) : 0});
+        };
+        constexpr auto any_first = DropPoint::before_begin;
+        constexpr auto any_last = DropPoint::after_wait;
+        add(o.instance, any_first, any_last);
+        add(o.device, any_first, any_last);
+        add(o.queue, any_first, any_last);
+        add(o.pool, any_first, any_last);
+        add(o.cmd, DropPoint::after_submit, any_last);  // needed to submit
+        add(o.fence, wait ? DropPoint::after_wait : DropPoint::after_submit, any_last);
+        // Every operation copies into readback; a round that waits reads it at the end.
+        if (!wait) add(o.readback, DropPoint::after_end, any_last);
+        add(o.source, any_first, any_last);
+        add(o.storage, any_first, any_last);
+        add(o.image, any_first, any_last);
+        add(o.view, any_first, any_last);
+        add(o.sampler, any_first, any_last);
+        add(o.set_layout, any_first, any_last);
+        add(o.descriptor_pool, any_first, any_last);
+        add(o.set, any_first, any_last);
+        add(o.layout, any_first, any_last);
+        add(o.pipeline, any_first, any_last);
+        if (o.secondary) {
+            // Not while it records: the drop comes after the primary executed it.
+            const auto point = point_in(any_first, any_last);
+            items.push_back({[this] { o.secondary = {}; }, point, point == DropPoint::while_recording ? ops : 0});
         }
         std::shuffle(items.begin(), items.end(), rng);
-        auto drop_at = [&](DropPoint p) {
+        for (const auto& item : items) ++coverage.drops[static_cast<int>(item.point)];
+        auto drop_at = [&](DropPoint p, int before_op = 0) {
             for (auto& item : items) {
-                if (item.point == p) item.drop();
+                if (item.point == p && item.before_op == before_op) item.drop();
             }
         };
-        // What is dropped before begin is not recorded: only the living buffers are.
-        auto cmd = pool.allocate();
+
+        // What each slot of readback should hold; unset: no operation wrote it.
+        std::optional<std::uint32_t> expected[slots];
         drop_at(DropPoint::before_begin);
-        const bool secondary_records = use_secondary && secondary;
-        auto recorder = secondary_records ? secondary : cmd;
-        if (secondary_records) recorder.begin_secondary();
-        cmd.begin(pick(2) ? VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT : 0);
-        std::uint32_t value = 0;
-        for (std::size_t i = 0; i < buffers.size(); ++i) {
-            if (!buffers[i]) continue;
-            value = static_cast<std::uint32_t>(pick(1000) + 1);
-            record_fill_copy(recorder, buffers[i], readback, value);
-            transfer_barrier(recorder);
-            if (pick(3) == 0) {
-                buffers[i].reset();  // dropped right after recording
-            }
+        o.cmd.begin(pick(2) ? VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT : 0);
+        const bool in_secondary = bool(o.secondary);
+        if (in_secondary) {
+            o.secondary.begin_secondary();
+            ++coverage.secondaries;
         }
-        drop_at(DropPoint::while_recording);
-        if (secondary_records) {
-            recorder.end();
-            cmd.execute_commands(std::span(&recorder, 1));
+        const vkrc::CommandBuffer& recorder = in_secondary ? o.secondary : o.cmd;
+        for (int op = 0; op < ops; ++op) {
+            drop_at(DropPoint::while_recording, op);
+            expected[op] = record_one(recorder, op);
         }
-        cmd.end();
-        recorder = {};
+        if (in_secondary) {
+            o.secondary.end();
+            o.cmd.execute_commands(std::span(&o.secondary, 1));
+        }
+        drop_at(DropPoint::while_recording, ops);
+        o.cmd.end();
         drop_at(DropPoint::after_end);
-        auto fence = vkrc::Fence::create(cmd.pool().device());
-        auto q = queue ? queue : cmd.pool().device().default_queue();
-        vkrc::submit(q, {.command_buffers = std::span(&cmd, 1)}, fence);
+        const auto queue = o.queue ? o.queue : o.cmd.pool().device().default_queue();
+        vkrc::submit(queue, {.command_buffers = std::span(&o.cmd, 1)}, o.fence);
         drop_at(DropPoint::after_submit);
-        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+        if (wait) {
+            ASSERT_EQ(o.fence.wait(), VK_SUCCESS);
+            for (int slot = 0; slot < slots; ++slot) {
+                if (expected[slot]) {
+                    ASSERT_TRUE(slot_holds(o.readback, slot, *expected[slot])) << "slot " << slot;
+                }
+            }
+        } else {
+            ++coverage.unwaited;
+        }
         drop_at(DropPoint::after_wait);
-        if (value != 0) ASSERT_TRUE(all_equal(readback, value));
+    }
+
+    // Records one operation on objects still alive into slot; what the slot
+    // will hold, or nothing when no operation's objects are alive.
+    std::optional<std::uint32_t> record_one(const vkrc::CommandBuffer& cmd, int slot) {
+        enum Kind { fill, image_copy, dispatch };
+        std::vector<Kind> kinds;
+        if (o.source) kinds.push_back(fill);
+        if (o.image || o.view) kinds.push_back(image_copy);
+        // The set keeps none of what it points at alive: each must be.
+        if (o.view && o.sampler && o.storage && o.set && o.pipeline) kinds.push_back(dispatch);
+        if (kinds.empty()) return std::nullopt;
+        const auto color = make_color(static_cast<std::uint32_t>(rng()));
+        // The dispatch, which needs the most objects alive, is picked first half the time.
+        const auto kind = kinds.back() == dispatch && pick(2) == 0
+                              ? dispatch
+                              : kinds[static_cast<std::size_t>(pick(static_cast<int>(kinds.size())))];
+        switch (kind) {
+            case fill: {
+                const auto value = static_cast<std::uint32_t>(rng());
+                cmd.fill_buffer(o.source, 0, slot_bytes, value);
+                transfer_barrier(cmd);
+                VkBufferCopy region{0, static_cast<VkDeviceSize>(slot) * slot_bytes, slot_bytes};
+                cmd.copy_buffer(o.source, o.readback, std::span(&region, 1));
+                transfer_barrier(cmd);
+                ++coverage.fills;
+                return value;
+            }
+            case image_copy:
+                record_clear_copy(cmd, o.image ? o.image : o.view.image(), color.clear, slot, o.readback);
+                ++coverage.image_copies;
+                return color.packed;
+            case dispatch:
+                record_sample(cmd, o, color.clear, slot, o.readback);
+                ++coverage.dispatches;
+                return color.packed;
+        }
+        return std::nullopt;
     }
 };
 
+// Every 20th round makes its own instance and device, so that their last
+// handles (and with them the Vulkan objects) may go at any point; the other
+// rounds drop their copies of the fixture's. One round in eight (one in
+// two of those with a fresh device) never waits.
 TEST_F(VulkanTest, RandomDropPointsAndOrders) {
     const unsigned seed = std::random_device{}();
     std::printf("RandomDropPointsAndOrders seed: %u\n", seed);
     SCOPED_TRACE("seed " + std::to_string(seed));
     std::mt19937 rng(seed);
-    int rounds_run = 0;
+    Coverage coverage;
     for (int round = 0; round < 500; ++round) {
-        if (round % 50 == 49) {
-            // Everything, instance and device included, dropped in random order.
-            auto inst = vkrc::Instance::create(vkrc_test::validated_instance_info(log));
-            auto dev = vkrc::Device::create(vkrc::PhysicalDevice::select(inst, vkrc_test::test_device_requirements()));
-            Round r{rng, dev, dev.default_queue()};
-            dev.reset();
-            if (r.pick(2)) inst.reset();
-            r.run(true);
-            if (HasFatalFailure()) return;
-            continue;
+        SCOPED_TRACE("round " + std::to_string(round));
+        Round r{rng, coverage, {}};
+        if (round % 20 == 19) {
+            r.o.instance = vkrc::Instance::create(vkrc_test::validated_instance_info(log));
+            r.o.device =
+                vkrc::Device::create(vkrc::PhysicalDevice::select(r.o.instance, vkrc_test::test_device_requirements()));
+            ++coverage.fresh_devices;
+        } else {
+            r.o.instance = instance;
+            r.o.device = device;
         }
-        Round r{rng, device, queue};
-        r.run(r.pick(2) == 0);
+        r.o.queue = r.o.device.default_queue();
+        // Half the fresh devices go with their work in flight.
+        r.run(round % 20 == 19 ? r.pick(2) != 0 : r.pick(8) != 0);
         if (HasFatalFailure()) return;
-        ++rounds_run;
+        // Here rather than at TearDown, to name the round.
+        const auto messages = log->take();
+        ASSERT_TRUE(messages.empty()) << messages.front();
     }
-    std::printf("rounds %d\n", rounds_run);
+    std::printf(
+        "fills %d, image copies %d, dispatches %d, in a secondary %d, fresh devices %d, unwaited %d; drops before "
+        "begin %d, while recording %d, after end %d, after submit %d, after wait %d\n",
+        coverage.fills, coverage.image_copies, coverage.dispatches, coverage.secondaries, coverage.fresh_devices,
+        coverage.unwaited, coverage.drops[0], coverage.drops[1], coverage.drops[2], coverage.drops[3],
+        coverage.drops[4]);
+    // 500 rounds reach every kind of work and every drop point (a seed that
+    // did not would say little).
+    EXPECT_GT(coverage.fills, 0);
+    EXPECT_GT(coverage.image_copies, 0);
+    EXPECT_GT(coverage.dispatches, 0);
+    EXPECT_GT(coverage.secondaries, 0);
+    for (int d : coverage.drops) EXPECT_GT(d, 0);
     device.wait_idle();
     EXPECT_EQ(device.deferred_count(), 0u);
 }
