@@ -394,12 +394,13 @@ def header_cost_section():
 
 def newest_header_cost_runs():
     """The newest run of each compiler and -O level (README's row; docs/benchmarks.md keeps them all)."""
+    runs = header_cost_runs()
     newest = {}
-    for r in header_cost_runs():
+    for r in runs:
         key = (compiler_name(r), r["rows"][0]["flags"])
         if key not in newest or r["meta"].get("date", "") > newest[key]["meta"].get("date", ""):
             newest[key] = r
-    return [r for r in header_cost_runs() if r in newest.values()]
+    return [r for r in runs if r in newest.values()]
 
 
 def readme_compile_row():

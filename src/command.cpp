@@ -67,14 +67,22 @@ CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::ui
     return CommandPool(std::move(s));
 }
 
+namespace {
+// A command buffer's state before its handle exists (allocate and adopt set cmd).
+detail::Ref<detail::CommandBufferState> new_command_buffer_state(const CommandPool& pool, VkCommandBufferLevel level) {
+    detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
+    s->fn = &pool.state()->device.fn();
+    s->pool = pool;
+    s->level = level;
+    s->window.pool = pool.state();
+    return s;
+}
+}  // namespace
+
 CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     VKRC_REQUIRE_STATE("vkrc::CommandPool::allocate");
     auto& p = *state_;
-    detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
-    s->fn = &p.device.fn();
-    s->pool = *this;
-    s->level = level;
-    s->window.pool = &p;
+    auto s = new_command_buffer_state(*this, level);
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     ai.commandPool = p.pool;
     ai.level = level;
@@ -102,15 +110,10 @@ CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer comm
         throw UsageError(std::string(who) + ": level " + std::to_string(static_cast<int>(level)) +
                          " is neither PRIMARY nor SECONDARY");
     }
-    auto& p = *pool.state();
-    detail::Ref<detail::CommandBufferState> s(new detail::CommandBufferState);
-    s->fn = &p.device.fn();
-    s->pool = pool;
-    s->level = level;
+    auto s = new_command_buffer_state(pool, level);
     s->ownership = ownership;
-    s->window.pool = &p;
     // Registered like an allocated one, so that drops during its recording are held.
-    p.device.state()->commands.add(s->window);
+    pool.state()->device.state()->commands.add(s->window);
     s->cmd = command_buffer;
     return CommandBuffer(std::move(s));
 }

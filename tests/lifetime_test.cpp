@@ -137,13 +137,7 @@ void make_sampling_objects(Objects& o, const vkrc::Device& device) {
     o.sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
     o.storage = vkrc::Buffer::create(
         device, {.size = slot_bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
-    o.set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
-                              {.binding = 1,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    o.set_layout = vkrc_test::sample_texels_set_layout(device);
     o.descriptor_pool = vkrc::DescriptorPool::create(
         device,
         {.max_sets = 1,

@@ -217,13 +217,7 @@ TEST_F(StreamingTest, UploaderEveryMipUploadedAsynchronouslyIsSampledTexelByTexe
     auto view = vkrc::ImageView::create(image);
     auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
     auto out = device_buffer(texels.size() * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    auto set_layout = vkrc::DescriptorSetLayout::create(
-        device, {.bindings = {{.binding = 0,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
-                              {.binding = 1,
-                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto set_layout = vkrc_test::sample_texels_set_layout(device);
     auto layout = vkrc::PipelineLayout::create(
         device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 16}}});
     auto descriptors = vkrc::DescriptorPool::create(

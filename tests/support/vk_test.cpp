@@ -43,6 +43,16 @@ vkrc::DeviceRequirements test_device_requirements() {
     return req;
 }
 
+vkrc::DescriptorSetLayout sample_texels_set_layout(const vkrc::Device& device) {
+    return vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+                              {.binding = 1,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+}
+
 void VulkanTest::SetUp() {
     instance = vkrc::Instance::create(validated_instance_info(log));
     physical_device = vkrc::PhysicalDevice::select(instance, test_device_requirements());

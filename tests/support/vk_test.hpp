@@ -48,6 +48,10 @@ vkrc::InstanceCreateInfo validated_instance_info(const std::shared_ptr<Validatio
 // The device the tests run on: VKRC_TEST_DEVICE (a name substring) or the best.
 vkrc::DeviceRequirements test_device_requirements();
 
+// The set layout of shaders/sample_texels.comp: a combined image sampler at
+// binding 0, the storage buffer it writes at binding 1.
+vkrc::DescriptorSetLayout sample_texels_set_layout(const vkrc::Device& device);
+
 // Fixture: a validated instance, the chosen physical device and a device with
 // one graphics+compute queue. TearDown drops them all and fails the test on
 // any validation message, including those reported at destruction (leaks).
