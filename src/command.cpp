@@ -19,8 +19,7 @@ CommandPoolState::~CommandPoolState() {
     }
 }
 
-void CommandPoolState::free_completed() {
-    if (pending.empty()) return;
+void CommandPoolState::free_ready() {
     scratch.clear();
     pending.take_ready(*device.state(), scratch);
     if (!scratch.empty()) {

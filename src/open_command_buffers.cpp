@@ -23,10 +23,7 @@ void OpenCommandBuffers::remove(DeviceState& device, RecordingWindow& window) no
     close(device, window);
 }
 
-void OpenCommandBuffers::close_pool(DeviceState& device, const void* pool) noexcept {
-    // A frame loop resets a pool whose ONE_TIME_SUBMIT primaries its submit
-    // closed: nothing to scan, no lock (the pool is externally synchronised,
-    // so none of its windows opens meanwhile).
+void OpenCommandBuffers::close_pool_slow(DeviceState& device, const void* pool) noexcept {
     if (open_.load() != 0) {
         LockGuard lock(mutex_);
         for (RecordingWindow* w : windows_) {

@@ -560,7 +560,11 @@ class CommandPoolState final : public RefCounted {
 public:
     ~CommandPoolState() override;
     // Under mutex: frees the dropped command buffers the GPU is done with.
-    void free_completed();
+    // Inline: a frame loop's begin and reset find nothing pending.
+    void free_completed() {
+        if (!pending.empty()) free_ready();
+    }
+    void free_ready();
 
     Device device;
     VkCommandPool pool = VK_NULL_HANDLE;

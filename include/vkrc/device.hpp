@@ -341,8 +341,13 @@ public:
         // drop: a long hold by a reusable command buffer costs other closes nothing.
         if (held_count_.load() != 0 && end >= covered_.load(__ATOMIC_RELAXED)) release(device);
     }
-    // Closes every window of a pool (vkResetCommandPool).
-    void close_pool(DeviceState& device, const void* pool) noexcept;
+    // Closes every window of a pool (vkResetCommandPool). A frame loop
+    // resets a pool whose ONE_TIME_SUBMIT primaries its submit closed:
+    // nothing to scan, no lock (the pool is externally synchronised, so none
+    // of its windows opens meanwhile).
+    void close_pool(DeviceState& device, const void* pool) noexcept {
+        if (open_.load() != 0 || held_count_.load() != 0) close_pool_slow(device, pool);
+    }
     // Whether a drop of an object with this serial must wait for a close.
     bool holds(std::uint64_t serial) noexcept;
     // Holds action when holds(serial); false (and nothing done) otherwise.
@@ -361,6 +366,7 @@ public:
 
 private:
     std::uint64_t limit_locked() const noexcept;
+    void close_pool_slow(DeviceState& device, const void* pool) noexcept;
     mutable Mutex mutex_;
     List<RecordingWindow*> windows_;  // every allocated command buffer of the device
     List<Held> held_;
