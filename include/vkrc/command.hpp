@@ -459,22 +459,37 @@ private:
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
 };
 
+namespace detail {
+// What the memory, buffer and image barrier helpers fill alike: the stage
+// and access scopes and, where the barrier has them, ignored queue families
+// (no ownership transfer unless the caller sets one).
+template <class Barrier>
+inline Barrier scoped_barrier(VkStructureType type, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
+    Barrier b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
+    b.sType = type;
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    if constexpr (requires { b.srcQueueFamilyIndex; }) {
+        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    }
+    return b;
+}
+}  // namespace detail
+
 // An image barrier over every mip level and layer of one aspect. Inline: it
 // only fills a struct, which the caller's compiler folds into its own stores.
 inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
                                            VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                            VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                            VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
-    VkImageMemoryBarrier2 b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
-    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
+    auto b = detail::scoped_barrier<VkImageMemoryBarrier2>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, src_stage,
+                                                           src_access, dst_stage, dst_access);
     b.oldLayout = old_layout;
     b.newLayout = new_layout;
-    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image;
     b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
     return b;
@@ -482,13 +497,8 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
 // A global memory barrier.
 inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                        VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    VkMemoryBarrier2 b{};
-    b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    return b;
+    return detail::scoped_barrier<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, src_stage, src_access,
+                                                    dst_stage, dst_access);
 }
 
 // An image barrier over range (see mip_range and layer_range).
