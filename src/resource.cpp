@@ -2,6 +2,7 @@
 
 #include "vkrc/upload.hpp"
 
+#include "adopt.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
@@ -337,35 +338,21 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
-    if (!image) throw UsageError("vkrc::ImageView::adopt: the Image handle is empty");
-    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::ImageView::adopt: the VkImageView is VK_NULL_HANDLE");
-    detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
-    state->image = image;
-    state->view = view;
+    auto state = detail::adopted_state<&detail::ImageViewState::image, &detail::ImageViewState::view>(
+        "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
-    state->ownership = ownership;
     return ImageView(std::move(state));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    if (!buffer) throw UsageError("vkrc::BufferView::adopt: the Buffer handle is empty");
-    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::BufferView::adopt: the VkBufferView is VK_NULL_HANDLE");
-    detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
-    state->buffer = buffer;
-    state->view = view;
-    state->ownership = ownership;
-    return BufferView(std::move(state));
+    return BufferView(detail::adopted_state<&detail::BufferViewState::buffer, &detail::BufferViewState::view>(
+        "vkrc::BufferView::adopt", buffer, "Buffer", view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    if (!device) throw UsageError("vkrc::Sampler::adopt: the Device handle is empty");
-    if (sampler == VK_NULL_HANDLE) throw UsageError("vkrc::Sampler::adopt: the VkSampler is VK_NULL_HANDLE");
-    detail::Ref<detail::SamplerState> state(new detail::SamplerState);
-    state->device = device;
-    state->sampler = sampler;
-    state->ownership = ownership;
-    return Sampler(std::move(state));
+    return Sampler(detail::adopted_state<&detail::SamplerState::device, &detail::SamplerState::sampler>(
+        "vkrc::Sampler::adopt", device, "Device", sampler, "VkSampler", ownership));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
