@@ -457,6 +457,14 @@ private:
     // NVIDIA H200 for the table alone.
     const DeviceFunctions* fn_ = nullptr;
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+
+    // The one body of the VkBool32 dynamic-state setters (cmd is the
+    // vkCmdSet*Enable member of the table; who names the caller).
+    template <auto cmd>
+    void set_enable(const char* who, bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE(who);
+        (fn_->*cmd)(cmd_, enable ? VK_TRUE : VK_FALSE);
+    }
 };
 
 namespace detail {
@@ -1053,24 +1061,21 @@ inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std
                                  strides.empty() ? nullptr : strides.data());
 }
 inline void CommandBuffer::set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_test_enable");
-    fn_->vkCmdSetDepthTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthTestEnable>("vkrc::CommandBuffer::set_depth_test_enable", enable);
 }
 inline void CommandBuffer::set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_write_enable");
-    fn_->vkCmdSetDepthWriteEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthWriteEnable>("vkrc::CommandBuffer::set_depth_write_enable", enable);
 }
 inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
     fn_->vkCmdSetDepthCompareOp(cmd_, op);
 }
 inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds_test_enable");
-    fn_->vkCmdSetDepthBoundsTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthBoundsTestEnable>("vkrc::CommandBuffer::set_depth_bounds_test_enable",
+                                                                enable);
 }
 inline void CommandBuffer::set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_test_enable");
-    fn_->vkCmdSetStencilTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetStencilTestEnable>("vkrc::CommandBuffer::set_stencil_test_enable", enable);
 }
 inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
                                           VkStencilOp depth_fail_op,
@@ -1079,16 +1084,15 @@ inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp 
     fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
 }
 inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_rasterizer_discard_enable");
-    fn_->vkCmdSetRasterizerDiscardEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetRasterizerDiscardEnable>("vkrc::CommandBuffer::set_rasterizer_discard_enable",
+                                                                  enable);
 }
 inline void CommandBuffer::set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias_enable");
-    fn_->vkCmdSetDepthBiasEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthBiasEnable>("vkrc::CommandBuffer::set_depth_bias_enable", enable);
 }
 inline void CommandBuffer::set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_restart_enable");
-    fn_->vkCmdSetPrimitiveRestartEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetPrimitiveRestartEnable>("vkrc::CommandBuffer::set_primitive_restart_enable",
+                                                                 enable);
 }
 
 inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point,
