@@ -1,5 +1,7 @@
 #include "vkrc/command.hpp"
 
+#include "adopt.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -56,13 +58,9 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
 
 CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
                                Ownership ownership) {
-    if (!device) throw UsageError("vkrc::CommandPool::adopt: the Device handle is empty");
-    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::CommandPool::adopt: the VkCommandPool is VK_NULL_HANDLE");
-    detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);
-    s->device = device;
-    s->pool = pool;
+    auto s = detail::adopted_state<&detail::CommandPoolState::device, &detail::CommandPoolState::pool>(
+        "vkrc::CommandPool::adopt", device, "Device", pool, "VkCommandPool", ownership);
     s->queue_family_index = queue_family_index;
-    s->ownership = ownership;
     return CommandPool(std::move(s));
 }
 

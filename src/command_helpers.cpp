@@ -48,13 +48,8 @@ VkImageSubresourceRange layer_range(std::uint32_t base_layer, std::uint32_t laye
 VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access, VkDeviceSize offset,
                                       VkDeviceSize size) noexcept {
-    VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    auto b = detail::scoped_barrier<VkBufferMemoryBarrier2>(VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, src_stage,
+                                                            src_access, dst_stage, dst_access);
     b.buffer = buffer;
     b.offset = offset;
     b.size = size;

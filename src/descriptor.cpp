@@ -2,6 +2,7 @@
 
 #include "vkrc/descriptor_template.hpp"
 
+#include "adopt.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
@@ -149,12 +150,8 @@ DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescripto
 
 DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
                                      Ownership ownership) {
-    if (!device) throw UsageError("vkrc::DescriptorPool::adopt: the Device handle is empty");
-    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::DescriptorPool::adopt: the VkDescriptorPool is VK_NULL_HANDLE");
-    detail::Ref<detail::DescriptorPoolState> s(new detail::DescriptorPoolState);
-    s->device = device;
-    s->pool = pool;
-    s->ownership = ownership;
+    auto s = detail::adopted_state<&detail::DescriptorPoolState::device, &detail::DescriptorPoolState::pool>(
+        "vkrc::DescriptorPool::adopt", device, "Device", pool, "VkDescriptorPool", ownership);
     s->can_free_sets = (flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
     return DescriptorPool(std::move(s));
 }

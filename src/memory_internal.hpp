@@ -21,23 +21,24 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 
 // The statistics bookkeeping both allocators do: a VkDeviceMemory of bytes
 // made or freed (a block, or a dedicated allocation), a range of bytes
-// handed out or taken back (a dedicated allocation is both).
-inline void add_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
-    heap.block_bytes += bytes;
-    heap.block_count += 1;
+// handed out or taken back (a dedicated allocation is both). A count and its
+// bytes always move together.
+template <VkDeviceSize HeapStatistics::*Bytes, std::uint32_t HeapStatistics::*Count>
+inline void tally(HeapStatistics& heap, VkDeviceSize bytes, bool add) noexcept {
+    if (add) {
+        heap.*Bytes += bytes;
+        heap.*Count += 1;
+    } else {
+        heap.*Bytes -= bytes;
+        heap.*Count -= 1;
+    }
 }
-inline void remove_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
-    heap.block_bytes -= bytes;
-    heap.block_count -= 1;
-}
-inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
-    heap.allocation_bytes += bytes;
-    heap.allocation_count += 1;
-}
-inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
-    heap.allocation_bytes -= bytes;
-    heap.allocation_count -= 1;
-}
+constexpr auto tally_block = tally<&HeapStatistics::block_bytes, &HeapStatistics::block_count>;
+constexpr auto tally_range = tally<&HeapStatistics::allocation_bytes, &HeapStatistics::allocation_count>;
+inline void add_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_block(heap, bytes, true); }
+inline void remove_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_block(heap, bytes, false); }
+inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_range(heap, bytes, true); }
+inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_range(heap, bytes, false); }
 
 // Vulkan's alignments are powers of two; the division is for anything else.
 constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {

@@ -1,5 +1,7 @@
 #include "vkrc/pipeline.hpp"
 
+#include "adopt.hpp"
+
 #include <algorithm>
 #include <filesystem>
 #include <cerrno>
@@ -44,58 +46,38 @@ void require(bool ok, const char* who, const char* problem) {
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
 
 PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {
-    require(static_cast<bool>(device), "vkrc::PipelineLayout::adopt", "the Device handle is empty");
-    require(layout != VK_NULL_HANDLE, "vkrc::PipelineLayout::adopt", "the VkPipelineLayout is VK_NULL_HANDLE");
-    detail::Ref<detail::PipelineLayoutState> s(new detail::PipelineLayoutState);
-    s->device = device;
-    s->layout = layout;
-    s->ownership = ownership;
-    return PipelineLayout(std::move(s));
+    return PipelineLayout(
+        detail::adopted_state<&detail::PipelineLayoutState::device, &detail::PipelineLayoutState::layout>(
+            "vkrc::PipelineLayout::adopt", device, "Device", layout, "VkPipelineLayout", ownership));
 }
 
 RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
                              std::span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
-    require(static_cast<bool>(device), "vkrc::RenderPass::adopt", "the Device handle is empty");
-    require(render_pass != VK_NULL_HANDLE, "vkrc::RenderPass::adopt", "the VkRenderPass is VK_NULL_HANDLE");
-    detail::Ref<detail::RenderPassState> s(new detail::RenderPassState);
-    s->device = device;
-    s->render_pass = render_pass;
-    s->color_counts = List<std::uint32_t>(color_attachment_counts);
-    s->ownership = ownership;
+    List<std::uint32_t> counts(color_attachment_counts);  // before the state: a failed copy must not destroy
+    auto s = detail::adopted_state<&detail::RenderPassState::device, &detail::RenderPassState::render_pass>(
+        "vkrc::RenderPass::adopt", device, "Device", render_pass, "VkRenderPass", ownership);
+    s->color_counts = std::move(counts);
     return RenderPass(std::move(s));
 }
 
 Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                                Ownership ownership) {
-    require(static_cast<bool>(render_pass), "vkrc::Framebuffer::adopt", "the RenderPass handle is empty");
-    require(framebuffer != VK_NULL_HANDLE, "vkrc::Framebuffer::adopt", "the VkFramebuffer is VK_NULL_HANDLE");
-    detail::Ref<detail::FramebufferState> s(new detail::FramebufferState);
-    s->render_pass = render_pass;
-    s->framebuffer = framebuffer;
+    auto s = detail::adopted_state<&detail::FramebufferState::render_pass, &detail::FramebufferState::framebuffer>(
+        "vkrc::Framebuffer::adopt", render_pass, "RenderPass", framebuffer, "VkFramebuffer", ownership);
     s->extent = extent;
-    s->ownership = ownership;
     return Framebuffer(std::move(s));
 }
 
 PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, Ownership ownership) {
-    require(static_cast<bool>(device), "vkrc::PipelineCache::adopt", "the Device handle is empty");
-    require(cache != VK_NULL_HANDLE, "vkrc::PipelineCache::adopt", "the VkPipelineCache is VK_NULL_HANDLE");
-    detail::Ref<detail::PipelineCacheState> s(new detail::PipelineCacheState);
-    s->device = device;
-    s->cache = cache;
-    s->ownership = ownership;
-    return PipelineCache(std::move(s));
+    return PipelineCache(detail::adopted_state<&detail::PipelineCacheState::device, &detail::PipelineCacheState::cache>(
+        "vkrc::PipelineCache::adopt", device, "Device", cache, "VkPipelineCache", ownership));
 }
 
 Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                          Ownership ownership) {
-    require(static_cast<bool>(layout), "vkrc::Pipeline::adopt", "the PipelineLayout handle is empty");
-    require(pipeline != VK_NULL_HANDLE, "vkrc::Pipeline::adopt", "the VkPipeline is VK_NULL_HANDLE");
-    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
-    s->layout = layout;
-    s->pipeline = pipeline;
+    auto s = detail::adopted_state<&detail::PipelineState::layout, &detail::PipelineState::pipeline>(
+        "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
     s->bind_point = bind_point;
-    s->ownership = ownership;
     return Pipeline(std::move(s));
 }
 

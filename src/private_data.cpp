@@ -1,5 +1,7 @@
 #include "vkrc/private_data.hpp"
 
+#include "adopt.hpp"
+
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
@@ -12,14 +14,9 @@ PrivateDataSlotState::~PrivateDataSlotState() {
 }  // namespace detail
 
 PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership) {
-    if (!device) throw UsageError("vkrc::PrivateDataSlot::adopt: the Device handle is empty");
-    if (slot == VK_NULL_HANDLE)
-        throw UsageError("vkrc::PrivateDataSlot::adopt: the VkPrivateDataSlot is VK_NULL_HANDLE");
-    detail::Ref<detail::PrivateDataSlotState> state(new detail::PrivateDataSlotState);
-    state->device = device;
-    state->slot = slot;
-    state->ownership = ownership;
-    return PrivateDataSlot(std::move(state));
+    return PrivateDataSlot(
+        detail::adopted_state<&detail::PrivateDataSlotState::device, &detail::PrivateDataSlotState::slot>(
+            "vkrc::PrivateDataSlot::adopt", device, "Device", slot, "VkPrivateDataSlot", ownership));
 }
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {

@@ -2,10 +2,12 @@
 
 #include "vkrc/upload.hpp"
 
+#include "adopt.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -65,19 +67,50 @@ SamplerState::~SamplerState() {
 
 namespace {
 
-// The memory of a new buffer or image: its requirements, with the dedicated
-// ones, from get_requirements (vkGet*MemoryRequirements2), placed by the
-// allocator; request carries the rest. Binding is the caller's.
-template <class GetRequirements>
-Allocation allocate_memory(const Device& device, AllocationRequest request, const SharedAllocator& allocator,
-                           GetRequirements get_requirements) {
+// Buffer::create and Image::create once the info is checked: vkCreate* into
+// the state (which owns the handle from then on, so a failure below destroys
+// it), memory for its requirements (with the dedicated ones) from the
+// allocator, and the bind. request carries the intent and placement.
+template <class State, class CreateInfo>
+void create_bound(const Device& device, const CreateInfo& ci, State& state, AllocationRequest request,
+                  const SharedAllocator& allocator) {
+    constexpr bool is_buffer = std::is_same_v<State, detail::BufferState>;
+    const auto& fn = device.fn();
     VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
     VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
-    get_requirements(requirements);
+    if constexpr (is_buffer) {
+        check(fn.vkCreateBuffer(device.vk(), &ci, nullptr, &state.buffer), "vkCreateBuffer");
+        request.dedicated_buffer = state.buffer;
+        const VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr,
+                                                    state.buffer};
+        fn.vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
+    } else {
+        check(fn.vkCreateImage(device.vk(), &ci, nullptr, &state.image), "vkCreateImage");
+        request.dedicated_image = state.image;
+        const VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr,
+                                                   state.image};
+        fn.vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
+    }
     request.requirements = requirements.memoryRequirements;
     request.prefers_dedicated = dedicated.prefersDedicatedAllocation;
     request.requires_dedicated = dedicated.requiresDedicatedAllocation;
-    return Allocation::create(device, request, allocator);
+    state.allocation = Allocation::create(device, request, allocator);
+    const VkDeviceMemory memory = state.allocation.memory();
+    const VkDeviceSize offset = state.allocation.offset();
+    if constexpr (is_buffer) {
+        check(fn.vkBindBufferMemory(device.vk(), state.buffer, memory, offset), "vkBindBufferMemory");
+    } else {
+        check(fn.vkBindImageMemory(device.vk(), state.image, memory, offset), "vkBindImageMemory");
+    }
+}
+
+// The sharing of a VkBufferCreateInfo or VkImageCreateInfo from vkrc's info
+// (the queue families matter for concurrent sharing only).
+template <class CreateInfo, class Info>
+void set_sharing(CreateInfo& ci, const Info& info) noexcept {
+    ci.sharingMode = info.sharing_mode;
+    ci.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
+    ci.pQueueFamilyIndices = info.queue_family_indices.data();
 }
 
 // The address of a bound buffer with SHADER_DEVICE_ADDRESS usage; 0 without.
@@ -158,26 +191,13 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     ci.flags = info.flags;
     ci.size = info.size;
     ci.usage = info.usage;
-    ci.sharingMode = info.sharing_mode;
-    ci.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
-    ci.pQueueFamilyIndices = info.queue_family_indices.data();
-
-    // The state owns the buffer from here, so a failure below destroys it.
-    auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
-    check(device.fn().vkCreateBuffer(device.vk(), &ci, nullptr, &state->buffer), "vkCreateBuffer");
+    set_sharing(ci, info);
     AllocationRequest request;
     request.intent = info.memory;
-    request.dedicated_buffer = state->buffer;
     request.linear = true;
     request.device_address = (info.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
-    state->allocation = allocate_memory(device, request, info.allocator, [&](VkMemoryRequirements2& requirements) {
-        VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr,
-                                              state->buffer};
-        device.fn().vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
-    });
-    check(device.fn().vkBindBufferMemory(device.vk(), state->buffer, state->allocation.memory(),
-                                         state->allocation.offset()),
-          "vkBindBufferMemory");
+    auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
+    create_bound(device, ci, *state, request, info.allocator);
     state->device_address = query_device_address(device, state->buffer, info.usage);
     return Buffer(std::move(state));
 }
@@ -233,24 +253,13 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
     ci.samples = info.samples;
     ci.tiling = info.tiling;
     ci.usage = info.usage;
-    ci.sharingMode = info.sharing_mode;
-    ci.queueFamilyIndexCount = static_cast<std::uint32_t>(info.queue_family_indices.size());
-    ci.pQueueFamilyIndices = info.queue_family_indices.data();
+    set_sharing(ci, info);
     ci.initialLayout = info.initial_layout;
-
-    auto state = image_state(device, info, Ownership::owned);
-    check(device.fn().vkCreateImage(device.vk(), &ci, nullptr, &state->image), "vkCreateImage");
     AllocationRequest request;
     request.intent = info.memory;
-    request.dedicated_image = state->image;
     request.linear = info.tiling == VK_IMAGE_TILING_LINEAR;
-    state->allocation = allocate_memory(device, request, info.allocator, [&](VkMemoryRequirements2& requirements) {
-        VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr, state->image};
-        device.fn().vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
-    });
-    check(device.fn().vkBindImageMemory(device.vk(), state->image, state->allocation.memory(),
-                                        state->allocation.offset()),
-          "vkBindImageMemory");
+    auto state = image_state(device, info, Ownership::owned);
+    create_bound(device, ci, *state, request, info.allocator);
     return Image(std::move(state));
 }
 
@@ -337,35 +346,21 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
-    if (!image) throw UsageError("vkrc::ImageView::adopt: the Image handle is empty");
-    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::ImageView::adopt: the VkImageView is VK_NULL_HANDLE");
-    detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
-    state->image = image;
-    state->view = view;
+    auto state = detail::adopted_state<&detail::ImageViewState::image, &detail::ImageViewState::view>(
+        "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
-    state->ownership = ownership;
     return ImageView(std::move(state));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    if (!buffer) throw UsageError("vkrc::BufferView::adopt: the Buffer handle is empty");
-    if (view == VK_NULL_HANDLE) throw UsageError("vkrc::BufferView::adopt: the VkBufferView is VK_NULL_HANDLE");
-    detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
-    state->buffer = buffer;
-    state->view = view;
-    state->ownership = ownership;
-    return BufferView(std::move(state));
+    return BufferView(detail::adopted_state<&detail::BufferViewState::buffer, &detail::BufferViewState::view>(
+        "vkrc::BufferView::adopt", buffer, "Buffer", view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    if (!device) throw UsageError("vkrc::Sampler::adopt: the Device handle is empty");
-    if (sampler == VK_NULL_HANDLE) throw UsageError("vkrc::Sampler::adopt: the VkSampler is VK_NULL_HANDLE");
-    detail::Ref<detail::SamplerState> state(new detail::SamplerState);
-    state->device = device;
-    state->sampler = sampler;
-    state->ownership = ownership;
-    return Sampler(std::move(state));
+    return Sampler(detail::adopted_state<&detail::SamplerState::device, &detail::SamplerState::sampler>(
+        "vkrc::Sampler::adopt", device, "Device", sampler, "VkSampler", ownership));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {

@@ -1,5 +1,7 @@
 #include "vkrc/shader.hpp"
 
+#include "adopt.hpp"
+
 #include <filesystem>
 #include <cstdio>
 #include <cstring>
@@ -59,13 +61,8 @@ ShaderModule ShaderModule::create(const Device& device, std::span<const std::byt
 }
 
 ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
-    if (!device) throw UsageError("vkrc::ShaderModule::adopt: the Device handle is empty");
-    if (module == VK_NULL_HANDLE) throw UsageError("vkrc::ShaderModule::adopt: the VkShaderModule is VK_NULL_HANDLE");
-    detail::Ref<detail::ShaderModuleState> s(new detail::ShaderModuleState);
-    s->device = device;
-    s->module = module;
-    s->ownership = ownership;
-    return ShaderModule(std::move(s));
+    return ShaderModule(detail::adopted_state<&detail::ShaderModuleState::device, &detail::ShaderModuleState::module>(
+        "vkrc::ShaderModule::adopt", device, "Device", module, "VkShaderModule", ownership));
 }
 
 ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {

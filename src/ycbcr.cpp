@@ -1,5 +1,7 @@
 #include "vkrc/ycbcr.hpp"
 
+#include "adopt.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -16,15 +18,12 @@ SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
 SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSamplerYcbcrConversion conversion,
                                                      VkFormat format, Ownership ownership) {
     constexpr const char* who = "vkrc::SamplerYcbcrConversion::adopt";
-    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
-    if (conversion == VK_NULL_HANDLE)
-        throw UsageError(std::string(who) + ": the VkSamplerYcbcrConversion is VK_NULL_HANDLE");
+    // Before the state exists: once it holds an owned conversion, a throw would destroy it.
     if (format == VK_FORMAT_UNDEFINED) throw UsageError(std::string(who) + ": format is VK_FORMAT_UNDEFINED");
-    detail::Ref<detail::SamplerYcbcrConversionState> state(new detail::SamplerYcbcrConversionState);
-    state->device = device;
-    state->conversion = conversion;
+    auto state = detail::adopted_state<&detail::SamplerYcbcrConversionState::device,
+                                       &detail::SamplerYcbcrConversionState::conversion>(
+        who, device, "Device", conversion, "VkSamplerYcbcrConversion", ownership);
     state->format = format;
-    state->ownership = ownership;
     return SamplerYcbcrConversion(std::move(state));
 }
 

@@ -457,7 +457,36 @@ private:
     // NVIDIA H200 for the table alone.
     const DeviceFunctions* fn_ = nullptr;
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+
+    // The one body of the VkBool32 dynamic-state setters (cmd is the
+    // vkCmdSet*Enable member of the table; who names the caller).
+    template <auto cmd>
+    void set_enable(const char* who, bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE(who);
+        (fn_->*cmd)(cmd_, enable ? VK_TRUE : VK_FALSE);
+    }
 };
+
+namespace detail {
+// What the memory, buffer and image barrier helpers fill alike: the stage
+// and access scopes and, where the barrier has them, ignored queue families
+// (no ownership transfer unless the caller sets one).
+template <class Barrier>
+inline Barrier scoped_barrier(VkStructureType type, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
+    Barrier b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
+    b.sType = type;
+    b.srcStageMask = src_stage;
+    b.srcAccessMask = src_access;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    if constexpr (requires { b.srcQueueFamilyIndex; }) {
+        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    }
+    return b;
+}
+}  // namespace detail
 
 // An image barrier over every mip level and layer of one aspect. Inline: it
 // only fills a struct, which the caller's compiler folds into its own stores.
@@ -465,16 +494,10 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
                                            VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                            VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                            VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
-    VkImageMemoryBarrier2 b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
-    b.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
+    auto b = detail::scoped_barrier<VkImageMemoryBarrier2>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, src_stage,
+                                                           src_access, dst_stage, dst_access);
     b.oldLayout = old_layout;
     b.newLayout = new_layout;
-    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image;
     b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
     return b;
@@ -482,13 +505,8 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
 // A global memory barrier.
 inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                        VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    VkMemoryBarrier2 b{};
-    b.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    return b;
+    return detail::scoped_barrier<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, src_stage, src_access,
+                                                    dst_stage, dst_access);
 }
 
 // An image barrier over range (see mip_range and layer_range).
@@ -1047,24 +1065,21 @@ inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std
                                  strides.empty() ? nullptr : strides.data());
 }
 inline void CommandBuffer::set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_test_enable");
-    fn_->vkCmdSetDepthTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthTestEnable>("vkrc::CommandBuffer::set_depth_test_enable", enable);
 }
 inline void CommandBuffer::set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_write_enable");
-    fn_->vkCmdSetDepthWriteEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthWriteEnable>("vkrc::CommandBuffer::set_depth_write_enable", enable);
 }
 inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
     fn_->vkCmdSetDepthCompareOp(cmd_, op);
 }
 inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds_test_enable");
-    fn_->vkCmdSetDepthBoundsTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthBoundsTestEnable>("vkrc::CommandBuffer::set_depth_bounds_test_enable",
+                                                                enable);
 }
 inline void CommandBuffer::set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_test_enable");
-    fn_->vkCmdSetStencilTestEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetStencilTestEnable>("vkrc::CommandBuffer::set_stencil_test_enable", enable);
 }
 inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
                                           VkStencilOp depth_fail_op,
@@ -1073,16 +1088,15 @@ inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp 
     fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
 }
 inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_rasterizer_discard_enable");
-    fn_->vkCmdSetRasterizerDiscardEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetRasterizerDiscardEnable>("vkrc::CommandBuffer::set_rasterizer_discard_enable",
+                                                                  enable);
 }
 inline void CommandBuffer::set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias_enable");
-    fn_->vkCmdSetDepthBiasEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetDepthBiasEnable>("vkrc::CommandBuffer::set_depth_bias_enable", enable);
 }
 inline void CommandBuffer::set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_restart_enable");
-    fn_->vkCmdSetPrimitiveRestartEnable(cmd_, enable ? VK_TRUE : VK_FALSE);
+    set_enable<&DeviceFunctions::vkCmdSetPrimitiveRestartEnable>("vkrc::CommandBuffer::set_primitive_restart_enable",
+                                                                 enable);
 }
 
 inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point,

@@ -309,6 +309,21 @@ inline void write_mapped(const char* who, const AllocationState* s, std::byte* m
         s->flush(offset, count * sizeof(T));
 }
 
+// The write overloads Allocation and WriteOnlyView share: each is one call
+// of Derived's write(offset, data, count).
+template <class Derived>
+class MappedWrites {
+public:
+    template <class T>
+    void write(VkDeviceSize offset, std::span<const T> data) const {
+        static_cast<const Derived&>(*this).write(offset, data.data(), data.size());
+    }
+    template <class T>
+    void write_value(VkDeviceSize offset, const T& value) const {
+        static_cast<const Derived&>(*this).write(offset, &value, 1);
+    }
+};
+
 }  // namespace detail
 
 // Writes to host-coherent upload memory as plain copies. Reading
@@ -318,22 +333,15 @@ inline void write_mapped(const char* who, const AllocationState* s, std::byte* m
 // (fixed for the allocation's life), so a view kept next to the other
 // per-frame data writes with no pointer chase through the Allocation. Use it
 // while its Allocation lives.
-class WriteOnlyView {
+class WriteOnlyView : public detail::MappedWrites<WriteOnlyView> {
 public:
     // An empty view (size 0), to be assigned from Allocation::write_only().
     WriteOnlyView() noexcept = default;
+    using MappedWrites::write;
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
         // Coherent: write_mapped's flush branch folds away.
         detail::write_mapped("vkrc::WriteOnlyView::write", nullptr, mapped_, size_, true, offset, data, count);
-    }
-    template <class T>
-    void write(VkDeviceSize offset, std::span<const T> data) const {
-        write(offset, data.data(), data.size());
-    }
-    template <class T>
-    void write_value(VkDeviceSize offset, const T& value) const {
-        write(offset, &value, 1);
     }
     VkDeviceSize size() const noexcept { return size_; }
     // The bytes [offset, offset + size) as a view of their own (a ring's
@@ -359,7 +367,7 @@ private:
 // A range of device memory owned by its handles; keeps its Device alive and
 // returns itself to its allocator once the last owner is gone and the GPU
 // work submitted before then has completed.
-class Allocation : public Handle<detail::AllocationState> {
+class Allocation : public Handle<detail::AllocationState>, public detail::MappedWrites<Allocation> {
 public:
     Allocation() noexcept = default;
     // Allocates for request from allocator (null: the device's default).
@@ -408,6 +416,7 @@ public:
     // memory. Any alignment of offset is fine. Throws UsageError when the
     // memory is not host-visible and (with VKRC_RUNTIME_CHECKS) when the bytes
     // do not fit or count * sizeof(T) overflows.
+    using MappedWrites::write;
     template <class T>
     void write(VkDeviceSize offset, const T* data, std::size_t count) const {
         VKRC_REQUIRE_STATE("vkrc::Allocation::write");
@@ -416,14 +425,6 @@ public:
             detail::throw_not_host_visible("vkrc::Allocation::write");
         detail::write_mapped("vkrc::Allocation::write", &s, s.info.mapped, s.info.size, s.coherent, offset, data,
                              count);
-    }
-    template <class T>
-    void write(VkDeviceSize offset, std::span<const T> data) const {
-        write(offset, data.data(), data.size());
-    }
-    template <class T>
-    void write_value(VkDeviceSize offset, const T& value) const {
-        write(offset, &value, 1);
     }
     // Invalidates the bytes on non-coherent memory, then copies them out.
     template <class T>
