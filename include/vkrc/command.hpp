@@ -461,7 +461,7 @@ private:
     // The one body of the VkBool32 dynamic-state setters (cmd is the
     // vkCmdSet*Enable member of the table; who names the caller).
     template <auto cmd>
-    void set_enable(const char* who, bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+    void set_enable([[maybe_unused]] const char* who, bool enable) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE(who);
         (fn_->*cmd)(cmd_, enable ? VK_TRUE : VK_FALSE);
     }
