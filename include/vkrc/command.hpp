@@ -156,7 +156,9 @@ public:
     void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
                            std::span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
-        begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values, contents);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
+        record_begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values.data(),
+                                 clear_values.size(), contents);
     }
     void begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
                            std::span<const VkClearValue> clear_values,
@@ -196,7 +198,9 @@ public:
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
     void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
                              std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
-        push_descriptor_set(bind_point, layout.vk(), set, writes);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
+        fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout.vk(), set, static_cast<std::uint32_t>(writes.size()),
+                                       writes.data());
     }
     void push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t set,
                              std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
@@ -228,15 +232,20 @@ public:
     // Typed overloads read the raw handles; raw ones are the escape hatch.
     void copy_buffer(const Buffer& src, const Buffer& dst,
                      std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_buffer(src.vk(), dst.vk(), regions);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
+        fn_->vkCmdCopyBuffer(cmd_, src.vk(), dst.vk(), static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
                               std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_buffer_to_image(src.vk(), dst.vk(), dst_layout, regions);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
+        fn_->vkCmdCopyBufferToImage(cmd_, src.vk(), dst.vk(), dst_layout, static_cast<std::uint32_t>(regions.size()),
+                                    regions.data());
     }
     void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
                               std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_image_to_buffer(src.vk(), src_layout, dst.vk(), regions);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
+        fn_->vkCmdCopyImageToBuffer(cmd_, src.vk(), src_layout, dst.vk(), static_cast<std::uint32_t>(regions.size()),
+                                    regions.data());
     }
     void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size,
                      std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
@@ -291,7 +300,9 @@ public:
     void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                     std::span<const VkImageBlit> regions,
                     VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
-        blit_image(src.vk(), src_layout, dst.vk(), dst_layout, regions, filter);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
+        fn_->vkCmdBlitImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
+                            static_cast<std::uint32_t>(regions.size()), regions.data(), filter);
     }
     void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
                     std::span<const VkImageBlit> regions,
@@ -299,24 +310,32 @@ public:
     // src: multisampled; dst: single-sample, same format.
     void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                        std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        resolve_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
+        fn_->vkCmdResolveImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
+                               static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
                        std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                     std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
+        fn_->vkCmdCopyImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
+                            static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     // Outside rendering; the image needs TRANSFER_DST usage.
     void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
                            std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        clear_color_image(image.vk(), layout, color, ranges);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
+        fn_->vkCmdClearColorImage(cmd_, image.vk(), layout, &color, static_cast<std::uint32_t>(ranges.size()),
+                                  ranges.data());
     }
     void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
                            std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
     void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
                                    std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        clear_depth_stencil_image(image.vk(), layout, value, ranges);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
+        fn_->vkCmdClearDepthStencilImage(cmd_, image.vk(), layout, &value, static_cast<std::uint32_t>(ranges.size()),
+                                         ranges.data());
     }
     void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
                                    std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
@@ -439,7 +458,10 @@ public:
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
                               std::span<const VkDescriptorSet> sets,
                               std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
-        bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
+        fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout.vk(), first_set, static_cast<std::uint32_t>(sets.size()),
+                                     sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
+                                     dynamic_offsets.data());
     }
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
                               std::span<const VkDescriptorSet> sets,
@@ -450,6 +472,11 @@ public:
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
+    // Both begin_render_pass overloads; the clear values come as pointer and
+    // count because passing a std::span on costs each includer's compile.
+    void record_begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
+                                  const VkClearValue* clear_values, std::size_t clear_value_count,
+                                  VkSubpassContents contents) const noexcept;
     // The device's function table and the Vulkan handle, also held by the
     // state, copied into the handle: a recording call then loads both
     // straight from the handle (as vk::raii's members are), one pointer
@@ -634,13 +661,19 @@ inline void CommandBuffer::begin_render_pass(VkRenderPass render_pass, VkFramebu
                                              std::span<const VkClearValue> clear_values,
                                              VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
+    record_begin_render_pass(render_pass, framebuffer, render_area, clear_values.data(), clear_values.size(), contents);
+}
+inline void CommandBuffer::record_begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer,
+                                                    VkRect2D render_area, const VkClearValue* clear_values,
+                                                    std::size_t clear_value_count,
+                                                    VkSubpassContents contents) const noexcept {
     VkRenderPassBeginInfo info{};
     info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
     info.renderPass = render_pass;
     info.framebuffer = framebuffer;
     info.renderArea = render_area;
-    info.clearValueCount = static_cast<std::uint32_t>(clear_values.size());
-    info.pClearValues = clear_values.data();
+    info.clearValueCount = static_cast<std::uint32_t>(clear_value_count);
+    info.pClearValues = clear_values;
     fn_->vkCmdBeginRenderPass(cmd_, &info, contents);
 }
 inline void CommandBuffer::next_subpass(VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
@@ -654,7 +687,24 @@ inline void CommandBuffer::end_render_pass() const VKRC_UNCHECKED_NOEXCEPT {
 
 namespace detail {
 [[noreturn]] void throw_too_many_color_attachments(std::size_t count);
+
+// begin_rendering's conversion: a function rather than a lambda, and an
+// index loop rather than span iterators, because each closure type and
+// iterator instantiation costs every includer's compile (bench/header_cost).
+inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttachment& a) noexcept {
+    VkRenderingAttachmentInfo r{};
+    r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+    r.imageView = a.image_view;
+    r.imageLayout = a.image_layout;
+    r.loadOp = a.load_op;
+    r.storeOp = a.store_op;
+    r.clearValue = a.clear_value;
+    r.resolveMode = a.resolve_mode;
+    r.resolveImageView = a.resolve_image_view;
+    r.resolveImageLayout = a.resolve_image_layout;
+    return r;
 }
+}  // namespace detail
 
 inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
 #if VKRC_RUNTIME_CHECKS
@@ -663,24 +713,12 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
         detail::throw_too_many_color_attachments(info.color_attachments.size());
     }
 #endif
-    auto convert = [](const RenderingAttachment& a) {
-        VkRenderingAttachmentInfo r{};
-        r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-        r.imageView = a.image_view;
-        r.imageLayout = a.image_layout;
-        r.loadOp = a.load_op;
-        r.storeOp = a.store_op;
-        r.clearValue = a.clear_value;
-        r.resolveMode = a.resolve_mode;
-        r.resolveImageView = a.resolve_image_view;
-        r.resolveImageLayout = a.resolve_image_layout;
-        return r;
-    };
     VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
+    const RenderingAttachment* color_attachments = info.color_attachments.data();
+    const std::size_t color_count = info.color_attachments.size();
     std::uint32_t count = 0;
-    for (const auto& a : info.color_attachments) {
-        if (count == RenderingInfo::max_color_attachments) break;
-        colors[count++] = convert(a);
+    for (; count < color_count && count < RenderingInfo::max_color_attachments; ++count) {
+        colors[count] = detail::rendering_attachment_info(color_attachments[count]);
     }
     VkRenderingAttachmentInfo depth, stencil;
     VkRenderingInfo r{};
@@ -693,11 +731,11 @@ inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
     r.colorAttachmentCount = count;
     r.pColorAttachments = colors;
     if (info.depth_attachment) {
-        depth = convert(*info.depth_attachment);
+        depth = detail::rendering_attachment_info(*info.depth_attachment);
         r.pDepthAttachment = &depth;
     }
     if (info.stencil_attachment) {
-        stencil = convert(*info.stencil_attachment);
+        stencil = detail::rendering_attachment_info(*info.stencil_attachment);
         r.pStencilAttachment = &stencil;
     }
     fn_->vkCmdBeginRendering(cmd_, &r);

@@ -28,9 +28,13 @@ public:
     template <class String, class = decltype(std::declval<const String&>().c_str())>
     explicit Text(const String& text) : Text(text.c_str()) {}
     Text(const Text& other) noexcept;
-    Text(Text&& other) noexcept : block_(std::exchange(other.block_, nullptr)) {}
+    // By hand rather than std::exchange and std::swap, whose instantiations
+    // every includer would compile (bench/header_cost).
+    Text(Text&& other) noexcept : block_(other.block_) { other.block_ = nullptr; }
     Text& operator=(Text other) noexcept {
-        std::swap(block_, other.block_);
+        Block* mine = block_;
+        block_ = other.block_;
+        other.block_ = mine;
         return *this;
     }
     ~Text();

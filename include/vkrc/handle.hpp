@@ -202,14 +202,16 @@ public:
     Ref(const Ref& other) noexcept : p_(other.p_) {
         if (p_) p_->add_ref();
     }
-    Ref(Ref&& other) noexcept : p_(std::exchange(other.p_, nullptr)) {}
+    // Pointer moves by hand rather than std::exchange and std::swap, whose
+    // instantiations for each state type every includer would compile.
+    Ref(Ref&& other) noexcept : p_(other.p_) { other.p_ = nullptr; }
     template <class U>
     Ref(const Ref<U>& other) noexcept : p_(other.get()) {
         if (p_) p_->add_ref();
     }
     // Copy-and-swap: safe for self-assignment in both forms.
     Ref& operator=(Ref other) noexcept {
-        std::swap(p_, other.p_);
+        swap(other);
         return *this;
     }
     // Through RefCounted: a state type may declare a release() of its own
@@ -228,9 +230,17 @@ public:
     T& operator*() const noexcept { return *p_; }
     explicit operator bool() const noexcept { return p_ != nullptr; }
     // Gives up ownership without releasing; the caller now owns a reference.
-    T* detach() noexcept { return std::exchange(p_, nullptr); }
+    T* detach() noexcept {
+        T* p = p_;
+        p_ = nullptr;
+        return p;
+    }
     void reset() noexcept { Ref().swap(*this); }
-    void swap(Ref& other) noexcept { std::swap(p_, other.p_); }
+    void swap(Ref& other) noexcept {
+        T* p = p_;
+        p_ = other.p_;
+        other.p_ = p;
+    }
 
 private:
     T* p_ = nullptr;

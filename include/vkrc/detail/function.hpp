@@ -32,9 +32,13 @@ public:
     requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(std::forward<Args>(args)...); }
     Function(F f) : callable_(new Holder<F>(std::move(f))) {}
     Function(const Function& other) : callable_(other.callable_ ? other.callable_->clone() : nullptr) {}
-    Function(Function&& other) noexcept : callable_(std::exchange(other.callable_, nullptr)) {}
+    // By hand rather than std::exchange and std::swap, whose instantiations
+    // every includer would compile.
+    Function(Function&& other) noexcept : callable_(other.callable_) { other.callable_ = nullptr; }
     Function& operator=(Function other) noexcept {
-        std::swap(callable_, other.callable_);
+        Callable* mine = callable_;
+        callable_ = other.callable_;
+        other.callable_ = mine;
         return *this;
     }
     ~Function() { delete callable_; }

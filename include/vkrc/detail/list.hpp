@@ -101,10 +101,18 @@ public:
         data_ = grown;
         capacity_ = capacity;
     }
+    // By hand rather than std::swap, whose instantiations (for each T*)
+    // every includer would compile.
     void swap(List& other) noexcept {
-        std::swap(data_, other.data_);
-        std::swap(size_, other.size_);
-        std::swap(capacity_, other.capacity_);
+        T* data = data_;
+        data_ = other.data_;
+        other.data_ = data;
+        std::size_t n = size_;
+        size_ = other.size_;
+        other.size_ = n;
+        n = capacity_;
+        capacity_ = other.capacity_;
+        other.capacity_ = n;
     }
 
     friend bool operator==(const List& a, const List& b) {
