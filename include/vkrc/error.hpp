@@ -7,6 +7,7 @@
 #pragma once
 
 #include "vkrc/config.hpp"
+#include "vkrc/detail/moves.hpp"
 
 #include <vulkan/vulkan_core.h>
 
@@ -28,13 +29,9 @@ public:
     template <class String, class = decltype(std::declval<const String&>().c_str())>
     explicit Text(const String& text) : Text(text.c_str()) {}
     Text(const Text& other) noexcept;
-    // By hand rather than std::exchange and std::swap, whose instantiations
-    // every includer would compile (bench/header_cost).
-    Text(Text&& other) noexcept : block_(other.block_) { other.block_ = nullptr; }
+    Text(Text&& other) noexcept : block_(moves::take(other.block_)) {}
     Text& operator=(Text other) noexcept {
-        Block* mine = block_;
-        block_ = other.block_;
-        other.block_ = mine;
+        moves::swap_values(block_, other.block_);
         return *this;
     }
     ~Text();

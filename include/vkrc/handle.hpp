@@ -7,6 +7,7 @@
 #pragma once
 
 #include "vkrc/config.hpp"
+#include "vkrc/detail/moves.hpp"
 
 #include <pthread.h>
 
@@ -202,9 +203,7 @@ public:
     Ref(const Ref& other) noexcept : p_(other.p_) {
         if (p_) p_->add_ref();
     }
-    // Pointer moves by hand rather than std::exchange and std::swap, whose
-    // instantiations for each state type every includer would compile.
-    Ref(Ref&& other) noexcept : p_(other.p_) { other.p_ = nullptr; }
+    Ref(Ref&& other) noexcept : p_(moves::take(other.p_)) {}
     template <class U>
     Ref(const Ref<U>& other) noexcept : p_(other.get()) {
         if (p_) p_->add_ref();
@@ -230,17 +229,9 @@ public:
     T& operator*() const noexcept { return *p_; }
     explicit operator bool() const noexcept { return p_ != nullptr; }
     // Gives up ownership without releasing; the caller now owns a reference.
-    T* detach() noexcept {
-        T* p = p_;
-        p_ = nullptr;
-        return p;
-    }
+    T* detach() noexcept { return moves::take(p_); }
     void reset() noexcept { Ref().swap(*this); }
-    void swap(Ref& other) noexcept {
-        T* p = p_;
-        p_ = other.p_;
-        other.p_ = p;
-    }
+    void swap(Ref& other) noexcept { moves::swap_values(p_, other.p_); }
 
 private:
     T* p_ = nullptr;

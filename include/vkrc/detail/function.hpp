@@ -9,6 +9,8 @@
 // cold paths (messages and logs), where the heap copy does not matter.
 #pragma once
 
+#include "vkrc/detail/moves.hpp"
+
 #include <utility>
 
 namespace vkrc {
@@ -32,13 +34,9 @@ public:
     requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(std::forward<Args>(args)...); }
     Function(F f) : callable_(new Holder<F>(std::move(f))) {}
     Function(const Function& other) : callable_(other.callable_ ? other.callable_->clone() : nullptr) {}
-    // By hand rather than std::exchange and std::swap, whose instantiations
-    // every includer would compile.
-    Function(Function&& other) noexcept : callable_(other.callable_) { other.callable_ = nullptr; }
+    Function(Function&& other) noexcept : callable_(moves::take(other.callable_)) {}
     Function& operator=(Function other) noexcept {
-        Callable* mine = callable_;
-        callable_ = other.callable_;
-        other.callable_ = mine;
+        moves::swap_values(callable_, other.callable_);
         return *this;
     }
     ~Function() { delete callable_; }

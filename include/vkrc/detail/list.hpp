@@ -9,6 +9,8 @@
 // contiguous range, so std::span<const T> takes it as it takes a vector.
 #pragma once
 
+#include "vkrc/detail/moves.hpp"
+
 #include <cstddef>
 #include <initializer_list>
 #include <new>
@@ -101,18 +103,10 @@ public:
         data_ = grown;
         capacity_ = capacity;
     }
-    // By hand rather than std::swap, whose instantiations (for each T*)
-    // every includer would compile.
     void swap(List& other) noexcept {
-        T* data = data_;
-        data_ = other.data_;
-        other.data_ = data;
-        std::size_t n = size_;
-        size_ = other.size_;
-        other.size_ = n;
-        n = capacity_;
-        capacity_ = other.capacity_;
-        other.capacity_ = n;
+        moves::swap_values(data_, other.data_);
+        moves::swap_values(size_, other.size_);
+        moves::swap_values(capacity_, other.capacity_);
     }
 
     friend bool operator==(const List& a, const List& b) {
