@@ -23,22 +23,22 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 // made or freed (a block, or a dedicated allocation), a range of bytes
 // handed out or taken back (a dedicated allocation is both). A count and its
 // bytes always move together.
-template <VkDeviceSize HeapStatistics::*Bytes, std::uint32_t HeapStatistics::*Count>
-inline void tally(HeapStatistics& heap, VkDeviceSize bytes, bool add) noexcept {
-    if (add) {
-        heap.*Bytes += bytes;
-        heap.*Count += 1;
-    } else {
-        heap.*Bytes -= bytes;
-        heap.*Count -= 1;
-    }
+inline void tally(VkDeviceSize& total, std::uint32_t& count, VkDeviceSize bytes, bool add) noexcept {
+    total = add ? total + bytes : total - bytes;
+    count = add ? count + 1 : count - 1;
 }
-constexpr auto tally_block = tally<&HeapStatistics::block_bytes, &HeapStatistics::block_count>;
-constexpr auto tally_range = tally<&HeapStatistics::allocation_bytes, &HeapStatistics::allocation_count>;
-inline void add_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_block(heap, bytes, true); }
-inline void remove_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_block(heap, bytes, false); }
-inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_range(heap, bytes, true); }
-inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept { tally_range(heap, bytes, false); }
+inline void add_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    tally(heap.block_bytes, heap.block_count, bytes, true);
+}
+inline void remove_block(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    tally(heap.block_bytes, heap.block_count, bytes, false);
+}
+inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    tally(heap.allocation_bytes, heap.allocation_count, bytes, true);
+}
+inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
+    tally(heap.allocation_bytes, heap.allocation_count, bytes, false);
+}
 
 // Vulkan's alignments are powers of two; the division is for anything else.
 constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {

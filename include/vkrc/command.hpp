@@ -230,6 +230,8 @@ public:
                       std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const VKRC_UNCHECKED_NOEXCEPT;
     // Typed overloads read the raw handles; raw ones are the escape hatch.
+    // Each makes its vkCmd* call itself: forwarding a std::span to the raw
+    // overload costs every includer's compile (bench/header_cost).
     void copy_buffer(const Buffer& src, const Buffer& dst,
                      std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
