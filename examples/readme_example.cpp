@@ -13,10 +13,10 @@ int main() {
     cmd.fill_buffer(buffer, 0, buffer.size(), 42);
     auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                         VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.pipeline_barrier(vkrc::Span(&to_host, 1), {}, {});
     cmd.end();
     auto done = vkrc::Fence::create(device);
-    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, done);
+    vkrc::submit(queue, {.command_buffers = vkrc::Span(&cmd, 1)}, done);
     done.wait();
     std::printf("%s filled the buffer with %u\n", device.physical_device().name(),
                 buffer.allocation().read_value<std::uint32_t>(512));

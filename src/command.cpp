@@ -206,7 +206,7 @@ void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
 }
 
 namespace detail {
-void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept {
+void close_submitted(Span<const CommandBuffer> command_buffers) noexcept {
     for (const CommandBuffer& c : command_buffers) {
         auto& s = *c.state();
         if (s.window.one_time)

@@ -151,7 +151,7 @@ void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const Mipmap
                       info.src_access, blit, read),
         image_barrier(raw, range(1, VK_REMAINING_MIP_LEVELS), VK_IMAGE_LAYOUT_UNDEFINED,
                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, blit, write)};
-    cmd.pipeline_barrier({}, {}, std::span(start, levels > 1 ? 2 : 1));
+    cmd.pipeline_barrier({}, {}, Span(start, levels > 1 ? 2 : 1));
     for (std::uint32_t level = 1; level < levels; ++level) {
         VkImageBlit region{};
         region.srcSubresource = {aspect, level - 1, info.base_layer, layers};
@@ -159,15 +159,15 @@ void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const Mipmap
         region.dstSubresource = {aspect, level, info.base_layer, layers};
         region.dstOffsets[1] = end_of(image.extent(level));
         cmd.blit_image(raw, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, raw, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       std::span(&region, 1), info.filter);
+                       Span(&region, 1), info.filter);
         // The level just written is the next blit's source.
         auto next = image_barrier(raw, range(level, 1), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, blit, write, blit, read);
-        cmd.pipeline_barrier({}, {}, std::span(&next, 1));
+        cmd.pipeline_barrier({}, {}, Span(&next, 1));
     }
     auto done = image_barrier(raw, range(0, levels), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, info.final_layout, blit,
                               write, info.dst_stage, info.dst_access);
-    cmd.pipeline_barrier({}, {}, std::span(&done, 1));
+    cmd.pipeline_barrier({}, {}, Span(&done, 1));
 }
 
 // Queue labels

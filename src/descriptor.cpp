@@ -357,7 +357,7 @@ void update(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescri
 namespace {
 
 void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                        std::span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element, const char* who) {
+                        Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element, const char* who) {
     if (!is_buffer_type(type)) {
         throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) + " is not a buffer type");
     }
@@ -366,7 +366,7 @@ void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t bindi
 }
 
 void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                       std::span<const VkDescriptorImageInfo> infos, std::uint32_t array_element, const char* who) {
+                       Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element, const char* who) {
     if (!is_image_type(type)) {
         throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) +
                          " is not an image or sampler type");
@@ -381,24 +381,24 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, V
                                  VkDeviceSize range, std::uint32_t array_element) const {
     VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffer");
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    write_buffer_infos(*state_, binding, type, std::span(&info, 1), array_element, "vkrc::DescriptorSet::write_buffer");
+    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, "vkrc::DescriptorSet::write_buffer");
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
     VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_image");
     const VkDescriptorImageInfo info{sampler, view, layout};
-    write_image_infos(*state_, binding, type, std::span(&info, 1), array_element, "vkrc::DescriptorSet::write_image");
+    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, "vkrc::DescriptorSet::write_image");
 }
 
 void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,
-                                  std::span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
+                                  Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
     VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffers");
     write_buffer_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_buffers");
 }
 
-void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type,
-                                 std::span<const VkDescriptorImageInfo> infos, std::uint32_t array_element) const {
+void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
+                                 std::uint32_t array_element) const {
     VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_images");
     write_image_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_images");
 }

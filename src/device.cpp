@@ -123,7 +123,7 @@ void DeviceState::submitted_snapshot(List<std::uint64_t>& out) {
     for (std::size_t i = 0; i < queues.size(); ++i) out[i] = queues[i].timeline.covering_value();
 }
 
-bool DeviceState::reached(std::span<const std::uint64_t> snapshot) noexcept {
+bool DeviceState::reached(Span<const std::uint64_t> snapshot) noexcept {
     if (lost.load(std::memory_order_relaxed)) return true;
     for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
         auto& q = queues[i];
@@ -234,7 +234,7 @@ void destroy_raw_device(const PhysicalDevice& physical, VkDevice raw) noexcept {
     if (destroy) destroy(raw, nullptr);
 }
 
-void init_queues(detail::DeviceState& s, std::span<const QueueRequest> requests) {
+void init_queues(detail::DeviceState& s, Span<const QueueRequest> requests) {
     VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     VkSemaphoreCreateInfo ci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
@@ -286,7 +286,7 @@ bool family_can_do(const PhysicalDevice& physical, std::uint32_t family, QueueRo
 
 // The first queue of the dedicated family, else the first other than those
 // in taken that can do the role's work, else taken[0] (the graphics queue).
-std::size_t pick_role_queue(const detail::DeviceState& s, QueueRole role, std::span<const std::size_t> taken) {
+std::size_t pick_role_queue(const detail::DeviceState& s, QueueRole role, Span<const std::size_t> taken) {
     const int dedicated = find_dedicated_queue_family(s.physical_device, role);
     for (std::size_t i = 0; i < s.queues.size(); ++i) {
         if (static_cast<int>(s.queues[i].family_index) == dedicated) return i;
@@ -335,9 +335,8 @@ void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& i
     }
 }
 
-void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership,
-                 std::span<const QueueRequest> queues, std::span<const char* const> extensions,
-                 detail::Ref<detail::DeviceState>& state) {
+void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
+                 Span<const char* const> extensions, detail::Ref<detail::DeviceState>& state) {
     state = detail::Ref<detail::DeviceState>(new detail::DeviceState);
     auto& s = *state;
     s.device = raw;
@@ -423,8 +422,8 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     return Device(std::move(state));
 }
 
-Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership ownership,
-                     std::span<const QueueRequest> queues, std::span<const char* const> enabled_extensions) {
+Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
+                     Span<const char* const> enabled_extensions) {
     if (!physical) throw UsageError("vkrc::Device::adopt: the PhysicalDevice handle is empty");
     if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Device::adopt: the VkDevice is VK_NULL_HANDLE");
     detail::Ref<detail::DeviceState> state;
@@ -499,7 +498,7 @@ namespace {
 // its signals fit on the stack; otherwise into one more batch, which
 // submission order still places after all the work before it. Under the
 // queue's lock.
-VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, std::span<const VkSubmitInfo2> submits,
+VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, Span<const VkSubmitInfo2> submits,
                            VkFence fence, std::uint64_t number) noexcept {
     q.timeline.take_signal_request();
     VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
@@ -539,7 +538,7 @@ VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, std::s
 
 }  // namespace
 
-std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fence) const {
+std::uint64_t Queue::submit(Span<const VkSubmitInfo2> submits, VkFence fence) const {
     auto& q = *queue_;
     auto& d = *device_.state();
     VkResult r;
@@ -558,7 +557,7 @@ std::uint64_t Queue::submit(std::span<const VkSubmitInfo2> submits, VkFence fenc
     return number;
 }
 
-std::uint64_t detail::submit_signalled(const Queue& queue, std::span<const VkSubmitInfo2> submits) {
+std::uint64_t detail::submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits) {
     auto& q = *queue.state();
     auto& d = *queue.device().state();
     VkResult r;

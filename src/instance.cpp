@@ -37,8 +37,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL debug_trampoline(VkDebugUtilsMessageSeverityFlagB
                                                 VkDebugUtilsMessageTypeFlagsEXT types,
                                                 const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
     const auto& callback = *static_cast<const DebugCallback*>(user);
-    callback(DebugMessage{severity, types, data->pMessageIdName, data->pMessage,
-                          std::span(data->pObjects, data->objectCount)});
+    callback(
+        DebugMessage{severity, types, data->pMessageIdName, data->pMessage, Span(data->pObjects, data->objectCount)});
     return VK_FALSE;  // never abort the call that produced the message
 }
 }  // namespace detail
@@ -131,8 +131,8 @@ Instance Instance::create(const InstanceCreateInfo& info) {
 }
 
 Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_version,
-                         PFN_vkGetInstanceProcAddr get_instance_proc_addr,
-                         std::span<const char* const> enabled_extensions, std::span<const char* const> enabled_layers) {
+                         PFN_vkGetInstanceProcAddr get_instance_proc_addr, Span<const char* const> enabled_extensions,
+                         Span<const char* const> enabled_layers) {
     if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Instance::adopt: the VkInstance is VK_NULL_HANDLE");
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));

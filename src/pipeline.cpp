@@ -52,7 +52,7 @@ PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layo
 }
 
 RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
-                             std::span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
+                             Span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
     List<std::uint32_t> counts(color_attachment_counts);  // before the state: a failed copy must not destroy
     auto s = detail::adopted_state<&detail::RenderPassState::device, &detail::RenderPassState::render_pass>(
         "vkrc::RenderPass::adopt", device, "Device", render_pass, "VkRenderPass", ownership);
@@ -177,7 +177,7 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
 
 // Pipeline caches
 
-PipelineCache PipelineCache::create(const Device& device, std::span<const std::byte> initial_data) {
+PipelineCache PipelineCache::create(const Device& device, Span<const std::byte> initial_data) {
     require(static_cast<bool>(device), "vkrc::PipelineCache::create", "the Device handle is empty");
     VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
     ci.initialDataSize = initial_data.size();
@@ -339,8 +339,8 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::render_pass(const RenderPass& 
     subpass_ = subpass;
     return *this;
 }
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(std::span<const VkFormat> color_formats,
-                                                            VkFormat depth_format, VkFormat stencil_format) {
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(Span<const VkFormat> color_formats, VkFormat depth_format,
+                                                            VkFormat stencil_format) {
     color_formats_ = color_formats;
     depth_format_ = depth_format;
     stencil_format_ = stencil_format;

@@ -22,15 +22,14 @@ void check_specialization(const Specialization& spec, const char* who) {
     }
 }
 
-VkSpecializationInfo specialization_info(std::span<const VkSpecializationMapEntry> entries,
-                                         std::span<const std::byte> data) {
+VkSpecializationInfo specialization_info(Span<const VkSpecializationMapEntry> entries, Span<const std::byte> data) {
     return {static_cast<std::uint32_t>(entries.size()), entries.data(), data.size(), data.data()};
 }
 
 constexpr VkShaderStageFlags tessellation_stages =
     VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT | VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT;
 
-bool contains(std::span<const VkDynamicState> states, VkDynamicState state) {
+bool contains(Span<const VkDynamicState> states, VkDynamicState state) {
     return std::find(states.begin(), states.end(), state) != states.end();
 }
 
@@ -79,7 +78,7 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::multisample(const MultisampleS
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_attachments(
-    std::span<const VkPipelineColorBlendAttachmentState> states) {
+    Span<const VkPipelineColorBlendAttachmentState> states) {
     blends_ = states;
     return *this;
 }
@@ -92,15 +91,15 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::logic_op(VkLogicOp op) {
     logic_op_ = op;
     return *this;
 }
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::viewports(std::span<const VkViewport> viewports) {
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::viewports(Span<const VkViewport> viewports) {
     viewports_ = viewports;
     return *this;
 }
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::scissors(std::span<const VkRect2D> scissors) {
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::scissors(Span<const VkRect2D> scissors) {
     scissors_ = scissors;
     return *this;
 }
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_states(std::span<const VkDynamicState> states) {
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_states(Span<const VkDynamicState> states) {
     dynamic_states_ = states;
     return *this;
 }
@@ -138,8 +137,8 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::next(const void* chain) {
     return *this;
 }
 
-void GraphicsPipelineBuilder::attach_specializations(std::span<VkPipelineShaderStageCreateInfo> stages,
-                                                     std::span<VkSpecializationInfo> infos) const {
+void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageCreateInfo> stages,
+                                                     Span<VkSpecializationInfo> infos) const {
     for (const auto& sp : specializations_) {
         auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& st) { return st.stage == sp.stage; });
         require(it != stages.end(), "vkrc::GraphicsPipelineBuilder::build",

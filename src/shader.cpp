@@ -45,13 +45,13 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
 }
 }  // namespace
 
-ShaderModule ShaderModule::create(const Device& device, std::span<const std::uint32_t> spirv) {
+ShaderModule ShaderModule::create(const Device& device, Span<const std::uint32_t> spirv) {
     detail::Ref<detail::ShaderModuleState> s;
     make(device, spirv.data(), spirv.size_bytes(), "vkrc::ShaderModule::create", s);
     return ShaderModule(std::move(s));
 }
 
-ShaderModule ShaderModule::create(const Device& device, std::span<const std::byte> spirv) {
+ShaderModule ShaderModule::create(const Device& device, Span<const std::byte> spirv) {
     // Vulkan wants 4-byte-aligned words; bytes from anywhere are copied into them.
     std::vector<std::uint32_t> words((spirv.size() + 3) / 4);
     if (!spirv.empty()) std::memcpy(words.data(), spirv.data(), spirv.size());

@@ -24,8 +24,7 @@ VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlo
 // all) covers; UsageError when it is 0 or more than the image has.
 std::uint32_t uploaded_levels(const Image& image, std::uint32_t level_count, const char* who);
 // upload_image's checks of data and info against the image.
-void check_image_upload(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info,
-                        const char* who);
+void check_image_upload(const Image& image, Span<const std::byte> data, const ImageUploadInfo& info, const char* who);
 // download_image's checks of the level, layer and layout.
 void check_image_download(const Image& image, VkImageLayout layout, std::uint32_t mip_level, std::uint32_t array_layer,
                           const char* who);

@@ -67,7 +67,7 @@ List<std::byte> Download::read() const {
     if (!t) throw UsageError("vkrc::Download::read: the download is empty or its batch was not submitted");
     t.wait_on_host();
     List<std::byte> out(size_);
-    readback_.allocation().read(0, std::span<std::byte>(out.data(), out.size()));
+    readback_.allocation().read(0, Span<std::byte>(out.data(), out.size()));
     return out;
 }
 
@@ -169,7 +169,7 @@ void end_batch(detail::UploaderState& s) {
 }
 
 // Submits the open batch; under the Uploader's lock.
-Ticket submit_batch(detail::UploaderState& s, std::span<const SemaphoreSubmit> waits) {
+Ticket submit_batch(detail::UploaderState& s, Span<const SemaphoreSubmit> waits) {
     end_batch(s);
     List<VkSemaphoreSubmitInfo> wait_infos;
     for (const auto& w : waits) wait_infos.push_back(w.info());
@@ -273,7 +273,7 @@ VkDeviceSize Uploader::staging_size() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Uploader::staging_size").staging.size();
 }
 
-void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) const {
+void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, Span<const std::byte> data) const {
     constexpr const char* who = "vkrc::Uploader::upload_buffer";
     VKRC_REQUIRE_STATE(who);
     auto& s = *state_;
@@ -314,7 +314,7 @@ List<VkBufferImageCopy> level_regions(const Image& image, std::uint32_t levels, 
 
 }  // namespace
 
-void Uploader::upload_image(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info) const {
+void Uploader::upload_image(const Image& image, Span<const std::byte> data, const ImageUploadInfo& info) const {
     constexpr const char* who = "vkrc::Uploader::upload_image";
     VKRC_REQUIRE_STATE(who);
     auto& s = *state_;
@@ -413,7 +413,7 @@ Download Uploader::download_image(const Image& image, VkImageLayout layout, std:
     return d;
 }
 
-Ticket Uploader::submit(std::span<const SemaphoreSubmit> waits) const {
+Ticket Uploader::submit(Span<const SemaphoreSubmit> waits) const {
     VKRC_REQUIRE_STATE("vkrc::Uploader::submit");
     auto& s = *state_;
     LockGuard lock(s.mutex);

@@ -39,7 +39,7 @@ constexpr std::size_t inline_batches = 4;
     }
 }
 
-void submit_infos(const Queue& queue, std::span<const VkSubmitInfo2> infos, const Fence& fence) {
+void submit_infos(const Queue& queue, Span<const VkSubmitInfo2> infos, const Fence& fence) {
 #if VKRC_RUNTIME_CHECKS
     if (fence && !(fence.device() == queue.device())) {
         throw UsageError("vkrc::submit: the Fence belongs to another device than the queue");
@@ -64,7 +64,7 @@ private:
 
 }  // namespace
 
-void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence) {
+void submit(const Queue& queue, Span<const SubmitBatch> batches, const Fence& fence) {
     if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
     std::size_t n_waits = 0, n_signals = 0, n_cmds = 0;
     for (const auto& b : batches) {
@@ -84,14 +84,14 @@ void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fenc
         s += b.signals.size();
         c += b.command_buffers.size();
     }
-    submit_infos(queue, std::span<const VkSubmitInfo2>(infos.data(), batches.size()), fence);
+    submit_infos(queue, Span<const VkSubmitInfo2>(infos.data(), batches.size()), fence);
     for (const auto& batch : batches) detail::close_submitted(batch.command_buffers);
 }
 
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
     if (batch.waits.size() > inline_semaphores || batch.signals.size() > inline_semaphores ||
         batch.command_buffers.size() > inline_command_buffers) [[unlikely]] {
-        return submit(queue, std::span<const SubmitBatch>(&batch, 1), fence);
+        return submit(queue, Span<const SubmitBatch>(&batch, 1), fence);
     }
     if (!queue) throw UsageError("vkrc::submit: the Queue is empty");
     VkSubmitInfo2 info;
@@ -99,7 +99,7 @@ void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
     VkSemaphoreSubmitInfo signals[inline_semaphores];
     VkCommandBufferSubmitInfo cmds[inline_command_buffers];
     fill_batch(queue, batch, info, waits, signals, cmds);
-    submit_infos(queue, std::span<const VkSubmitInfo2>(&info, 1), fence);
+    submit_infos(queue, Span<const VkSubmitInfo2>(&info, 1), fence);
     detail::close_submitted(batch.command_buffers);
 }
 

@@ -149,8 +149,8 @@ struct Choice {
 };
 
 // The first preferred format the surface supports, else the surface's first.
-Choice<VkSurfaceFormatKHR> choose_format(std::span<const VkSurfaceFormatKHR> formats,
-                                         std::span<const VkSurfaceFormatKHR> preferred) {
+Choice<VkSurfaceFormatKHR> choose_format(Span<const VkSurfaceFormatKHR> formats,
+                                         Span<const VkSurfaceFormatKHR> preferred) {
     if (formats.size() == 1 && formats[0].format == VK_FORMAT_UNDEFINED && !preferred.empty()) {
         return {preferred[0], "the surface accepts any format: the first preferred one"};
     }
@@ -169,7 +169,7 @@ Choice<VkSurfaceFormatKHR> choose_format(std::span<const VkSurfaceFormatKHR> for
 
 // requested if supported; IMMEDIATE and MAILBOX fall back to each other,
 // everything at last to FIFO (which every surface supports).
-VkPresentModeKHR choose_present_mode(std::span<const VkPresentModeKHR> modes, VkPresentModeKHR requested) {
+VkPresentModeKHR choose_present_mode(Span<const VkPresentModeKHR> modes, VkPresentModeKHR requested) {
     std::vector<VkPresentModeKHR> order{requested};
     if (requested == VK_PRESENT_MODE_IMMEDIATE_KHR) order.push_back(VK_PRESENT_MODE_MAILBOX_KHR);
     if (requested == VK_PRESENT_MODE_MAILBOX_KHR) order.push_back(VK_PRESENT_MODE_IMMEDIATE_KHR);
@@ -473,8 +473,8 @@ void Frame::hold(const detail::Ref<detail::FrameImages>& set) noexcept {
     filled_from_ = set.get();
 }
 
-std::span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
-std::span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
+Span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
+Span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
 
 VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
 VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }

@@ -238,7 +238,7 @@ QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& inf
     return QueryPool(std::move(s));
 }
 
-VkResult QueryPool::results(std::uint32_t first_query, std::span<std::uint64_t> out, VkQueryResultFlags flags,
+VkResult QueryPool::results(std::uint32_t first_query, Span<std::uint64_t> out, VkQueryResultFlags flags,
                             std::uint32_t stride_words) const {
     if (stride_words == 0) throw UsageError("vkrc::QueryPool::results: stride_words is 0");
     const std::size_t count = out.size() / stride_words;

@@ -6,11 +6,11 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-bool contains(std::span<const Text> names, const char* name) noexcept {
+bool contains(Span<const Text> names, const char* name) noexcept {
     return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-bool contains(std::span<const char* const> names, const char* name) noexcept {
+bool contains(Span<const char* const> names, const char* name) noexcept {
     return std::any_of(names.begin(), names.end(), [&](const char* n) { return std::strcmp(n, name) == 0; });
 }
 

@@ -4,7 +4,7 @@
 #include "vkrc/error.hpp"
 
 #include <cstdint>
-#include <span>
+#include "vkrc/detail/span.hpp"
 #include <string>
 #include <vector>
 
@@ -12,8 +12,8 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 // Whether a list of extension or layer names holds name.
-bool contains(std::span<const Text> names, const char* name) noexcept;
-bool contains(std::span<const char* const> names, const char* name) noexcept;
+bool contains(Span<const Text> names, const char* name) noexcept;
+bool contains(Span<const char* const> names, const char* name) noexcept;
 // Adds name to a list of extension or layer names unless it is there.
 void add_unique(std::vector<const char*>& names, const char* name);
 // The lower-case hexadecimal digits of v, without a prefix.

@@ -132,8 +132,7 @@ VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlo
     return checked_mul(checked_mul(checked_mul(columns, rows, who), e.depth, who), block.bytes, who);
 }
 
-void check_image_upload(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info,
-                        const char* who) {
+void check_image_upload(const Image& image, Span<const std::byte> data, const ImageUploadInfo& info, const char* who) {
     checked_block(image, who);
     uploaded_levels(image, info.level_count, who);
     const VkDeviceSize expected = image_data_size(image, info.level_count);
@@ -186,7 +185,7 @@ Uploader one_time_uploader(const Queue& queue, VkDeviceSize size) {
 }
 }  // namespace
 
-void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) {
+void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, Span<const std::byte> data) {
     constexpr const char* who = "vkrc::upload_buffer";
     detail::check_transfer(queue, buffer, VK_BUFFER_USAGE_TRANSFER_DST_BIT, "VK_BUFFER_USAGE_TRANSFER_DST_BIT", who);
     detail::check_buffer_range(buffer, offset, data.size(), who);
@@ -207,8 +206,7 @@ List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDevi
     return download.read();
 }
 
-void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
-                  const ImageUploadInfo& info) {
+void upload_image(const Queue& queue, const Image& image, Span<const std::byte> data, const ImageUploadInfo& info) {
     constexpr const char* who = "vkrc::upload_image";
     detail::check_transfer(queue, image, VK_IMAGE_USAGE_TRANSFER_DST_BIT, "VK_IMAGE_USAGE_TRANSFER_DST_BIT", who);
     detail::check_image_upload(image, data, info, who);

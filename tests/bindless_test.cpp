@@ -5,6 +5,7 @@
 
 #include "shaders/bindless.comp.h"
 
+#include <span>
 #include <vector>
 
 namespace {

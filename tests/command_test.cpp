@@ -2,6 +2,7 @@
 
 #include "shaders/fill_pattern.comp.h"
 
+#include <span>
 #include <thread>
 #include <vector>
 

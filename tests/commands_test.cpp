@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdlib>
+#include <span>
 #include <vector>
 
 namespace {

@@ -6,6 +6,7 @@
 
 #include "shaders/device_address.comp.h"
 
+#include <span>
 #include <vector>
 
 namespace {

@@ -8,6 +8,7 @@
 #include "shaders/rect.vert.h"
 
 #include <array>
+#include <span>
 
 namespace {
 

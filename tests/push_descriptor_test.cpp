@@ -5,6 +5,8 @@
 
 #include "shaders/fill_pattern.comp.h"
 
+#include <span>
+
 namespace {
 
 using vkrc_test::VulkanTest;

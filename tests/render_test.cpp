@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstring>
+#include <span>
 #include <thread>
 #include <vector>
 

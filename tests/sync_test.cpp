@@ -1,6 +1,7 @@
 #include "support/vk_test.hpp"
 
 #include <chrono>
+#include <span>
 
 namespace {
 

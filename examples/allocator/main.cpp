@@ -13,6 +13,7 @@
 #include <cstring>
 #include <exception>
 #include <memory>
+#include <span>
 
 int main(int argc, char** argv) try {
     const bool validation = argc > 1 && std::strcmp(argv[1], "--validation") == 0;

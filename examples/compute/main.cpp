@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <span>
 #include <vector>
 
 namespace {
@@ -41,7 +42,7 @@ int run(bool validation) {
         {.size = bytes, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
     std::vector<std::uint32_t> input(count);
     for (std::uint32_t i = 0; i < count; ++i) input[i] = i + 1;
-    starts.allocation().write(0, std::span<const std::uint32_t>(input));
+    starts.allocation().write(0, input);
 
     // 3. A descriptor set pointing the shader's two bindings at the buffers.
     auto set_layout =
@@ -86,7 +87,7 @@ int run(bool validation) {
 
     // 7. Read the results and compare each with the CPU's answer.
     std::vector<std::uint32_t> output(count);
-    steps.allocation().read(0, std::span(output));
+    steps.allocation().read(0, output);
     std::uint32_t mismatches = 0, longest = 0;
     for (std::uint32_t i = 0; i < count; ++i) {
         if (output[i] != collatz_steps(input[i])) ++mismatches;

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <chrono>
+#include <span>
 #include <vector>
 
 namespace {

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <cstdio>
+#include <span>
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include "vkrc/pipeline.hpp"
 #include "vkrc/sync.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -74,7 +74,7 @@ struct CommandBufferInheritance {
     std::uint32_t subpass = 0;
     Framebuffer framebuffer{};
     // Dynamic rendering, without render_pass: need not outlive begin_secondary().
-    std::span<const VkFormat> color_formats{};
+    Span<const VkFormat> color_formats{};
     VkFormat depth_format = VK_FORMAT_UNDEFINED;
     VkFormat stencil_format = VK_FORMAT_UNDEFINED;
     VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
@@ -107,7 +107,7 @@ struct RenderingInfo {
     // Required (the default is empty).
     VkRect2D render_area{};
     // Optional (empty: none).
-    std::span<const RenderingAttachment> color_attachments{};
+    Span<const RenderingAttachment> color_attachments{};
     // Optional (null: none).
     const RenderingAttachment* depth_attachment = nullptr;
     const RenderingAttachment* stencil_attachment = nullptr;
@@ -154,14 +154,14 @@ public:
 
     // Render passes and dynamic rendering
     void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
-                           std::span<const VkClearValue> clear_values,
+                           Span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
         record_begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values.data(),
                                  clear_values.size(), contents);
     }
     void begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
-                           std::span<const VkClearValue> clear_values,
+                           Span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
     void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
     void end_render_pass() const VKRC_UNCHECKED_NOEXCEPT;
@@ -178,8 +178,8 @@ public:
     }
     void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
                             VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT;
-    void bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                             std::span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_vertex_buffers(std::uint32_t first_binding, Span<const VkBuffer> buffers,
+                             Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_index_buffer(const Buffer& buffer, VkDeviceSize offset = 0,
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
         bind_index_buffer(buffer.vk(), offset, type);
@@ -188,22 +188,22 @@ public:
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT;
     // Binds one set at index set_index of the pipeline's layout.
     void bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
-                             std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
-    void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+                             Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
                         std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
     // Push descriptors (VK_KHR_push_descriptor, which must be enabled on the
     // device: the function is called as loaded). Writes set `set` of layout,
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
     void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
-                             std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
+                             Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
         fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout.vk(), set, static_cast<std::uint32_t>(writes.size()),
                                        writes.data());
     }
     void push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t set,
-                             std::span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
+                             Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
     // The same through a PUSH_DESCRIPTORS_KHR template, to its pipeline layout and set.
     void push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
                                            const void* data) const VKRC_UNCHECKED_NOEXCEPT {
@@ -233,18 +233,18 @@ public:
     // Each makes its vkCmd* call itself: forwarding a std::span to the raw
     // overload costs every includer's compile (bench/header_cost).
     void copy_buffer(const Buffer& src, const Buffer& dst,
-                     std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                     Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
         fn_->vkCmdCopyBuffer(cmd_, src.vk(), dst.vk(), static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
-                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
         fn_->vkCmdCopyBufferToImage(cmd_, src.vk(), dst.vk(), dst_layout, static_cast<std::uint32_t>(regions.size()),
                                     regions.data());
     }
     void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
-                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
         fn_->vkCmdCopyImageToBuffer(cmd_, src.vk(), src_layout, dst.vk(), static_cast<std::uint32_t>(regions.size()),
                                     regions.data());
@@ -253,20 +253,20 @@ public:
                      std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
         fill_buffer(dst.vk(), offset, size, data);
     }
-    void copy_buffer(VkBuffer src, VkBuffer dst, std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+    void copy_buffer(VkBuffer src, VkBuffer dst, Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                              std::span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
                      std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Synchronisation (synchronization2)
     void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
-    void pipeline_barrier(std::span<const VkMemoryBarrier2> memory, std::span<const VkBufferMemoryBarrier2> buffers,
-                          std::span<const VkImageMemoryBarrier2> images,
+    void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
+                          Span<const VkImageMemoryBarrier2> images,
                           VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
         set_event(event.vk(), dependency);
@@ -278,9 +278,9 @@ public:
     void reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
-    void execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
+    void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
     // Raw secondaries (recorded by other code): passed as they are, in one call.
-    void execute_commands(std::span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
+    void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
 
     // Queries
     void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
@@ -300,50 +300,48 @@ public:
     // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
     // during the call only. Typed overloads read the raw handles.
     void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    std::span<const VkImageBlit> regions,
-                    VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
+                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
         fn_->vkCmdBlitImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
                             static_cast<std::uint32_t>(regions.size()), regions.data(), filter);
     }
     void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    std::span<const VkImageBlit> regions,
-                    VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT;
+                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT;
     // src: multisampled; dst: single-sample, same format.
     void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                       std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
         fn_->vkCmdResolveImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
                                static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                       std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT;
     void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
         fn_->vkCmdCopyImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
                             static_cast<std::uint32_t>(regions.size()), regions.data());
     }
     // Outside rendering; the image needs TRANSFER_DST usage.
     void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
-                           std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
         fn_->vkCmdClearColorImage(cmd_, image.vk(), layout, &color, static_cast<std::uint32_t>(ranges.size()),
                                   ranges.data());
     }
     void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                           std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
+                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
     void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
         fn_->vkCmdClearDepthStencilImage(cmd_, image.vk(), layout, &value, static_cast<std::uint32_t>(ranges.size()),
                                          ranges.data());
     }
     void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
+                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
     // Inside rendering (a render pass or dynamic rendering).
-    void clear_attachments(std::span<const VkClearAttachment> attachments,
-                           std::span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT;
+    void clear_attachments(Span<const VkClearAttachment> attachments,
+                           Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
     // this call (data need not outlive it). size and offset are multiples of
     // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
@@ -418,8 +416,8 @@ public:
 
     // Dynamic state (Vulkan 1.0): each needs its VK_DYNAMIC_STATE_* in the
     // bound pipeline's dynamic states.
-    void set_viewports(std::uint32_t first, std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_scissors(std::uint32_t first, std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewports(std::uint32_t first, Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_scissors(std::uint32_t first, Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
     // Other widths than 1.0 need the wideLines feature.
     void set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT;
     // A clamp other than 0 needs the depthBiasClamp feature.
@@ -435,13 +433,13 @@ public:
     void set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT;
     void set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT;
     // The viewport and scissor counts are dynamic too (VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT).
-    void set_viewport_with_count(std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_scissor_with_count(std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
     // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
     // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
-    void bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                              std::span<const VkDeviceSize> offsets, std::span<const VkDeviceSize> sizes = {},
-                              std::span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
+                              Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes = {},
+                              Span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
     void set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
     void set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT;
@@ -458,16 +456,16 @@ public:
     // layouts made by other code (or adopted): the same single calls.
     void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT;
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
-                              std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
+                              Span<const VkDescriptorSet> sets,
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
         fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout.vk(), first_set, static_cast<std::uint32_t>(sets.size()),
                                      sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
                                      dynamic_offsets.data());
     }
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
-                              std::span<const VkDescriptorSet> sets,
-                              std::span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkDescriptorSet> sets,
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
     void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
                         const void* data) const VKRC_UNCHECKED_NOEXCEPT;
 
@@ -601,7 +599,7 @@ namespace detail {
 
 // After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
 // (OpenCommandBuffers), whose held drops then wait for that submission.
-void close_submitted(std::span<const CommandBuffer> command_buffers) noexcept;
+void close_submitted(Span<const CommandBuffer> command_buffers) noexcept;
 
 class CommandPoolState final : public RefCounted {
 public:
@@ -660,7 +658,7 @@ inline VkCommandBufferLevel CommandBuffer::level() const VKRC_UNCHECKED_NOEXCEPT
 }
 
 inline void CommandBuffer::begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
-                                             std::span<const VkClearValue> clear_values,
+                                             Span<const VkClearValue> clear_values,
                                              VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
     record_begin_render_pass(render_pass, framebuffer, render_area, clear_values.data(), clear_values.size(), contents);
@@ -756,8 +754,8 @@ inline void CommandBuffer::bind_vertex_buffer(std::uint32_t binding, VkBuffer bu
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffer");
     fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, &buffer, &offset);
 }
-inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                                               std::span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, Span<const VkBuffer> buffers,
+                                               Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers");
     fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                 offsets.data());
@@ -769,15 +767,15 @@ inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offse
 }
 inline void CommandBuffer::bind_descriptor_set(
     const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
-    std::span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
+    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_set");
     VkDescriptorSet raw = set.vk();
     fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
                                  static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
 }
 inline void CommandBuffer::bind_descriptor_sets(
-    const Pipeline& pipeline, std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
-    std::span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
+    const Pipeline& pipeline, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
+    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
     fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), first_set,
                                  static_cast<std::uint32_t>(sets.size()), sets.data(),
@@ -789,8 +787,8 @@ inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShader
     fn_->vkCmdPushConstants(cmd_, layout.vk(), stages, offset, size, data);
 }
 inline void CommandBuffer::push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
-                                               std::uint32_t set, std::span<const VkWriteDescriptorSet> writes) const
-    VKRC_UNCHECKED_NOEXCEPT {
+                                               std::uint32_t set,
+                                               Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
     fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout, set, static_cast<std::uint32_t>(writes.size()),
                                    writes.data());
@@ -831,24 +829,22 @@ inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint3
     fn_->vkCmdDispatch(cmd_, x, y, z);
 }
 inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst,
-                                       std::span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                                       Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
     fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                                                std::span<const VkBufferImageCopy> regions) const
-    VKRC_UNCHECKED_NOEXCEPT {
+                                                Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
     fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                                                std::span<const VkBufferImageCopy> regions) const
-    VKRC_UNCHECKED_NOEXCEPT {
+                                                Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
     fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
 }
 inline void CommandBuffer::copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      std::span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                                      Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
     fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                         regions.data());
@@ -863,9 +859,9 @@ inline void CommandBuffer::pipeline_barrier(const VkDependencyInfo& dependency) 
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
     fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
 }
-inline void CommandBuffer::pipeline_barrier(std::span<const VkMemoryBarrier2> memory,
-                                            std::span<const VkBufferMemoryBarrier2> buffers,
-                                            std::span<const VkImageMemoryBarrier2> images,
+inline void CommandBuffer::pipeline_barrier(Span<const VkMemoryBarrier2> memory,
+                                            Span<const VkBufferMemoryBarrier2> buffers,
+                                            Span<const VkImageMemoryBarrier2> images,
                                             VkDependencyFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
     VkDependencyInfo d{};
@@ -888,7 +884,7 @@ inline void CommandBuffer::reset_event(VkEvent event, VkPipelineStageFlags2 stag
     fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
 }
 
-inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
     constexpr std::size_t chunk = 32;
     VkCommandBuffer raw[chunk];
@@ -898,8 +894,7 @@ inline void CommandBuffer::execute_commands(std::span<const CommandBuffer> secon
         fn_->vkCmdExecuteCommands(cmd_, n, raw);
     }
 }
-inline void CommandBuffer::execute_commands(std::span<const VkCommandBuffer> secondaries) const
-    VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
     fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
 }
@@ -916,33 +911,31 @@ inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, VkQueryP
 }
 
 inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      std::span<const VkImageBlit> regions,
-                                      VkFilter filter) const VKRC_UNCHECKED_NOEXCEPT {
+                                      Span<const VkImageBlit> regions, VkFilter filter) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
     fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                         regions.data(), filter);
 }
 inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                         std::span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
+                                         Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
     fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                            regions.data());
 }
 inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                                             std::span<const VkImageSubresourceRange> ranges) const
-    VKRC_UNCHECKED_NOEXCEPT {
+                                             Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
     fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()), ranges.data());
 }
 inline void CommandBuffer::clear_depth_stencil_image(
     VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-    std::span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+    Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
     fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
                                      ranges.data());
 }
-inline void CommandBuffer::clear_attachments(std::span<const VkClearAttachment> attachments,
-                                             std::span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::clear_attachments(Span<const VkClearAttachment> attachments,
+                                             Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_attachments");
     fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
                                static_cast<std::uint32_t>(rects.size()), rects.data());
@@ -1032,12 +1025,12 @@ inline void CommandBuffer::insert_label(const char* name, const LabelColor& colo
 }
 
 inline void CommandBuffer::set_viewports(std::uint32_t first,
-                                         std::span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
+                                         Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewports");
     fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
 inline void CommandBuffer::set_scissors(std::uint32_t first,
-                                        std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+                                        Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissors");
     fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
@@ -1086,19 +1079,17 @@ inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) 
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_topology");
     fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
 }
-inline void CommandBuffer::set_viewport_with_count(std::span<const VkViewport> viewports) const
-    VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_with_count");
     fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
 }
-inline void CommandBuffer::set_scissor_with_count(std::span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor_with_count");
     fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
 }
-inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, std::span<const VkBuffer> buffers,
-                                                std::span<const VkDeviceSize> offsets,
-                                                std::span<const VkDeviceSize> sizes,
-                                                std::span<const VkDeviceSize> strides) const VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
+                                                Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes,
+                                                Span<const VkDeviceSize> strides) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
     fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                  offsets.data(), sizes.empty() ? nullptr : sizes.data(),
@@ -1144,10 +1135,9 @@ inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point,
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
     fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
 }
-inline void CommandBuffer::bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
-                                                std::uint32_t first_set, std::span<const VkDescriptorSet> sets,
-                                                std::span<const std::uint32_t> dynamic_offsets) const
-    VKRC_UNCHECKED_NOEXCEPT {
+inline void CommandBuffer::bind_descriptor_sets(
+    VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
+    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
     fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
                                  sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),

@@ -4,7 +4,7 @@
 #include "vkrc/detail/pool_free_list.hpp"
 #include "vkrc/resource.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 #include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
@@ -142,9 +142,9 @@ public:
     // UsageError when the binding does not exist, has another type, or the
     // elements do not all lie in it (its descriptor_count, or the set's
     // variable count); the raw handles are not checked further.
-    void write_buffers(std::uint32_t binding, VkDescriptorType type, std::span<const VkDescriptorBufferInfo> infos,
+    void write_buffers(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorBufferInfo> infos,
                        std::uint32_t array_element = 0) const;
-    void write_images(std::uint32_t binding, VkDescriptorType type, std::span<const VkDescriptorImageInfo> infos,
+    void write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
                       std::uint32_t array_element = 0) const;
     // vkUpdateDescriptorSetWithTemplate: data is laid out as the template's
     // entries say (read during the call). The template's type must be

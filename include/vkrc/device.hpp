@@ -4,7 +4,7 @@
 #include "vkrc/instance.hpp"
 
 #include "vkrc/detail/list.hpp"
-#include <span>
+#include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -86,7 +86,7 @@ public:
     // Wraps a device made elsewhere; queues lists what it was created with.
     // Its functions are loaded with vkGetDeviceProcAddr either way.
     static Device adopt(const PhysicalDevice& physical_device, VkDevice device, Ownership ownership,
-                        std::span<const QueueRequest> queues, std::span<const char* const> enabled_extensions = {});
+                        Span<const QueueRequest> queues, Span<const char* const> enabled_extensions = {});
 
     VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT;
     const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
@@ -150,7 +150,7 @@ public:
     // GPU-lifetime tracking at all. No heap allocation. Returns the
     // submission's number on this queue (they count up from 1).
     // Throws DeviceLostError on device loss.
-    std::uint64_t submit(std::span<const VkSubmitInfo2> submits, VkFence fence = VK_NULL_HANDLE) const;
+    std::uint64_t submit(Span<const VkSubmitInfo2> submits, VkFence fence = VK_NULL_HANDLE) const;
     // vkQueueWaitIdle, then runs deferred destructions.
     void wait_idle() const;
 
@@ -175,7 +175,7 @@ public:
 
 private:
     friend class Device;
-    Queue(Device device, detail::QueueState* queue) noexcept : device_(std::move(device)), queue_(queue) {}
+    Queue(Device device, detail::QueueState* queue) noexcept : device_(moves::move(device)), queue_(queue) {}
     Device device_;
     detail::QueueState* queue_ = nullptr;  // owned by the device
 };
@@ -443,7 +443,7 @@ public:
     // covering values of every queue (out is resized to the queue count), and
     // whether the GPU has completed the work they stand for.
     void submitted_snapshot(List<std::uint64_t>& out);
-    bool reached(std::span<const std::uint64_t> snapshot) noexcept;
+    bool reached(Span<const std::uint64_t> snapshot) noexcept;
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
 
@@ -469,7 +469,7 @@ private:
 // Queue::submit that always signals the queue's timeline with the
 // submission's number, which it returns: a value to wait on at once, for
 // tickets (stream.cpp). Throws DeviceLostError on device loss.
-std::uint64_t submit_signalled(const Queue& queue, std::span<const VkSubmitInfo2> submits);
+std::uint64_t submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits);
 
 // Converts any Vulkan handle to the word stored in a DeferredAction.
 template <class VkHandle>

@@ -13,7 +13,6 @@
 
 #include <cstddef>
 #include <exception>
-#include <utility>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -26,7 +25,8 @@ public:
     Text(const char* text);  // copies; null means empty
     Text(const char* data, std::size_t size);
     // Any string type with c_str() (std::string), without <string> here.
-    template <class String, class = decltype(std::declval<const String&>().c_str())>
+    template <class String>
+    requires requires(const String& s) { s.c_str(); }
     explicit Text(const String& text) : Text(text.c_str()) {}
     Text(const Text& other) noexcept;
     Text(Text&& other) noexcept : block_(moves::take(other.block_)) {}
@@ -79,7 +79,8 @@ class UsageError : public std::exception {
 public:
     explicit UsageError(const char* message) : what_(message) {}
     // Any string type with c_str() (std::string), without <string> here.
-    template <class String, class = decltype(std::declval<const String&>().c_str())>
+    template <class String>
+    requires requires(const String& s) { s.c_str(); }
     explicit UsageError(const String& message) : what_(message.c_str()) {}
     const char* what() const noexcept override { return what_.c_str(); }
 

@@ -12,7 +12,6 @@
 #include <pthread.h>
 
 #include <cstdint>
-#include <utility>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -277,7 +276,7 @@ public:
     State* state() const noexcept { return state_.get(); }
 
 protected:
-    explicit Handle(detail::Ref<State> state) noexcept : state_(std::move(state)) {}
+    explicit Handle(detail::Ref<State> state) noexcept : state_(moves::move(state)) {}
     // The state, for the wrappers' accessors: who (e.g. "vkrc::Buffer::vk")
     // names the call in the UsageError an empty handle gets.
     State& live([[maybe_unused]] const char* who) const VKRC_UNCHECKED_NOEXCEPT {

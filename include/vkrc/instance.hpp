@@ -4,7 +4,7 @@
 #include "vkrc/error.hpp"
 #include "vkrc/functions.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 #include "vkrc/handle.hpp"
 #include "vkrc/detail/function.hpp"
 
@@ -27,7 +27,7 @@ struct DebugMessage {
     const char* message_id_name{};  // may be null
     const char* message{};
     // The objects the message is about, with their names (set_name) where given.
-    std::span<const VkDebugUtilsObjectNameInfoEXT> objects{};
+    Span<const VkDebugUtilsObjectNameInfoEXT> objects{};
 };
 using DebugCallback = Function<void(const DebugMessage&)>;
 
@@ -78,8 +78,7 @@ public:
     // see them.
     static Instance adopt(VkInstance instance, Ownership ownership, std::uint32_t api_version,
                           PFN_vkGetInstanceProcAddr get_instance_proc_addr = nullptr,
-                          std::span<const char* const> enabled_extensions = {},
-                          std::span<const char* const> enabled_layers = {});
+                          Span<const char* const> enabled_extensions = {}, Span<const char* const> enabled_layers = {});
 
     VkInstance vk() const VKRC_UNCHECKED_NOEXCEPT;
     const InstanceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
@@ -150,7 +149,7 @@ struct DeviceRequirements {
 class NoSuitableDeviceError : public std::exception {
 public:
     NoSuitableDeviceError(Text message, List<Text> rejections)
-        : what_(std::move(message)), rejections_(std::move(rejections)) {}
+        : what_(moves::move(message)), rejections_(moves::move(rejections)) {}
     const char* what() const noexcept override { return what_.c_str(); }
     // One line per rejected device: "<name>: <reason>; <reason>".
     const List<Text>& rejections() const noexcept { return rejections_; }

@@ -12,7 +12,6 @@
 
 #include <cstddef>
 #include <cstring>
-#include <span>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -142,7 +141,7 @@ using SharedAllocator = detail::Ref<DeviceAllocator>;
 // converts to SharedAllocator).
 template <class A, class... Args>
 detail::Ref<A> make_allocator(Args&&... args) {
-    return detail::Ref<A>(new A(std::forward<Args>(args)...));
+    return detail::Ref<A>(new A(moves::forward<Args>(args)...));
 }
 
 // The memory type for type_bits and intent: the lowest index with every
@@ -314,8 +313,10 @@ inline void write_mapped(const char* who, const AllocationState* s, std::byte* m
 template <class Derived>
 class MappedWrites {
 public:
-    template <class T>
-    void write(VkDeviceSize offset, std::span<const T> data) const {
+    // Any contiguous range: a std::span, std::vector, std::array, vkrc::Span or List.
+    template <class Range>
+    requires requires(const Range& r) { r.size(); }
+    void write(VkDeviceSize offset, const Range& data) const {
         static_cast<const Derived&>(*this).write(offset, data.data(), data.size());
     }
     template <class T>
@@ -442,10 +443,10 @@ public:
             s.invalidate(offset, count * sizeof(T));
         std::memcpy(out, s.info.mapped + offset, count * sizeof(T));
     }
-    template <class T>
-    void read(VkDeviceSize offset, std::span<T> out) const {
-        read(offset, out.data(), out.size());
-    }
+    // Into any contiguous range of writable elements (a std::span, std::vector, ...).
+    template <class Range>
+    requires requires(Range& r) { r.size(); }
+    void read(VkDeviceSize offset, Range&& out) const { read(offset, out.data(), out.size()); }
     template <class T>
     T read_value(VkDeviceSize offset) const {
         T value;

@@ -4,7 +4,7 @@
 #include "vkrc/descriptor.hpp"
 #include "vkrc/shader.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 #include "vkrc/detail/list.hpp"
 
 VKRC_BEGIN_NAMESPACE
@@ -75,7 +75,7 @@ public:
     // Wraps one made elsewhere from device; color_attachment_counts: each
     // subpass's (copied). Ownership as for PipelineLayout::adopt.
     static RenderPass adopt(const Device& device, VkRenderPass render_pass,
-                            std::span<const std::uint32_t> color_attachment_counts, Ownership ownership);
+                            Span<const std::uint32_t> color_attachment_counts, Ownership ownership);
     VkRenderPass vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t color_attachment_count(std::uint32_t subpass) const;
@@ -124,7 +124,7 @@ class PipelineCache : public Handle<detail::PipelineCacheState> {
 public:
     PipelineCache() noexcept = default;
     // An empty cache, or one primed with data from save().
-    static PipelineCache create(const Device& device, std::span<const std::byte> initial_data = {});
+    static PipelineCache create(const Device& device, Span<const std::byte> initial_data = {});
     // Primes the cache from a file written by save(). A missing, truncated,
     // corrupt or foreign (other driver/device) file is ignored with a warning
     // on stderr: the cache starts empty and loaded_from_file() is false.
@@ -148,8 +148,8 @@ private:
 // builder and ComputePipeline::create copy both spans: they need only live
 // through the call. Each entry's offset + size must lie within data.
 struct Specialization {
-    std::span<const VkSpecializationMapEntry> map_entries{};
-    std::span<const std::byte> data{};
+    Span<const VkSpecializationMapEntry> map_entries{};
+    Span<const std::byte> data{};
 };
 
 // Mirrors VkComputePipelineCreateInfo and its one stage.
@@ -283,8 +283,7 @@ public:
     GraphicsPipelineBuilder& render_pass(const RenderPass& render_pass, std::uint32_t subpass = 0);
     // Dynamic rendering (Vulkan 1.3) instead of a render pass (default: no attachments). The formats
     // are copied: the span need not outlive the call.
-    GraphicsPipelineBuilder& rendering(std::span<const VkFormat> color_formats,
-                                       VkFormat depth_format = VK_FORMAT_UNDEFINED,
+    GraphicsPipelineBuilder& rendering(Span<const VkFormat> color_formats, VkFormat depth_format = VK_FORMAT_UNDEFINED,
                                        VkFormat stencil_format = VK_FORMAT_UNDEFINED);
 
     // Full state (issue 14). Each replaces what the narrower calls above set:
@@ -295,18 +294,18 @@ public:
     GraphicsPipelineBuilder& multisample(const MultisampleState& state);
     // One blend state per colour attachment (build() checks the count);
     // replaces blend() for every attachment. Different states need independentBlend.
-    GraphicsPipelineBuilder& blend_attachments(std::span<const VkPipelineColorBlendAttachmentState> states);
+    GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states);
     GraphicsPipelineBuilder& blend_constants(const float (&constants)[4]);
     // Enables the logic op (needs the logicOp feature) instead of blending.
     GraphicsPipelineBuilder& logic_op(VkLogicOp op);
     // Static viewports and scissors (copied). Their counts are the pipeline's
     // (more than one needs multiViewport); the values count only when
     // VIEWPORT / SCISSOR are not dynamic (see dynamic_states).
-    GraphicsPipelineBuilder& viewports(std::span<const VkViewport> viewports);
-    GraphicsPipelineBuilder& scissors(std::span<const VkRect2D> scissors);
+    GraphicsPipelineBuilder& viewports(Span<const VkViewport> viewports);
+    GraphicsPipelineBuilder& scissors(Span<const VkRect2D> scissors);
     // Replaces the dynamic state list (viewport and scissor by default).
     // With VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT the counts are dynamic too.
-    GraphicsPipelineBuilder& dynamic_states(std::span<const VkDynamicState> states);
+    GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states);
     GraphicsPipelineBuilder& primitive_restart(bool enable);
     // Specialization constants of the shader at stage (added with shader();
     // build() throws UsageError when there is none). Copied.
@@ -372,8 +371,7 @@ private:
     VkPipelineCreateFlags flags_ = 0;
     const void* next_ = nullptr;
     // build()'s pieces (src/pipeline_state.cpp); the results point into *this.
-    void attach_specializations(std::span<VkPipelineShaderStageCreateInfo> stages,
-                                std::span<VkSpecializationInfo> infos) const;
+    void attach_specializations(Span<VkPipelineShaderStageCreateInfo> stages, Span<VkSpecializationInfo> infos) const;
     void check_tessellation() const;
     VkPipelineViewportStateCreateInfo viewport_state() const;
     VkPipelineRasterizationStateCreateInfo rasterization_state() const;

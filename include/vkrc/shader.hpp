@@ -4,7 +4,7 @@
 #include "vkrc/device.hpp"
 
 #include <cstddef>
-#include <span>
+#include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -16,9 +16,9 @@ class ShaderModule : public Handle<detail::ShaderModuleState> {
 public:
     ShaderModule() noexcept = default;
     // Throws UsageError for an empty module or a wrong SPIR-V magic number.
-    static ShaderModule create(const Device& device, std::span<const std::uint32_t> spirv);
+    static ShaderModule create(const Device& device, Span<const std::uint32_t> spirv);
     // Bytes of a .spv file; also rejects a size that is not a multiple of 4.
-    static ShaderModule create(const Device& device, std::span<const std::byte> spirv);
+    static ShaderModule create(const Device& device, Span<const std::byte> spirv);
     static ShaderModule load(const Device& device, const char* spv_file);
     // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).

@@ -108,10 +108,10 @@ public:
     VkDeviceSize staging_size() const VKRC_UNCHECKED_NOEXCEPT;
 
     // As vkrc::upload_buffer, into the open batch.
-    void upload_buffer(const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data) const;
+    void upload_buffer(const Buffer& buffer, VkDeviceSize offset, Span<const std::byte> data) const;
     // As vkrc::upload_image, into the open batch: every level and layer,
     // block-compressed formats in whole blocks.
-    void upload_image(const Image& image, std::span<const std::byte> data, const ImageUploadInfo& info = {}) const;
+    void upload_image(const Image& image, Span<const std::byte> data, const ImageUploadInfo& info = {}) const;
     // Records a copy of size bytes at offset out of buffer (needs
     // VK_BUFFER_USAGE_TRANSFER_SRC_BIT) into the open batch; read() it after submit().
     Download download_buffer(const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size) const;
@@ -122,7 +122,7 @@ public:
     // Submits the open batch after the given waits and returns its ticket
     // (signalled on the queue's timeline). With nothing recorded, returns the
     // ticket of the last batch (an empty one if none).
-    Ticket submit(std::span<const SemaphoreSubmit> waits = {}) const;
+    Ticket submit(Span<const SemaphoreSubmit> waits = {}) const;
 
 private:
     using Handle::Handle;

@@ -3,7 +3,7 @@
 
 #include "vkrc/command.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -35,17 +35,17 @@ struct SemaphoreSubmit {
 // One batch of a submission (VkSubmitInfo2).
 // Every span is optional (empty: none) and read during submit(); it need not outlive the call.
 struct SubmitBatch {
-    std::span<const SemaphoreSubmit> waits{};
+    Span<const SemaphoreSubmit> waits{};
     // Their handles must not be empty; dropping them after submit() is deferred past the GPU's use.
-    std::span<const CommandBuffer> command_buffers{};
-    std::span<const SemaphoreSubmit> signals{};
+    Span<const CommandBuffer> command_buffers{};
+    Span<const SemaphoreSubmit> signals{};
 };
 
 // Queue::submit with typed batches; the fence (if any) signals when all are
 // done. The Vulkan structures are built on the stack up to 4 wait and 4
 // signal semaphores and 8 command buffers per batch (4 batches), on the heap
 // beyond.
-void submit(const Queue& queue, std::span<const SubmitBatch> batches, const Fence& fence = {});
+void submit(const Queue& queue, Span<const SubmitBatch> batches, const Fence& fence = {});
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence = {});
 
 VKRC_END_NAMESPACE

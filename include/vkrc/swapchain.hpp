@@ -73,8 +73,8 @@ public:
     // free and signals when rendering is done. Empty spans headless.
     // Out of line: building a std::span in a header makes every includer
     // check the span constructors' range concepts (bench/header_cost).
-    std::span<const SemaphoreSubmit> waits() const noexcept;
-    std::span<const SemaphoreSubmit> signals() const noexcept;
+    Span<const SemaphoreSubmit> waits() const noexcept;
+    Span<const SemaphoreSubmit> signals() const noexcept;
 
 private:
     friend class Swapchain;

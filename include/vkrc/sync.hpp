@@ -6,7 +6,7 @@
 
 #include "vkrc/device.hpp"
 
-#include <span>
+#include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -112,7 +112,7 @@ public:
     // Reset queries before use with CommandBuffer::reset_query_pool.
     // vkGetQueryPoolResults as 64-bit values into out (one per query, or
     // stride_words per query). VK_NOT_READY when flags lack WAIT and some are not ready.
-    VkResult results(std::uint32_t first_query, std::span<std::uint64_t> out,
+    VkResult results(std::uint32_t first_query, Span<std::uint64_t> out,
                      VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
     // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
     double timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT;

@@ -28,7 +28,7 @@ FormatBlock format_block(VkFormat format) noexcept;
 // Copies data to buffer at offset through a staging buffer. The buffer needs
 // VK_BUFFER_USAGE_TRANSFER_DST_BIT. The copy waits for earlier submissions on
 // the queue to finish with the buffer; later submits on any queue see the data.
-void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, std::span<const std::byte> data);
+void upload_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, Span<const std::byte> data);
 
 // Copies size bytes at offset out of buffer (needs VK_BUFFER_USAGE_TRANSFER_SRC_BIT).
 List<std::byte> download_buffer(const Queue& queue, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size);
@@ -55,8 +55,7 @@ VkDeviceSize image_data_size(const Image& image, std::uint32_t level_count = VK_
 
 // Fills every mip level and array layer of a colour image (needs
 // VK_IMAGE_USAGE_TRANSFER_DST_BIT) from data laid out as image_data_size says.
-void upload_image(const Queue& queue, const Image& image, std::span<const std::byte> data,
-                  const ImageUploadInfo& info = {});
+void upload_image(const Queue& queue, const Image& image, Span<const std::byte> data, const ImageUploadInfo& info = {});
 
 // Copies one mip level of one array layer of a colour image (needs
 // VK_IMAGE_USAGE_TRANSFER_SRC_BIT), tightly packed. The image is in layout

@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <span>
 #include <vector>
 
 int main() try {

@@ -3,6 +3,8 @@
 // instruction, no lock and no other call.
 #include <vkrc/command.hpp>
 
+#include <span>
+
 void hot_draw(const vkrc::CommandBuffer& cmd) { cmd.draw(3); }
 void hot_draw_indexed(const vkrc::CommandBuffer& cmd) { cmd.draw_indexed(36, 1, 0, 0, 0); }
 void hot_bind_pipeline(const vkrc::CommandBuffer& cmd, const vkrc::Pipeline& p) { cmd.bind_pipeline(p); }

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace vkrc_test {

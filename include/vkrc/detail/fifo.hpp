@@ -11,7 +11,6 @@
 #include "vkrc/detail/list.hpp"
 
 #include <cstddef>
-#include <utility>
 
 namespace vkrc {
 
@@ -30,7 +29,7 @@ public:
 
     void push_back(T item) {
         if (size_ == slots_.size()) grow();
-        (*this)[size_++] = std::move(item);
+        (*this)[size_++] = moves::move(item);
     }
     // Removes the first count elements (at most size()).
     void pop_front(std::size_t count = 1) noexcept {
@@ -44,7 +43,7 @@ private:
     // Power-of-two capacity, so that an index wraps with a mask.
     void grow() {
         List<T> grown(slots_.empty() ? 8 : slots_.size() * 2);
-        for (std::size_t i = 0; i < size_; ++i) grown[i] = std::move((*this)[i]);
+        for (std::size_t i = 0; i < size_; ++i) grown[i] = moves::move((*this)[i]);
         slots_.swap(grown);
         head_ = 0;
     }

@@ -11,8 +11,6 @@
 
 #include "vkrc/detail/moves.hpp"
 
-#include <utility>
-
 namespace vkrc {
 
 namespace detail {
@@ -31,8 +29,8 @@ public:
     Function() noexcept = default;
     Function(decltype(nullptr)) noexcept {}
     template <class F>
-    requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(std::forward<Args>(args)...); }
-    Function(F f) : callable_(new Holder<F>(std::move(f))) {}
+    requires(!detail::same_type<F, Function>) && requires(F& f, Args&&... args) { f(moves::forward<Args>(args)...); }
+    Function(F f) : callable_(new Holder<F>(moves::move(f))) {}
     Function(const Function& other) : callable_(other.callable_ ? other.callable_->clone() : nullptr) {}
     Function(Function&& other) noexcept : callable_(moves::take(other.callable_)) {}
     Function& operator=(Function other) noexcept {
@@ -43,7 +41,7 @@ public:
 
     explicit operator bool() const noexcept { return callable_ != nullptr; }
     // Calls the held callable; the Function must not be empty.
-    R operator()(Args... args) const { return callable_->call(std::forward<Args>(args)...); }
+    R operator()(Args... args) const { return callable_->call(moves::forward<Args>(args)...); }
 
 private:
     struct Callable {
@@ -53,11 +51,11 @@ private:
     };
     template <class F>
     struct Holder final : Callable {
-        explicit Holder(F&& callable) : f(std::move(callable)) {}
+        explicit Holder(F&& callable) : f(moves::move(callable)) {}
         R call(Args&&... args) override {
             if constexpr (detail::same_type<R, void>)
-                f(std::forward<Args>(args)...);  // drops a result, as std::function does
-            else return f(std::forward<Args>(args)...);
+                f(moves::forward<Args>(args)...);  // drops a result, as std::function does
+            else return f(moves::forward<Args>(args)...);
         }
         Callable* clone() const override { return new Holder(F(f)); }
         F f;

@@ -5,8 +5,8 @@
 // largest part of that (bench/header_cost). List is the little of std::vector
 // that vkrc needs: built from a braced list (so `.bindings = {{...}, {...}}`
 // keeps working), from any contiguous range (std::vector, std::array,
-// std::span) or with a count of value-initialised elements. It is a
-// contiguous range, so std::span<const T> takes it as it takes a vector.
+// std::span, vkrc::Span) or with a count of value-initialised elements. It is a
+// contiguous range, so vkrc::Span<const T> takes it as it takes a vector.
 #pragma once
 
 #include "vkrc/detail/moves.hpp"
@@ -14,7 +14,6 @@
 #include <cstddef>
 #include <initializer_list>
 #include <new>
-#include <utility>
 
 namespace vkrc {
 
@@ -26,7 +25,7 @@ public:
     // destructor frees what was made.
     List(std::initializer_list<T> items) : List() { append_copies(items.begin(), items.size()); }
     List(const T* items, std::size_t count) : List() { append_copies(items, count); }
-    // Any contiguous range of T: std::vector, std::array, std::span, List.
+    // Any contiguous range of T: std::vector, std::array, std::span, vkrc::Span, List.
     template <class Range>
     requires requires(const Range& r) {
         static_cast<const T*>(r.data());
@@ -46,7 +45,7 @@ public:
         return *this;
     }
     List& operator=(List&& other) noexcept {
-        List(std::move(other)).swap(*this);
+        List(moves::move(other)).swap(*this);
         return *this;
     }
     ~List() {
@@ -72,7 +71,7 @@ public:
     // Appends one element, growing the storage geometrically.
     T& push_back(T item) {
         if (size_ == capacity_) reserve(capacity_ == 0 ? 4 : capacity_ * 2);
-        new (data_ + size_) T(std::move(item));
+        new (data_ + size_) T(moves::move(item));
         return data_[size_++];
     }
     // Appends copies of count items.
@@ -86,7 +85,7 @@ public:
     // Removes the first count elements (at most size()), moving the rest down
     // once: a List used as a queue drains what is ready in one pass.
     void erase_front(std::size_t count) noexcept {
-        for (std::size_t i = count; i < size_; ++i) data_[i - count] = std::move(data_[i]);
+        for (std::size_t i = count; i < size_; ++i) data_[i - count] = moves::move(data_[i]);
         while (count-- > 0) data_[--size_].~T();
     }
     void clear() noexcept {
@@ -96,7 +95,7 @@ public:
         if (capacity <= capacity_) return;
         T* grown = allocate(capacity);
         for (std::size_t i = 0; i < size_; ++i) {
-            new (grown + i) T(std::move(data_[i]));
+            new (grown + i) T(moves::move(data_[i]));
             data_[i].~T();
         }
         ::operator delete(data_);

@@ -1,10 +1,25 @@
 // The moves of vkrc's owning members, written once by hand: std::exchange
 // and std::swap would be instantiated for each member type in every
-// translation unit that includes vkrc (bench/header_cost). A namespace of
+// translation unit that includes vkrc, and <utility> (std::move, std::forward)
+// brings <compare> and std::pair with it (bench/header_cost). A namespace of
 // their own, which vkrc and its policy namespaces both reach as moves::.
 #pragma once
 
+#include <type_traits>
+
 namespace vkrc::moves {
+
+// std::move.
+template <class T>
+constexpr std::remove_reference_t<T>&& move(T&& value) noexcept {
+    return static_cast<std::remove_reference_t<T>&&>(value);
+}
+
+// std::forward.
+template <class T>
+constexpr T&& forward(std::remove_reference_t<T>& value) noexcept {
+    return static_cast<T&&>(value);
+}
 
 // p's value, leaving p null: a move constructor's steal.
 template <class T>
