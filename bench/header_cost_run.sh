@@ -5,20 +5,27 @@
 # git revision, host, load) that scripts/gen_bench_docs.py reads; copy them
 # into docs/results/ and run the generator. Run it once per compiler:
 #
-#   bench/header_cost_run.sh BUILD_DIR OUT [REPETITIONS]
+#   bench/header_cost_run.sh BUILD_DIR OUT [REPETITIONS [--instructions]]
 #
 # BUILD_DIR: a Release build with the bench, e.g. for clang
 #   CXX=clang++ cmake -S . -B build-clang -DCMAKE_BUILD_TYPE=Release -DVKRC_BUILD_BENCH=ON -DVKRC_BUILD_EXAMPLES=OFF
 #   cmake --build build-clang --target header_cost
 # REPETITIONS: compiles of each probe per flag set (default 5; the median is kept).
+# --instructions (or INSTRUCTIONS=1 in the environment): header_cost
+#   --instructions, which also counts the compiler's instructions of each probe
+#   once under valgrind (the instructions and instruction_ratio_to_raii
+#   columns): a figure the machine's load does not move. Needs valgrind; adds
+#   minutes per flag set (vk::raii under valgrind).
 set -euo pipefail
-if [ $# -lt 2 ]; then
-  echo "usage: bench/header_cost_run.sh BUILD_DIR OUT [REPETITIONS]" >&2
+if [ $# -lt 2 ] || [ $# -gt 4 ] || { [ $# -eq 4 ] && [ "$4" != --instructions ]; }; then
+  echo "usage: bench/header_cost_run.sh BUILD_DIR OUT [REPETITIONS [--instructions]]" >&2
   exit 2
 fi
 build=$1
 out=$2
 repetitions=${3:-5}
+options=()
+if [ "${4:-}" = --instructions ] || [ "${INSTRUCTIONS:-0}" = 1 ]; then options=(--instructions); fi
 bin="$build/bench/header_cost/header_cost"
 [ -x "$bin" ] || { echo "header_cost_run.sh: no $bin (build the header_cost target first)" >&2; exit 1; }
 mkdir -p "$out"
@@ -38,14 +45,15 @@ date_utc=$(date -u +%Y-%m-%dT%H:%MZ)
 for level in -O3 -O0; do
   csv="$out/tmp-header-cost.csv"
   load_before=$(cut -d' ' -f1-3 /proc/loadavg)
-  echo "== bench/header_cost --csv FILE $repetitions $level ($version)" >&2
-  "$bin" --csv "$csv" "$repetitions" "$level"
+  command="bench/header_cost --csv FILE ${options[*]:+${options[*]} }$repetitions $level"
+  echo "== $command ($version)" >&2
+  "$bin" --csv "$csv" "${options[@]}" "$repetitions" "$level"
   load_after=$(cut -d' ' -f1-3 /proc/loadavg)
   {
     echo "# compiler: $version"
     echo "# vulkan-headers: ${headers:-unknown}"
     echo "# date: $date_utc"
-    echo "# command: bench/header_cost --csv FILE $repetitions $level (Release build)"
+    echo "# command: $command (Release build)"
     echo "# git: $revision"
     echo "# host: $(nproc) CPUs, ${cpu:-unknown CPU}, $(uname -sr)"
     echo "# load: load average $load_before before, $load_after after"

@@ -366,7 +366,32 @@ def compiler_name(r):
     return f"clang++ {version}" if "clang" in text else f"g++ {version}"
 
 
-HEADER_COST_GOAL = 0.08  # vkrc / vk::raii CPU time (issue 18)
+HEADER_COST_GOAL = 0.08  # vkrc / vk::raii CPU time (issue 18); the instruction ratio is judged by it too
+
+
+def instruction_ratio(r, probe):
+    """probe's compiler instructions over vk::raii's (header_cost --instructions), from the counts rather than
+    the rounded ratio column; None where the run did not count them (files from before the column, or runs
+    without --instructions, leave it out or empty)."""
+    get = {x["probe"]: x for x in r["rows"]}
+    count, raii = get[probe].get("instructions"), get["vk::raii"].get("instructions")
+    return int(count) / int(raii) if count and raii else None
+
+
+def instructions_counted(runs):
+    return any(instruction_ratio(r, "vkrc") is not None for r in runs)
+
+
+def header_cost_goal(ratio):
+    return "met" if ratio <= HEADER_COST_GOAL else "not met"
+
+
+def instruction_cells(r):
+    """A header-cost row's instruction columns: the ratios and their own verdict, apart from the CPU time's."""
+    ratio = instruction_ratio(r, "vkrc")
+    if ratio is None:
+        return " not measured | | |"
+    return f" {ratio:.3f} | {instruction_ratio(r, 'floor'):.3f} | {header_cost_goal(ratio)} |"
 
 
 def header_cost_section():
@@ -376,19 +401,25 @@ def header_cost_section():
     out = []
     for r in found:
         out += [run_line(r, ("compiler", "vulkan-headers", "date", "command", "git", "host", "load")), ""]
-    out += [f"Medians of {found[0]['rows'][0]['repetitions']} compiles each, CPU time (user + system) of the compiler:",
-            "",
+    counted = instructions_counted(found)
+    out += [f"Medians of {found[0]['rows'][0]['repetitions']} compiles each, CPU time (user + system) of the compiler"
+            + ("; instructions: those of the compiler (the driver and the processes it spawns) in one compile "
+               "under valgrind, which the machine's load does not move (`header_cost --instructions`):"
+               if counted else ":"), "",
             "| compiler | flags | vkrc ms | vk::raii ms | floor ms | ratio vkrc / vk::raii | floor / vk::raii | "
-            f"goal (<= {HEADER_COST_GOAL}) |",
-            "|---|---|---:|---:|---:|---:|---:|---|"]
+            f"goal by CPU time (<= {HEADER_COST_GOAL}) |"
+            + (" instructions vkrc / vk::raii | instructions floor / vk::raii | goal by instructions |"
+               if counted else ""),
+            "|---|---|---:|---:|---:|---:|---:|---|" + ("---:|---:|---|" if counted else "")]
     for r in found:
         get = {x["probe"]: x for x in r["rows"]}
         v, raii, floor = get["vkrc"], get["vk::raii"], get["floor"]
         ratio = float(v["cpu_ratio_to_raii"])
         compiler = compiler_name(r)
-        out.append(f"| {compiler} | `{v['flags']}` | {thousands(v['cpu_ms'])} | {thousands(raii['cpu_ms'])} | "
-                   f"{thousands(floor['cpu_ms'])} | {ratio:.3f} | {float(floor['cpu_ratio_to_raii']):.3f} | "
-                   f"{'met' if ratio <= HEADER_COST_GOAL else 'not met'} |")
+        row = (f"| {compiler} | `{v['flags']}` | {thousands(v['cpu_ms'])} | {thousands(raii['cpu_ms'])} | "
+               f"{thousands(floor['cpu_ms'])} | {ratio:.3f} | {float(floor['cpu_ratio_to_raii']):.3f} | "
+               f"{header_cost_goal(ratio)} |")
+        out.append(row + (instruction_cells(r) if counted else ""))
     return out
 
 
@@ -423,11 +454,18 @@ def readme_compile_row():
 
     raw = by_compiler(lambda r: f"{thousands(cell(r, 'floor')['cpu_ms'])} ms")
     raii = by_compiler(lambda r: f"{thousands(cell(r, 'vk::raii')['cpu_ms'])} ms")
+
+    def by_instructions(r):
+        ratio = instruction_ratio(r, "vkrc")
+        return "" if ratio is None else f"; instructions: {ratio:.3f}"
+
     vkrc = by_compiler(lambda r: f"{thousands(cell(r, 'vkrc')['cpu_ms'])} ms "
-                       f"(**{float(cell(r, 'vkrc')['cpu_ratio_to_raii']):.3f}**)")
+                       f"(**{float(cell(r, 'vkrc')['cpu_ratio_to_raii']):.3f}**{by_instructions(r)})")
+    counted = instructions_counted(found)
     return [f"| compile cost: instance + device TU, compiler CPU time (bench/header_cost, data "
             f"`docs/results/*header-cost*.csv`) | floor (the standard and Vulkan headers of vkrc's API, no vkrc): "
-            f"{raw} | {raii} | not comparable (Rust) | {vkrc}; in bold, the ratio to `vk::raii` (goal <= "
+            f"{raw} | {raii} | not comparable (Rust) | {vkrc}; in bold, the ratio to `vk::raii`"
+            f"{', after it the ratio of compiler instructions where counted' if counted else ''} (goal <= "
             f"{HEADER_COST_GOAL}) |"]
 
 
