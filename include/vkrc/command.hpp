@@ -121,6 +121,28 @@ struct RenderingInfo {
     const void* next = nullptr;
 };
 
+namespace detail {
+[[noreturn]] void throw_too_many_color_attachments(std::size_t count);
+
+// begin_rendering's conversion: a function rather than a lambda, and an
+// index loop rather than span iterators, because each closure type and
+// iterator instantiation costs every includer's compile (bench/header_cost).
+inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttachment& a) noexcept {
+    VkRenderingAttachmentInfo r{};
+    r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
+    r.imageView = a.image_view;
+    r.imageLayout = a.image_layout;
+    r.loadOp = a.load_op;
+    r.storeOp = a.store_op;
+    r.clearValue = a.clear_value;
+    r.resolveMode = a.resolve_mode;
+    r.resolveImageView = a.resolve_image_view;
+    r.resolveImageLayout = a.resolve_image_layout;
+    return r;
+}
+[[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
+}  // namespace detail
+
 // A command buffer; keeps its pool alive and returns to it when dropped (once
 // the GPU has finished the work submitted before the drop).
 class CommandBuffer : public Handle<detail::CommandBufferState> {
@@ -135,8 +157,14 @@ public:
     static CommandBuffer adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
                                Ownership ownership);
 
-    VkCommandBuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT;
+    VkCommandBuffer vk() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::vk");
+        return cmd_;
+    }
+    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fn");
+        return *fn_;
+    }
     const CommandPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
     VkCommandBufferLevel level() const VKRC_UNCHECKED_NOEXCEPT;
 
@@ -156,54 +184,94 @@ public:
     void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
                            Span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
-        record_begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values.data(),
-                                 clear_values.size(), contents);
+        begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values, contents);
     }
     void begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
                            Span<const VkClearValue> clear_values,
-                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
-    void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT;
-    void end_render_pass() const VKRC_UNCHECKED_NOEXCEPT;
+                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
+        VkRenderPassBeginInfo info{};
+        info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
+        info.renderPass = render_pass;
+        info.framebuffer = framebuffer;
+        info.renderArea = render_area;
+        info.clearValueCount = static_cast<std::uint32_t>(clear_values.size());
+        info.pClearValues = clear_values.data();
+        fn_->vkCmdBeginRenderPass(cmd_, &info, contents);
+    }
+    void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::next_subpass");
+        fn_->vkCmdNextSubpass(cmd_, contents);
+    }
+    void end_render_pass() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_render_pass");
+        fn_->vkCmdEndRenderPass(cmd_);
+    }
     // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
     // RenderingInfo::max_color_attachments colour attachments.
     void begin_rendering(const RenderingInfo& info) const;
-    void end_rendering() const VKRC_UNCHECKED_NOEXCEPT;
+    void end_rendering() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_rendering");
+        fn_->vkCmdEndRendering(cmd_);
+    }
 
     // State
-    void bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT {
+        bind_pipeline(pipeline.bind_point(), pipeline.vk());
+    }
     void bind_vertex_buffer(std::uint32_t binding, const Buffer& buffer,
                             VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         bind_vertex_buffer(binding, buffer.vk(), offset);
     }
     void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
-                            VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                            VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffer");
+        fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, &buffer, &offset);
+    }
     void bind_vertex_buffers(std::uint32_t first_binding, Span<const VkBuffer> buffers,
-                             Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT;
+                             Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers");
+        fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                                    offsets.data());
+    }
     void bind_index_buffer(const Buffer& buffer, VkDeviceSize offset = 0,
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
         bind_index_buffer(buffer.vk(), offset, type);
     }
     void bind_index_buffer(VkBuffer buffer, VkDeviceSize offset = 0,
-                           VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT;
+                           VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_index_buffer");
+        fn_->vkCmdBindIndexBuffer(cmd_, buffer, offset, type);
+    }
     // Binds one set at index set_index of the pipeline's layout.
     void bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
-                             Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+                             Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_set");
+        VkDescriptorSet raw = set.vk();
+        fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
+                                     static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+    }
     void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
-                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        bind_descriptor_sets(pipeline.bind_point(), pipeline.layout().vk(), first_set, sets, dynamic_offsets);
+    }
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
-                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
+                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+        push_constants(layout.vk(), stages, offset, size, data);
+    }
     // Push descriptors (VK_KHR_push_descriptor, which must be enabled on the
     // device: the function is called as loaded). Writes set `set` of layout,
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
     void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
                              Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
-        fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout.vk(), set, static_cast<std::uint32_t>(writes.size()),
-                                       writes.data());
+        push_descriptor_set(bind_point, layout.vk(), set, writes);
     }
     void push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t set,
-                             Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT;
+                             Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
+        fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout, set, static_cast<std::uint32_t>(writes.size()),
+                                       writes.data());
+    }
     // The same through a PUSH_DESCRIPTORS_KHR template, to its pipeline layout and set.
     void push_descriptor_set_with_template(const DescriptorUpdateTemplate& update_template,
                                            const void* data) const VKRC_UNCHECKED_NOEXCEPT {
@@ -212,75 +280,122 @@ public:
     }
     // Raw: layout and set must be those the template was created with (Vulkan's rule).
     void push_descriptor_set_with_template(VkDescriptorUpdateTemplate update_template, VkPipelineLayout layout,
-                                           std::uint32_t set, const void* data) const VKRC_UNCHECKED_NOEXCEPT;
+                                           std::uint32_t set, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set_with_template");
+        fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template, layout, set, data);
+    }
     template <class T>
     void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         push_constants(layout, stages, offset, sizeof(T), &value);
     }
-    void set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
+        fn_->vkCmdSetViewport(cmd_, 0, 1, &viewport);
+    }
+    void set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor");
+        fn_->vkCmdSetScissor(cmd_, 0, 1, &scissor);
+    }
     // Viewport (depth 0..1) and scissor covering extent.
-    void set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_and_scissor");
+        set_viewport({0.0f, 0.0f, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0f, 1.0f});
+        set_scissor({{0, 0}, extent});
+    }
 
     // Work
     void draw(std::uint32_t vertex_count, std::uint32_t instance_count = 1, std::uint32_t first_vertex = 0,
-              std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT;
+              std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw");
+        fn_->vkCmdDraw(cmd_, vertex_count, instance_count, first_vertex, first_instance);
+    }
     void draw_indexed(std::uint32_t index_count, std::uint32_t instance_count = 1, std::uint32_t first_index = 0,
-                      std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT;
-    void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const VKRC_UNCHECKED_NOEXCEPT;
+                      std::int32_t vertex_offset = 0, std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed");
+        fn_->vkCmdDrawIndexed(cmd_, index_count, instance_count, first_index, vertex_offset, first_instance);
+    }
+    void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch");
+        fn_->vkCmdDispatch(cmd_, x, y, z);
+    }
     // Typed overloads read the raw handles; raw ones are the escape hatch.
     // Each makes its vkCmd* call itself: forwarding a std::span to the raw
     // overload costs every includer's compile (bench/header_cost).
     void copy_buffer(const Buffer& src, const Buffer& dst,
                      Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
-        fn_->vkCmdCopyBuffer(cmd_, src.vk(), dst.vk(), static_cast<std::uint32_t>(regions.size()), regions.data());
+        copy_buffer(src.vk(), dst.vk(), regions);
     }
     void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
                               Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
-        fn_->vkCmdCopyBufferToImage(cmd_, src.vk(), dst.vk(), dst_layout, static_cast<std::uint32_t>(regions.size()),
-                                    regions.data());
+        copy_buffer_to_image(src.vk(), dst.vk(), dst_layout, regions);
     }
     void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
                               Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
-        fn_->vkCmdCopyImageToBuffer(cmd_, src.vk(), src_layout, dst.vk(), static_cast<std::uint32_t>(regions.size()),
-                                    regions.data());
+        copy_image_to_buffer(src.vk(), src_layout, dst.vk(), regions);
     }
     void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size,
                      std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
         fill_buffer(dst.vk(), offset, size, data);
     }
-    void copy_buffer(VkBuffer src, VkBuffer dst, Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+    void copy_buffer(VkBuffer src, VkBuffer dst, Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
+        fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
+    }
     void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
+        fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                                    regions.data());
+    }
     void copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
+        fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()),
+                                    regions.data());
+    }
     void copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
+        fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                            regions.data());
+    }
     void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
-                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT;
+                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fill_buffer");
+        fn_->vkCmdFillBuffer(cmd_, dst, offset, size, data);
+    }
 
     // Synchronisation (synchronization2)
-    void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
+    void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
+        fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
+    }
     void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
                           Span<const VkImageMemoryBarrier2> images,
                           VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
     void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
         set_event(event.vk(), dependency);
     }
-    void set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
+        fn_->vkCmdSetEvent2(cmd_, event, &dependency);
+    }
     void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
         reset_event(event.vk(), stage_mask);
     }
-    void reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT;
+    void reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
+        fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
+    }
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
     void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
     // Raw secondaries (recorded by other code): passed as they are, in one call.
-    void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
+    void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+        fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
+    }
 
     // Queries
     void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
@@ -288,67 +403,91 @@ public:
         reset_query_pool(pool.vk(), first_query, query_count);
     }
     void reset_query_pool(VkQueryPool pool, std::uint32_t first_query,
-                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT;
+                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
+        fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
+    }
     void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
                          std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
         write_timestamp(stage, pool.vk(), query);
     }
     void write_timestamp(VkPipelineStageFlags2 stage, VkQueryPool pool,
-                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
+                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
+        fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
+    }
 
     // Transfer commands on whole images and buffers. Layouts are the images'
     // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
     // during the call only. Typed overloads read the raw handles.
     void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                     Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
-        fn_->vkCmdBlitImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
-                            static_cast<std::uint32_t>(regions.size()), regions.data(), filter);
+        blit_image(src.vk(), src_layout, dst.vk(), dst_layout, regions, filter);
     }
     void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT;
+                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
+        fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                            regions.data(), filter);
+    }
     // src: multisampled; dst: single-sample, same format.
     void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                        Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
-        fn_->vkCmdResolveImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
-                               static_cast<std::uint32_t>(regions.size()), regions.data());
+        resolve_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
     }
     void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT;
+                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
+        fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
+                               regions.data());
+    }
     void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
                     Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
-        fn_->vkCmdCopyImage(cmd_, src.vk(), src_layout, dst.vk(), dst_layout,
-                            static_cast<std::uint32_t>(regions.size()), regions.data());
+        copy_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
     }
     // Outside rendering; the image needs TRANSFER_DST usage.
     void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
                            Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
-        fn_->vkCmdClearColorImage(cmd_, image.vk(), layout, &color, static_cast<std::uint32_t>(ranges.size()),
-                                  ranges.data());
+        clear_color_image(image.vk(), layout, color, ranges);
     }
     void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
+                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
+        fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
+                                  ranges.data());
+    }
     void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
                                    Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
-        fn_->vkCmdClearDepthStencilImage(cmd_, image.vk(), layout, &value, static_cast<std::uint32_t>(ranges.size()),
-                                         ranges.data());
+        clear_depth_stencil_image(image.vk(), layout, value, ranges);
     }
     void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT;
+                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
+        fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
+                                         ranges.data());
+    }
     // Inside rendering (a render pass or dynamic rendering).
     void clear_attachments(Span<const VkClearAttachment> attachments,
-                           Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT;
+                           Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_attachments");
+        fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
+                                   static_cast<std::uint32_t>(rects.size()), rects.data());
+    }
     // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
     // this call (data need not outlive it). size and offset are multiples of
     // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
     void update_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
         update_buffer(dst.vk(), offset, size, data);
     }
-    void update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const;
+    void update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
+#if VKRC_RUNTIME_CHECKS
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::update_buffer");
+        if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
+            detail::throw_bad_update_buffer(offset, size);
+        }
+#endif
+        fn_->vkCmdUpdateBuffer(cmd_, dst, offset, size, data);
+    }
 
     // Indirect work: parameters read by the GPU from buffer (INDIRECT_BUFFER
     // usage) at execution. stride 0 means tightly packed commands.
@@ -357,17 +496,28 @@ public:
         draw_indirect(buffer.vk(), offset, draw_count, stride);
     }
     void draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                       std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                       std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect");
+        fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
+                               stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+    }
     void draw_indexed_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
                                std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         draw_indexed_indirect(buffer.vk(), offset, draw_count, stride);
     }
     void draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                               std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                               std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect");
+        fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
+                                      stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+    }
     void dispatch_indirect(const Buffer& buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         dispatch_indirect(buffer.vk(), offset);
     }
-    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT;
+    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch_indirect");
+        fn_->vkCmdDispatchIndirect(cmd_, buffer, offset);
+    }
     // The draw count comes from count_buffer (a uint32 at count_offset),
     // clamped to max_draw_count. Needs the Vulkan 1.2 drawIndirectCount feature.
     void draw_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
@@ -376,7 +526,11 @@ public:
         draw_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
     }
     void draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer, VkDeviceSize count_offset,
-                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect_count");
+        fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
+                                    stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+    }
     void draw_indexed_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                      std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
@@ -384,7 +538,11 @@ public:
     }
     void draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                     std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                                     std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect_count");
+        fn_->vkCmdDrawIndexedIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
+                                           stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+    }
 
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
     void begin_query(const QueryPool& pool, std::uint32_t query,
@@ -392,11 +550,17 @@ public:
         begin_query(pool.vk(), query, flags);
     }
     void begin_query(VkQueryPool pool, std::uint32_t query,
-                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
+        fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
+    }
     void end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
         end_query(pool.vk(), query);
     }
-    void end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT;
+    void end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
+        fn_->vkCmdEndQuery(cmd_, pool, query);
+    }
     // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
     void copy_query_results(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count,
                             const Buffer& dst, VkDeviceSize offset, VkDeviceSize stride,
@@ -405,78 +569,172 @@ public:
     }
     void copy_query_results(VkQueryPool pool, std::uint32_t first_query, std::uint32_t query_count, VkBuffer dst,
                             VkDeviceSize offset, VkDeviceSize stride,
-                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT;
+                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
+        fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
+                                       flags | VK_QUERY_RESULT_64_BIT);
+    }
 
     // Debug-utils labels around and between commands, shown by debuggers and
     // capture tools. No-ops when the instance has not enabled
     // VK_EXT_debug_utils, so they may stay in release code. name is copied.
-    void begin_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT;
-    void end_label() const VKRC_UNCHECKED_NOEXCEPT;
-    void insert_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT;
+    void begin_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_label");
+        if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
+            const VkDebugUtilsLabelEXT label{
+                VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+            f(cmd_, &label);
+        }
+    }
+    void end_label() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_label");
+        if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(cmd_);
+    }
+    void insert_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::insert_label");
+        if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
+            const VkDebugUtilsLabelEXT label{
+                VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+            f(cmd_, &label);
+        }
+    }
 
     // Dynamic state (Vulkan 1.0): each needs its VK_DYNAMIC_STATE_* in the
     // bound pipeline's dynamic states.
-    void set_viewports(std::uint32_t first, Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_scissors(std::uint32_t first, Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewports(std::uint32_t first, Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewports");
+        fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+    }
+    void set_scissors(std::uint32_t first, Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissors");
+        fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+    }
     // Other widths than 1.0 need the wideLines feature.
-    void set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_line_width");
+        fn_->vkCmdSetLineWidth(cmd_, width);
+    }
     // A clamp other than 0 needs the depthBiasClamp feature.
-    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias");
+        fn_->vkCmdSetDepthBias(cmd_, constant_factor, clamp, slope_factor);
+    }
+    void set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_blend_constants");
+        fn_->vkCmdSetBlendConstants(cmd_, constants);
+    }
+    void set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds");
+        fn_->vkCmdSetDepthBounds(cmd_, min_bounds, max_bounds);
+    }
+    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_compare_mask");
+        fn_->vkCmdSetStencilCompareMask(cmd_, faces, mask);
+    }
+    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_write_mask");
+        fn_->vkCmdSetStencilWriteMask(cmd_, faces, mask);
+    }
+    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_reference");
+        fn_->vkCmdSetStencilReference(cmd_, faces, reference);
+    }
 
     // Dynamic state (Vulkan 1.3 core, formerly extended dynamic state 1 and 2).
-    void set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_cull_mode");
+        fn_->vkCmdSetCullMode(cmd_, mode);
+    }
+    void set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_front_face");
+        fn_->vkCmdSetFrontFace(cmd_, face);
+    }
+    void set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_topology");
+        fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
+    }
     // The viewport and scissor counts are dynamic too (VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT).
-    void set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_with_count");
+        fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
+    }
+    void set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor_with_count");
+        fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
+    }
     // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
     // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
     void bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
                               Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes = {},
-                              Span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
+        fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                                     offsets.data(), sizes.empty() ? nullptr : sizes.data(),
+                                     strides.empty() ? nullptr : strides.data());
+    }
+    void set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetDepthTestEnable>("vkrc::CommandBuffer::set_depth_test_enable", enable);
+    }
+    void set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetDepthWriteEnable>("vkrc::CommandBuffer::set_depth_write_enable", enable);
+    }
+    void set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
+        fn_->vkCmdSetDepthCompareOp(cmd_, op);
+    }
     // Enabling needs the depthBounds feature.
-    void set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+    void set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetDepthBoundsTestEnable>("vkrc::CommandBuffer::set_depth_bounds_test_enable",
+                                                                    enable);
+    }
+    void set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetStencilTestEnable>("vkrc::CommandBuffer::set_stencil_test_enable", enable);
+    }
     void set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op, VkStencilOp depth_fail_op,
-                        VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT;
+                        VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_op");
+        fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
+    }
+    void set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetRasterizerDiscardEnable>(
+            "vkrc::CommandBuffer::set_rasterizer_discard_enable", enable);
+    }
+    void set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetDepthBiasEnable>("vkrc::CommandBuffer::set_depth_bias_enable", enable);
+    }
+    void set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
+        set_enable<&DeviceFunctions::vkCmdSetPrimitiveRestartEnable>(
+            "vkrc::CommandBuffer::set_primitive_restart_enable", enable);
+    }
 
     // Binding by raw handles or by a PipelineLayout, for pipelines and
     // layouts made by other code (or adopted): the same single calls.
-    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT;
+    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
+        fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
+    }
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
                               Span<const VkDescriptorSet> sets,
                               Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
-        fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout.vk(), first_set, static_cast<std::uint32_t>(sets.size()),
-                                     sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
-                                     dynamic_offsets.data());
+        bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
     }
     void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
                               Span<const VkDescriptorSet> sets,
-                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT;
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
+        fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
+                                     sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
+                                     dynamic_offsets.data());
+    }
     void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
-                        const void* data) const VKRC_UNCHECKED_NOEXCEPT;
+                        const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
+        fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
+    }
 
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
-    // Both begin_render_pass overloads; the clear values come as pointer and
-    // count because passing a std::span on costs each includer's compile.
-    void record_begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
-                                  const VkClearValue* clear_values, std::size_t clear_value_count,
-                                  VkSubpassContents contents) const noexcept;
     // The device's function table and the Vulkan handle, also held by the
     // state, copied into the handle: a recording call then loads both
     // straight from the handle (as vk::raii's members are), one pointer
@@ -493,6 +751,70 @@ private:
         (fn_->*cmd)(cmd_, enable ? VK_TRUE : VK_FALSE);
     }
 };
+
+// The recording methods of more than one call.
+inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
+#if VKRC_RUNTIME_CHECKS
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_rendering");
+    if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
+        detail::throw_too_many_color_attachments(info.color_attachments.size());
+    }
+#endif
+    VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
+    const RenderingAttachment* color_attachments = info.color_attachments.data();
+    const std::size_t color_count = info.color_attachments.size();
+    std::uint32_t count = 0;
+    for (; count < color_count && count < RenderingInfo::max_color_attachments; ++count) {
+        colors[count] = detail::rendering_attachment_info(color_attachments[count]);
+    }
+    VkRenderingAttachmentInfo depth, stencil;
+    VkRenderingInfo r{};
+    r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+    r.pNext = info.next;
+    r.flags = info.flags;
+    r.viewMask = info.view_mask;
+    r.renderArea = info.render_area;
+    r.layerCount = info.layer_count;
+    r.colorAttachmentCount = count;
+    r.pColorAttachments = colors;
+    if (info.depth_attachment) {
+        depth = detail::rendering_attachment_info(*info.depth_attachment);
+        r.pDepthAttachment = &depth;
+    }
+    if (info.stencil_attachment) {
+        stencil = detail::rendering_attachment_info(*info.stencil_attachment);
+        r.pStencilAttachment = &stencil;
+    }
+    fn_->vkCmdBeginRendering(cmd_, &r);
+}
+
+inline void CommandBuffer::pipeline_barrier(Span<const VkMemoryBarrier2> memory,
+                                            Span<const VkBufferMemoryBarrier2> buffers,
+                                            Span<const VkImageMemoryBarrier2> images,
+                                            VkDependencyFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
+    VkDependencyInfo d{};
+    d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
+    d.dependencyFlags = flags;
+    d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
+    d.pMemoryBarriers = memory.data();
+    d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+    d.pBufferMemoryBarriers = buffers.data();
+    d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+    d.pImageMemoryBarriers = images.data();
+    fn_->vkCmdPipelineBarrier2(cmd_, &d);
+}
+
+inline void CommandBuffer::execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+    constexpr std::size_t chunk = 32;
+    VkCommandBuffer raw[chunk];
+    for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
+        std::uint32_t n = 0;
+        for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
+        fn_->vkCmdExecuteCommands(cmd_, n, raw);
+    }
+}
 
 namespace detail {
 // What the memory, buffer and image barrier helpers fill alike: the stage
@@ -642,511 +964,11 @@ inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEX
     return live("vkrc::CommandPool::queue_family_index").queue_family_index;
 }
 
-inline VkCommandBuffer CommandBuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::vk");
-    return cmd_;
-}
-inline const DeviceFunctions& CommandBuffer::fn() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fn");
-    return *fn_;
-}
 inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::CommandBuffer::pool").pool;
 }
 inline VkCommandBufferLevel CommandBuffer::level() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::CommandBuffer::level").level;
-}
-
-inline void CommandBuffer::begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
-                                             Span<const VkClearValue> clear_values,
-                                             VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
-    record_begin_render_pass(render_pass, framebuffer, render_area, clear_values.data(), clear_values.size(), contents);
-}
-inline void CommandBuffer::record_begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer,
-                                                    VkRect2D render_area, const VkClearValue* clear_values,
-                                                    std::size_t clear_value_count,
-                                                    VkSubpassContents contents) const noexcept {
-    VkRenderPassBeginInfo info{};
-    info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
-    info.renderPass = render_pass;
-    info.framebuffer = framebuffer;
-    info.renderArea = render_area;
-    info.clearValueCount = static_cast<std::uint32_t>(clear_value_count);
-    info.pClearValues = clear_values;
-    fn_->vkCmdBeginRenderPass(cmd_, &info, contents);
-}
-inline void CommandBuffer::next_subpass(VkSubpassContents contents) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::next_subpass");
-    fn_->vkCmdNextSubpass(cmd_, contents);
-}
-inline void CommandBuffer::end_render_pass() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_render_pass");
-    fn_->vkCmdEndRenderPass(cmd_);
-}
-
-namespace detail {
-[[noreturn]] void throw_too_many_color_attachments(std::size_t count);
-
-// begin_rendering's conversion: a function rather than a lambda, and an
-// index loop rather than span iterators, because each closure type and
-// iterator instantiation costs every includer's compile (bench/header_cost).
-inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttachment& a) noexcept {
-    VkRenderingAttachmentInfo r{};
-    r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-    r.imageView = a.image_view;
-    r.imageLayout = a.image_layout;
-    r.loadOp = a.load_op;
-    r.storeOp = a.store_op;
-    r.clearValue = a.clear_value;
-    r.resolveMode = a.resolve_mode;
-    r.resolveImageView = a.resolve_image_view;
-    r.resolveImageLayout = a.resolve_image_layout;
-    return r;
-}
-}  // namespace detail
-
-inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
-#if VKRC_RUNTIME_CHECKS
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_rendering");
-    if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
-        detail::throw_too_many_color_attachments(info.color_attachments.size());
-    }
-#endif
-    VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
-    const RenderingAttachment* color_attachments = info.color_attachments.data();
-    const std::size_t color_count = info.color_attachments.size();
-    std::uint32_t count = 0;
-    for (; count < color_count && count < RenderingInfo::max_color_attachments; ++count) {
-        colors[count] = detail::rendering_attachment_info(color_attachments[count]);
-    }
-    VkRenderingAttachmentInfo depth, stencil;
-    VkRenderingInfo r{};
-    r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-    r.pNext = info.next;
-    r.flags = info.flags;
-    r.viewMask = info.view_mask;
-    r.renderArea = info.render_area;
-    r.layerCount = info.layer_count;
-    r.colorAttachmentCount = count;
-    r.pColorAttachments = colors;
-    if (info.depth_attachment) {
-        depth = detail::rendering_attachment_info(*info.depth_attachment);
-        r.pDepthAttachment = &depth;
-    }
-    if (info.stencil_attachment) {
-        stencil = detail::rendering_attachment_info(*info.stencil_attachment);
-        r.pStencilAttachment = &stencil;
-    }
-    fn_->vkCmdBeginRendering(cmd_, &r);
-}
-inline void CommandBuffer::end_rendering() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_rendering");
-    fn_->vkCmdEndRendering(cmd_);
-}
-
-inline void CommandBuffer::bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
-    fn_->vkCmdBindPipeline(cmd_, pipeline.bind_point(), pipeline.vk());
-}
-inline void CommandBuffer::bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
-                                              VkDeviceSize offset) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffer");
-    fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, &buffer, &offset);
-}
-inline void CommandBuffer::bind_vertex_buffers(std::uint32_t first_binding, Span<const VkBuffer> buffers,
-                                               Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers");
-    fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
-                                offsets.data());
-}
-inline void CommandBuffer::bind_index_buffer(VkBuffer buffer, VkDeviceSize offset,
-                                             VkIndexType type) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_index_buffer");
-    fn_->vkCmdBindIndexBuffer(cmd_, buffer, offset, type);
-}
-inline void CommandBuffer::bind_descriptor_set(
-    const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
-    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_set");
-    VkDescriptorSet raw = set.vk();
-    fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
-                                 static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
-}
-inline void CommandBuffer::bind_descriptor_sets(
-    const Pipeline& pipeline, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
-    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
-    fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), first_set,
-                                 static_cast<std::uint32_t>(sets.size()), sets.data(),
-                                 static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
-}
-inline void CommandBuffer::push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
-                                          std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
-    fn_->vkCmdPushConstants(cmd_, layout.vk(), stages, offset, size, data);
-}
-inline void CommandBuffer::push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout,
-                                               std::uint32_t set,
-                                               Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
-    fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout, set, static_cast<std::uint32_t>(writes.size()),
-                                   writes.data());
-}
-inline void CommandBuffer::push_descriptor_set_with_template(VkDescriptorUpdateTemplate update_template,
-                                                             VkPipelineLayout layout, std::uint32_t set,
-                                                             const void* data) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set_with_template");
-    fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template, layout, set, data);
-}
-inline void CommandBuffer::set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
-    fn_->vkCmdSetViewport(cmd_, 0, 1, &viewport);
-}
-inline void CommandBuffer::set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor");
-    fn_->vkCmdSetScissor(cmd_, 0, 1, &scissor);
-}
-inline void CommandBuffer::set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_and_scissor");
-    set_viewport({0.0f, 0.0f, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0f, 1.0f});
-    set_scissor({{0, 0}, extent});
-}
-
-inline void CommandBuffer::draw(std::uint32_t vertex_count, std::uint32_t instance_count, std::uint32_t first_vertex,
-                                std::uint32_t first_instance) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw");
-    fn_->vkCmdDraw(cmd_, vertex_count, instance_count, first_vertex, first_instance);
-}
-inline void CommandBuffer::draw_indexed(std::uint32_t index_count, std::uint32_t instance_count,
-                                        std::uint32_t first_index, std::int32_t vertex_offset,
-                                        std::uint32_t first_instance) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed");
-    fn_->vkCmdDrawIndexed(cmd_, index_count, instance_count, first_index, vertex_offset, first_instance);
-}
-inline void CommandBuffer::dispatch(std::uint32_t x, std::uint32_t y, std::uint32_t z) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch");
-    fn_->vkCmdDispatch(cmd_, x, y, z);
-}
-inline void CommandBuffer::copy_buffer(VkBuffer src, VkBuffer dst,
-                                       Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
-    fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
-}
-inline void CommandBuffer::copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
-                                                Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
-    fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()), regions.data());
-}
-inline void CommandBuffer::copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
-                                                Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
-    fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
-}
-inline void CommandBuffer::copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
-    fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                        regions.data());
-}
-inline void CommandBuffer::fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
-                                       std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fill_buffer");
-    fn_->vkCmdFillBuffer(cmd_, dst, offset, size, data);
-}
-
-inline void CommandBuffer::pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-    fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
-}
-inline void CommandBuffer::pipeline_barrier(Span<const VkMemoryBarrier2> memory,
-                                            Span<const VkBufferMemoryBarrier2> buffers,
-                                            Span<const VkImageMemoryBarrier2> images,
-                                            VkDependencyFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-    VkDependencyInfo d{};
-    d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-    d.dependencyFlags = flags;
-    d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
-    d.pMemoryBarriers = memory.data();
-    d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
-    d.pBufferMemoryBarriers = buffers.data();
-    d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
-    d.pImageMemoryBarriers = images.data();
-    fn_->vkCmdPipelineBarrier2(cmd_, &d);
-}
-inline void CommandBuffer::set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
-    fn_->vkCmdSetEvent2(cmd_, event, &dependency);
-}
-inline void CommandBuffer::reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
-    fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
-}
-
-inline void CommandBuffer::execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
-    constexpr std::size_t chunk = 32;
-    VkCommandBuffer raw[chunk];
-    for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
-        std::uint32_t n = 0;
-        for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
-        fn_->vkCmdExecuteCommands(cmd_, n, raw);
-    }
-}
-inline void CommandBuffer::execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
-    fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
-}
-
-inline void CommandBuffer::reset_query_pool(VkQueryPool pool, std::uint32_t first_query,
-                                            std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
-    fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
-}
-inline void CommandBuffer::write_timestamp(VkPipelineStageFlags2 stage, VkQueryPool pool,
-                                           std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
-    fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
-}
-
-inline void CommandBuffer::blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                      Span<const VkImageBlit> regions, VkFilter filter) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
-    fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                        regions.data(), filter);
-}
-inline void CommandBuffer::resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
-                                         Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
-    fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                           regions.data());
-}
-inline void CommandBuffer::clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
-                                             Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
-    fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()), ranges.data());
-}
-inline void CommandBuffer::clear_depth_stencil_image(
-    VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-    Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
-    fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
-                                     ranges.data());
-}
-inline void CommandBuffer::clear_attachments(Span<const VkClearAttachment> attachments,
-                                             Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_attachments");
-    fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
-                               static_cast<std::uint32_t>(rects.size()), rects.data());
-}
-
-namespace detail {
-[[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
-}
-
-inline void CommandBuffer::update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
-#if VKRC_RUNTIME_CHECKS
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::update_buffer");
-    if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
-        detail::throw_bad_update_buffer(offset, size);
-    }
-#endif
-    fn_->vkCmdUpdateBuffer(cmd_, dst, offset, size, data);
-}
-
-inline void CommandBuffer::draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                                         std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect");
-    fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
-                           stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
-}
-inline void CommandBuffer::draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                                                 std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect");
-    fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
-                                  stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
-}
-inline void CommandBuffer::dispatch_indirect(VkBuffer buffer, VkDeviceSize offset) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch_indirect");
-    fn_->vkCmdDispatchIndirect(cmd_, buffer, offset);
-}
-inline void CommandBuffer::draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
-                                               VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                               std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect_count");
-    fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
-                                stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
-}
-inline void CommandBuffer::draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
-                                                       VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                                       std::uint32_t stride) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect_count");
-    fn_->vkCmdDrawIndexedIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
-                                       stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
-}
-
-inline void CommandBuffer::begin_query(VkQueryPool pool, std::uint32_t query,
-                                       VkQueryControlFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
-    fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
-}
-inline void CommandBuffer::end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
-    fn_->vkCmdEndQuery(cmd_, pool, query);
-}
-inline void CommandBuffer::copy_query_results(VkQueryPool pool, std::uint32_t first_query, std::uint32_t query_count,
-                                              VkBuffer dst, VkDeviceSize offset, VkDeviceSize stride,
-                                              VkQueryResultFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
-    fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
-                                   flags | VK_QUERY_RESULT_64_BIT);
-}
-
-inline void CommandBuffer::begin_label(const char* name, const LabelColor& color) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_label");
-    if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
-        const VkDebugUtilsLabelEXT label{
-            VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
-        f(cmd_, &label);
-    }
-}
-inline void CommandBuffer::end_label() const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_label");
-    if (auto f = fn_->vkCmdEndDebugUtilsLabelEXT) f(cmd_);
-}
-inline void CommandBuffer::insert_label(const char* name, const LabelColor& color) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::insert_label");
-    if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
-        const VkDebugUtilsLabelEXT label{
-            VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
-        f(cmd_, &label);
-    }
-}
-
-inline void CommandBuffer::set_viewports(std::uint32_t first,
-                                         Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewports");
-    fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
-}
-inline void CommandBuffer::set_scissors(std::uint32_t first,
-                                        Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissors");
-    fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
-}
-inline void CommandBuffer::set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_line_width");
-    fn_->vkCmdSetLineWidth(cmd_, width);
-}
-inline void CommandBuffer::set_depth_bias(float constant_factor, float clamp,
-                                          float slope_factor) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias");
-    fn_->vkCmdSetDepthBias(cmd_, constant_factor, clamp, slope_factor);
-}
-inline void CommandBuffer::set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_blend_constants");
-    fn_->vkCmdSetBlendConstants(cmd_, constants);
-}
-inline void CommandBuffer::set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds");
-    fn_->vkCmdSetDepthBounds(cmd_, min_bounds, max_bounds);
-}
-inline void CommandBuffer::set_stencil_compare_mask(VkStencilFaceFlags faces,
-                                                    std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_compare_mask");
-    fn_->vkCmdSetStencilCompareMask(cmd_, faces, mask);
-}
-inline void CommandBuffer::set_stencil_write_mask(VkStencilFaceFlags faces,
-                                                  std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_write_mask");
-    fn_->vkCmdSetStencilWriteMask(cmd_, faces, mask);
-}
-inline void CommandBuffer::set_stencil_reference(VkStencilFaceFlags faces,
-                                                 std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_reference");
-    fn_->vkCmdSetStencilReference(cmd_, faces, reference);
-}
-
-inline void CommandBuffer::set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_cull_mode");
-    fn_->vkCmdSetCullMode(cmd_, mode);
-}
-inline void CommandBuffer::set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_front_face");
-    fn_->vkCmdSetFrontFace(cmd_, face);
-}
-inline void CommandBuffer::set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_topology");
-    fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
-}
-inline void CommandBuffer::set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_with_count");
-    fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
-}
-inline void CommandBuffer::set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor_with_count");
-    fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
-}
-inline void CommandBuffer::bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
-                                                Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes,
-                                                Span<const VkDeviceSize> strides) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
-    fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
-                                 offsets.data(), sizes.empty() ? nullptr : sizes.data(),
-                                 strides.empty() ? nullptr : strides.data());
-}
-inline void CommandBuffer::set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetDepthTestEnable>("vkrc::CommandBuffer::set_depth_test_enable", enable);
-}
-inline void CommandBuffer::set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetDepthWriteEnable>("vkrc::CommandBuffer::set_depth_write_enable", enable);
-}
-inline void CommandBuffer::set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
-    fn_->vkCmdSetDepthCompareOp(cmd_, op);
-}
-inline void CommandBuffer::set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetDepthBoundsTestEnable>("vkrc::CommandBuffer::set_depth_bounds_test_enable",
-                                                                enable);
-}
-inline void CommandBuffer::set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetStencilTestEnable>("vkrc::CommandBuffer::set_stencil_test_enable", enable);
-}
-inline void CommandBuffer::set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op,
-                                          VkStencilOp depth_fail_op,
-                                          VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_op");
-    fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
-}
-inline void CommandBuffer::set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetRasterizerDiscardEnable>("vkrc::CommandBuffer::set_rasterizer_discard_enable",
-                                                                  enable);
-}
-inline void CommandBuffer::set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetDepthBiasEnable>("vkrc::CommandBuffer::set_depth_bias_enable", enable);
-}
-inline void CommandBuffer::set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-    set_enable<&DeviceFunctions::vkCmdSetPrimitiveRestartEnable>("vkrc::CommandBuffer::set_primitive_restart_enable",
-                                                                 enable);
-}
-
-inline void CommandBuffer::bind_pipeline(VkPipelineBindPoint bind_point,
-                                         VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
-    fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
-}
-inline void CommandBuffer::bind_descriptor_sets(
-    VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
-    Span<const std::uint32_t> dynamic_offsets) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
-    fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
-                                 sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
-                                 dynamic_offsets.data());
-}
-inline void CommandBuffer::push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset,
-                                          std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
-    fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
 }
 
 VKRC_END_NAMESPACE

@@ -5,19 +5,30 @@
 // their own, which vkrc and its policy namespaces both reach as moves::.
 #pragma once
 
-#include <type_traits>
-
 namespace vkrc::moves {
+
+template <class T>
+struct Unref {
+    using type = T;
+};
+template <class T>
+struct Unref<T&> {
+    using type = T;
+};
+template <class T>
+struct Unref<T&&> {
+    using type = T;
+};
 
 // std::move.
 template <class T>
-constexpr std::remove_reference_t<T>&& move(T&& value) noexcept {
-    return static_cast<std::remove_reference_t<T>&&>(value);
+constexpr typename Unref<T>::type&& move(T&& value) noexcept {
+    return static_cast<typename Unref<T>::type&&>(value);
 }
 
 // std::forward.
 template <class T>
-constexpr T&& forward(std::remove_reference_t<T>& value) noexcept {
+constexpr T&& forward(typename Unref<T>::type& value) noexcept {
     return static_cast<T&&>(value);
 }
 

@@ -11,19 +11,26 @@
 #pragma once
 
 #include <cstddef>
-#include <type_traits>
 
 namespace vkrc {
 
 namespace detail {
 template <class T>
 T& lvalue() noexcept;  // declared only, for decltype (std::declval without <utility>)
+template <class Pointer>
+struct Pointee {};
+template <class E>
+struct Pointee<E*> {
+    using type = E;
+};
 // The element type of a range's data() pointer.
 template <class Range>
-using RangeElement = std::remove_pointer_t<decltype(lvalue<std::remove_reference_t<Range>>().data())>;
-// Elements of type From can be viewed as T: the same type, at most adding const.
+using RangeElement = typename Pointee<decltype(lvalue<Range>().data())>::type;
+// Elements of type From can be viewed as T: the same type, at most adding
+// const (an array pointer converts only so; a Span of a base class must not
+// take an array of derived ones).
 template <class From, class T>
-inline constexpr bool viewable_as = std::is_convertible_v<From (*)[], T (*)[]>;
+concept viewable_as = requires(From (*from)[], void (*to)(T (*)[])) { to(from); };
 }  // namespace detail
 
 template <class T>
