@@ -30,7 +30,9 @@ using RangeElement = typename Pointee<decltype(lvalue<Range>().data())>::type;
 // const (an array pointer converts only so; a Span of a base class must not
 // take an array of derived ones).
 template <class From, class T>
-concept viewable_as = requires(From (*from)[], void (*to)(T (*)[])) { to(from); };
+concept viewable_as = requires(From (*from)[], void (*to)(T (*)[])) {
+    to(from);
+};
 }  // namespace detail
 
 template <class T>
