@@ -9,23 +9,16 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-template <class Member>
-struct MemberOf;
-template <class Class, class Type>
-struct MemberOf<Type Class::*> {
-    using State = Class;
-};
-
 // The state of an adopted handle: refuses an empty parent ("who: the
 // parent_name handle is empty") and a null handle ("who: the handle_name is
 // VK_NULL_HANDLE") with UsageError, then holds both and the ownership. The
-// caller fills in the rest; nothing it does after this may throw, or the
-// state would destroy an owned handle that adopt() did not take.
-template <auto parent_member, auto handle_member, class Parent, class VkHandle>
-Ref<typename MemberOf<decltype(parent_member)>::State> adopted_state(const char* who, const Parent& parent,
-                                                                     const char* parent_name, VkHandle handle,
-                                                                     const char* handle_name, Ownership ownership) {
-    using State = typename MemberOf<decltype(parent_member)>::State;
+// members default to those of a DeviceChildState. The caller fills in the
+// rest; nothing it does after this may throw, or the state would destroy an
+// owned handle that adopt() did not take.
+template <class State, auto parent_member = &State::device, auto handle_member = &State::handle, class Parent,
+          class VkHandle>
+Ref<State> adopted_state(const char* who, const Parent& parent, const char* parent_name, VkHandle handle,
+                         const char* handle_name, Ownership ownership) {
     if (!parent) throw UsageError(std::string(who) + ": the " + parent_name + " handle is empty");
     if (handle == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the " + handle_name + " is VK_NULL_HANDLE");
     Ref<State> s(new State);

@@ -16,16 +16,15 @@ void throw_too_many_color_attachments(std::size_t count) {
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
-    if (ownership == Ownership::owned) {
-        defer_destroy<&DeviceFunctions::vkDestroyCommandPool>(*device.state(), pool, serial());
-    }
+    destroy_owned<&DeviceFunctions::vkDestroyCommandPool>();
 }
 
 void CommandPoolState::free_ready() {
     scratch.clear();
     pending.take_ready(*device.state(), scratch);
     if (!scratch.empty()) {
-        device.fn().vkFreeCommandBuffers(device.vk(), pool, static_cast<std::uint32_t>(scratch.size()), scratch.data());
+        device.fn().vkFreeCommandBuffers(device.vk(), handle, static_cast<std::uint32_t>(scratch.size()),
+                                         scratch.data());
     }
 }
 
@@ -52,14 +51,14 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
     detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);
     s->device = device;
     s->queue_family_index = info.queue_family_index;
-    check(device.fn().vkCreateCommandPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateCommandPool");
+    check(device.fn().vkCreateCommandPool(device.vk(), &ci, nullptr, &s->handle), "vkCreateCommandPool");
     return CommandPool(std::move(s));
 }
 
 CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
                                Ownership ownership) {
-    auto s = detail::adopted_state<&detail::CommandPoolState::device, &detail::CommandPoolState::pool>(
-        "vkrc::CommandPool::adopt", device, "Device", pool, "VkCommandPool", ownership);
+    auto s = detail::adopted_state<detail::CommandPoolState>("vkrc::CommandPool::adopt", device, "Device", pool,
+                                                             "VkCommandPool", ownership);
     s->queue_family_index = queue_family_index;
     return CommandPool(std::move(s));
 }
@@ -81,7 +80,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     auto& p = *state_;
     auto s = new_command_buffer_state(*this, level);
     VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = p.pool;
+    ai.commandPool = p.handle;
     ai.level = level;
     ai.commandBufferCount = 1;
     LockGuard lock(p.mutex);
@@ -90,7 +89,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     try {
         p.device.state()->commands.add(s->window);
     } catch (...) {
-        p.device.fn().vkFreeCommandBuffers(p.device.vk(), p.pool, 1, &s->cmd);
+        p.device.fn().vkFreeCommandBuffers(p.device.vk(), p.handle, 1, &s->cmd);
         s->cmd = VK_NULL_HANDLE;
         throw;
     }
@@ -121,7 +120,7 @@ void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
     {
         LockGuard lock(p.mutex);
         p.free_completed();
-        check(p.device.fn().vkResetCommandPool(p.device.vk(), p.pool, flags), "vkResetCommandPool");
+        check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
     }
     p.device.state()->commands.close_pool(*p.device.state(), &p);
 }

@@ -14,14 +14,12 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 DescriptorSetLayoutState::~DescriptorSetLayoutState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*device.state(), layout, serial());
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorSetLayout>();
 }
 
 DescriptorPoolState::~DescriptorPoolState() {
     // Destroying the pool frees every set still in it, pending ones included.
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyDescriptorPool>(*device.state(), pool, serial());
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorPool>();
 }
 
 DescriptorSetState::~DescriptorSetState() {
@@ -130,7 +128,7 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
     ci.bindingCount = static_cast<std::uint32_t>(bindings.size());
     ci.pBindings = bindings.data();
     keep_bindings(*s, device, info.bindings);
-    check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->layout),
+    check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->handle),
           "vkCreateDescriptorSetLayout");
     return DescriptorSetLayout(std::move(s));
 }
@@ -143,15 +141,15 @@ DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescripto
     check_bindings(device, info, who);
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     keep_bindings(*s, device, info.bindings);
-    s->layout = layout;
+    s->handle = layout;
     s->ownership = ownership;
     return DescriptorSetLayout(std::move(s));
 }
 
 DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
                                      Ownership ownership) {
-    auto s = detail::adopted_state<&detail::DescriptorPoolState::device, &detail::DescriptorPoolState::pool>(
-        "vkrc::DescriptorPool::adopt", device, "Device", pool, "VkDescriptorPool", ownership);
+    auto s = detail::adopted_state<detail::DescriptorPoolState>("vkrc::DescriptorPool::adopt", device, "Device", pool,
+                                                                "VkDescriptorPool", ownership);
     s->can_free_sets = (flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
     return DescriptorPool(std::move(s));
 }
@@ -168,7 +166,7 @@ DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPool
     detail::Ref<detail::DescriptorPoolState> s(new detail::DescriptorPoolState);
     s->device = device;
     s->can_free_sets = (info.flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
-    check(device.fn().vkCreateDescriptorPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateDescriptorPool");
+    check(device.fn().vkCreateDescriptorPool(device.vk(), &ci, nullptr, &s->handle), "vkCreateDescriptorPool");
     return DescriptorPool(std::move(s));
 }
 
@@ -213,7 +211,7 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
     variable.pDescriptorCounts = &variable_descriptor_count;
     VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     if (layout.state()->has_variable_binding) ai.pNext = &variable;
-    ai.descriptorPool = p.pool;
+    ai.descriptorPool = p.handle;
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &raw_layout;
     thread_local List<VkDescriptorSet> ready;
@@ -221,7 +219,7 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
     ready.clear();
     p.pending.take_ready(d, ready);
     if (!ready.empty()) {
-        check(d.fn.vkFreeDescriptorSets(d.device, p.pool, static_cast<std::uint32_t>(ready.size()), ready.data()),
+        check(d.fn.vkFreeDescriptorSets(d.device, p.handle, static_cast<std::uint32_t>(ready.size()), ready.data()),
               "vkFreeDescriptorSets");
     }
     check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->set), "vkAllocateDescriptorSets");
@@ -253,7 +251,7 @@ DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorS
 void DescriptorPool::reset_sets() const {
     auto& p = *state_;
     LockGuard lock(p.mutex);
-    check(p.device.fn().vkResetDescriptorPool(p.device.vk(), p.pool, 0), "vkResetDescriptorPool");
+    check(p.device.fn().vkResetDescriptorPool(p.device.vk(), p.handle, 0), "vkResetDescriptorPool");
     p.pending.clear();
     ++p.generation;
 }

@@ -6,10 +6,9 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
+// A push template may be referred to by an open command buffer: the serial holds the drop.
 DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
-    if (ownership == Ownership::borrowed) return;
-    // A push template may be referred to by an open command buffer: the serial holds the drop.
-    defer_destroy<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>(*device.state(), update_template, serial());
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>();
 }
 
 }  // namespace detail
@@ -61,7 +60,7 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
         s->pipeline_layout = info.pipeline_layout;
         s->set = info.set;
     }
-    check(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &s->update_template),
+    check(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &s->handle),
           "vkCreateDescriptorUpdateTemplate");
     return DescriptorUpdateTemplate(std::move(s));
 }
@@ -77,7 +76,7 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::adopt(const Device& device,
     }
     detail::Ref<detail::DescriptorUpdateTemplateState> s(new detail::DescriptorUpdateTemplateState);
     s->device = device;
-    s->update_template = update_template;
+    s->handle = update_template;
     s->ownership = ownership;
     s->type = info.template_type;
     s->set_layout = info.descriptor_set_layout;

@@ -73,6 +73,9 @@ void throw_empty_handle(const char* call) {
                      ": the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image "
                      "has no Allocation)");
 }
+void throw_empty_handle(const char* type, const char* member) {
+    throw_empty_handle((std::string(type) + "::" + member).c_str());
+}
 }  // namespace detail
 
 Error::Error(VkResult result, const char* call) : result_(result), call_(call) {

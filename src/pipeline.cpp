@@ -15,22 +15,13 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-PipelineLayoutState::~PipelineLayoutState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyPipelineLayout>(*device.state(), layout, serial());
-}
-RenderPassState::~RenderPassState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyRenderPass>(*device.state(), render_pass, serial());
-}
+PipelineLayoutState::~PipelineLayoutState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineLayout>(); }
+RenderPassState::~RenderPassState() { destroy_owned<&DeviceFunctions::vkDestroyRenderPass>(); }
 FramebufferState::~FramebufferState() {
     if (ownership == Ownership::owned)
         defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer, serial());
 }
-PipelineCacheState::~PipelineCacheState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyPipelineCache>(*device.state(), cache, serial());
-}
+PipelineCacheState::~PipelineCacheState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineCache>(); }
 PipelineState::~PipelineState() {
     if (ownership == Ownership::owned)
         defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline, serial());
@@ -46,37 +37,38 @@ void require(bool ok, const char* who, const char* problem) {
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
 
 PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {
-    return PipelineLayout(
-        detail::adopted_state<&detail::PipelineLayoutState::device, &detail::PipelineLayoutState::layout>(
-            "vkrc::PipelineLayout::adopt", device, "Device", layout, "VkPipelineLayout", ownership));
+    return PipelineLayout(detail::adopted_state<detail::PipelineLayoutState>(
+        "vkrc::PipelineLayout::adopt", device, "Device", layout, "VkPipelineLayout", ownership));
 }
 
 RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
                              Span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
     List<std::uint32_t> counts(color_attachment_counts);  // before the state: a failed copy must not destroy
-    auto s = detail::adopted_state<&detail::RenderPassState::device, &detail::RenderPassState::render_pass>(
-        "vkrc::RenderPass::adopt", device, "Device", render_pass, "VkRenderPass", ownership);
+    auto s = detail::adopted_state<detail::RenderPassState>("vkrc::RenderPass::adopt", device, "Device", render_pass,
+                                                            "VkRenderPass", ownership);
     s->color_counts = std::move(counts);
     return RenderPass(std::move(s));
 }
 
 Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                                Ownership ownership) {
-    auto s = detail::adopted_state<&detail::FramebufferState::render_pass, &detail::FramebufferState::framebuffer>(
+    auto s = detail::adopted_state<detail::FramebufferState, &detail::FramebufferState::render_pass,
+                                   &detail::FramebufferState::framebuffer>(
         "vkrc::Framebuffer::adopt", render_pass, "RenderPass", framebuffer, "VkFramebuffer", ownership);
     s->extent = extent;
     return Framebuffer(std::move(s));
 }
 
 PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, Ownership ownership) {
-    return PipelineCache(detail::adopted_state<&detail::PipelineCacheState::device, &detail::PipelineCacheState::cache>(
+    return PipelineCache(detail::adopted_state<detail::PipelineCacheState>(
         "vkrc::PipelineCache::adopt", device, "Device", cache, "VkPipelineCache", ownership));
 }
 
 Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                          Ownership ownership) {
-    auto s = detail::adopted_state<&detail::PipelineState::layout, &detail::PipelineState::pipeline>(
-        "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
+    auto s =
+        detail::adopted_state<detail::PipelineState, &detail::PipelineState::layout, &detail::PipelineState::pipeline>(
+            "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
     s->bind_point = bind_point;
     return Pipeline(std::move(s));
 }
@@ -99,7 +91,7 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
     ci.pPushConstantRanges = info.push_constant_ranges.data();
     detail::Ref<detail::PipelineLayoutState> s(new detail::PipelineLayoutState);
     s->device = device;
-    check(device.fn().vkCreatePipelineLayout(device.vk(), &ci, nullptr, &s->layout), "vkCreatePipelineLayout");
+    check(device.fn().vkCreatePipelineLayout(device.vk(), &ci, nullptr, &s->handle), "vkCreatePipelineLayout");
     return PipelineLayout(std::move(s));
 }
 
@@ -138,7 +130,7 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
     detail::Ref<detail::RenderPassState> s(new detail::RenderPassState);
     s->device = device;
     s->color_counts = std::move(color_counts);
-    check(device.fn().vkCreateRenderPass(device.vk(), &ci, nullptr, &s->render_pass), "vkCreateRenderPass");
+    check(device.fn().vkCreateRenderPass(device.vk(), &ci, nullptr, &s->handle), "vkCreateRenderPass");
     return RenderPass(std::move(s));
 }
 
@@ -184,7 +176,7 @@ PipelineCache PipelineCache::create(const Device& device, Span<const std::byte> 
     ci.pInitialData = initial_data.data();
     detail::Ref<detail::PipelineCacheState> s(new detail::PipelineCacheState);
     s->device = device;
-    check(device.fn().vkCreatePipelineCache(device.vk(), &ci, nullptr, &s->cache), "vkCreatePipelineCache");
+    check(device.fn().vkCreatePipelineCache(device.vk(), &ci, nullptr, &s->handle), "vkCreatePipelineCache");
     s->loaded_from_file = !initial_data.empty();
     return PipelineCache(std::move(s));
 }
@@ -231,10 +223,10 @@ PipelineCache PipelineCache::load(const Device& device, const char* file) {
 List<std::byte> PipelineCache::data() const {
     const auto& d = state_->device;
     std::size_t size = 0;
-    check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, nullptr), "vkGetPipelineCacheData");
+    check(d.fn().vkGetPipelineCacheData(d.vk(), state_->handle, &size, nullptr), "vkGetPipelineCacheData");
     std::vector<std::byte> out(size);
     VkResult r =
-        check(d.fn().vkGetPipelineCacheData(d.vk(), state_->cache, &size, out.data()), "vkGetPipelineCacheData");
+        check(d.fn().vkGetPipelineCacheData(d.vk(), state_->handle, &size, out.data()), "vkGetPipelineCacheData");
     out.resize(size);
     (void)r;  // VK_INCOMPLETE only if the cache grew in between: the prefix is a valid cache
     return out;

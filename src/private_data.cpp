@@ -6,24 +6,20 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-PrivateDataSlotState::~PrivateDataSlotState() {
-    if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyPrivateDataSlot>(*device.state(), slot, serial());
-}
+PrivateDataSlotState::~PrivateDataSlotState() { destroy_owned<&DeviceFunctions::vkDestroyPrivateDataSlot>(); }
 
 }  // namespace detail
 
 PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership) {
-    return PrivateDataSlot(
-        detail::adopted_state<&detail::PrivateDataSlotState::device, &detail::PrivateDataSlotState::slot>(
-            "vkrc::PrivateDataSlot::adopt", device, "Device", slot, "VkPrivateDataSlot", ownership));
+    return PrivateDataSlot(detail::adopted_state<detail::PrivateDataSlotState>(
+        "vkrc::PrivateDataSlot::adopt", device, "Device", slot, "VkPrivateDataSlot", ownership));
 }
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
     if (!device) throw UsageError("vkrc::PrivateDataSlot::create: the Device handle is empty");
     VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO, info.next, info.flags};
     detail::Ref<detail::PrivateDataSlotState> state(new detail::PrivateDataSlotState);
-    check(device.fn().vkCreatePrivateDataSlot(device.vk(), &ci, nullptr, &state->slot), "vkCreatePrivateDataSlot");
+    check(device.fn().vkCreatePrivateDataSlot(device.vk(), &ci, nullptr, &state->handle), "vkCreatePrivateDataSlot");
     state->device = device;
     return PrivateDataSlot(std::move(state));
 }
@@ -31,14 +27,14 @@ PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataS
 void PrivateDataSlot::set_bits(VkObjectType object_type, std::uint64_t object, std::uint64_t data) const {
     VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::set");
     const auto& d = state_->device;
-    check(d.fn().vkSetPrivateData(d.vk(), object_type, object, state_->slot, data), "vkSetPrivateData");
+    check(d.fn().vkSetPrivateData(d.vk(), object_type, object, state_->handle, data), "vkSetPrivateData");
 }
 
 std::uint64_t PrivateDataSlot::get_bits(VkObjectType object_type, std::uint64_t object) const {
     VKRC_REQUIRE_STATE("vkrc::PrivateDataSlot::get");
     const auto& d = state_->device;
     std::uint64_t data = 0;
-    d.fn().vkGetPrivateData(d.vk(), object_type, object, state_->slot, &data);
+    d.fn().vkGetPrivateData(d.vk(), object_type, object, state_->handle, &data);
     return data;
 }
 

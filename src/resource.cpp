@@ -17,13 +17,11 @@ namespace detail {
 // members (the allocation, then the parents) are released after, so FIFO
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
-    if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyBuffer>(*device.state(), buffer, serial());
+    destroy_owned<&DeviceFunctions::vkDestroyBuffer>();
     if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
 ImageState::~ImageState() {
-    if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyImage>(*device.state(), image, serial());
+    destroy_owned<&DeviceFunctions::vkDestroyImage>();
     if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
 
@@ -58,10 +56,7 @@ BufferViewState::~BufferViewState() {
     if (buffer && ownership == Ownership::owned)
         defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
 }
-SamplerState::~SamplerState() {
-    if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroySampler>(*device.state(), sampler, serial());
-}
+SamplerState::~SamplerState() { destroy_owned<&DeviceFunctions::vkDestroySampler>(); }
 
 }  // namespace detail
 
@@ -79,16 +74,16 @@ void create_bound(const Device& device, const CreateInfo& ci, State& state, Allo
     VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};
     VkMemoryRequirements2 requirements{VK_STRUCTURE_TYPE_MEMORY_REQUIREMENTS_2, &dedicated};
     if constexpr (is_buffer) {
-        check(fn.vkCreateBuffer(device.vk(), &ci, nullptr, &state.buffer), "vkCreateBuffer");
-        request.dedicated_buffer = state.buffer;
+        check(fn.vkCreateBuffer(device.vk(), &ci, nullptr, &state.handle), "vkCreateBuffer");
+        request.dedicated_buffer = state.handle;
         const VkBufferMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_BUFFER_MEMORY_REQUIREMENTS_INFO_2, nullptr,
-                                                    state.buffer};
+                                                    state.handle};
         fn.vkGetBufferMemoryRequirements2(device.vk(), &query, &requirements);
     } else {
-        check(fn.vkCreateImage(device.vk(), &ci, nullptr, &state.image), "vkCreateImage");
-        request.dedicated_image = state.image;
+        check(fn.vkCreateImage(device.vk(), &ci, nullptr, &state.handle), "vkCreateImage");
+        request.dedicated_image = state.handle;
         const VkImageMemoryRequirementsInfo2 query{VK_STRUCTURE_TYPE_IMAGE_MEMORY_REQUIREMENTS_INFO_2, nullptr,
-                                                   state.image};
+                                                   state.handle};
         fn.vkGetImageMemoryRequirements2(device.vk(), &query, &requirements);
     }
     request.requirements = requirements.memoryRequirements;
@@ -98,9 +93,9 @@ void create_bound(const Device& device, const CreateInfo& ci, State& state, Allo
     const VkDeviceMemory memory = state.allocation.memory();
     const VkDeviceSize offset = state.allocation.offset();
     if constexpr (is_buffer) {
-        check(fn.vkBindBufferMemory(device.vk(), state.buffer, memory, offset), "vkBindBufferMemory");
+        check(fn.vkBindBufferMemory(device.vk(), state.handle, memory, offset), "vkBindBufferMemory");
     } else {
-        check(fn.vkBindImageMemory(device.vk(), state.image, memory, offset), "vkBindImageMemory");
+        check(fn.vkBindImageMemory(device.vk(), state.handle, memory, offset), "vkBindImageMemory");
     }
 }
 
@@ -198,7 +193,7 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     request.device_address = (info.usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0;
     auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
     create_bound(device, ci, *state, request, info.allocator);
-    state->device_address = query_device_address(device, state->buffer, info.usage);
+    state->device_address = query_device_address(device, state->handle, info.usage);
     return Buffer(std::move(state));
 }
 
@@ -207,7 +202,7 @@ Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, V
     if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
     if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
     auto state = buffer_state(device, size, usage, ownership);
-    state->buffer = buffer;
+    state->handle = buffer;
     state->cleanup = std::move(cleanup);
     state->device_address = query_device_address(device, buffer, usage);
     return Buffer(std::move(state));
@@ -268,7 +263,7 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
     if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
     if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
     auto state = image_state(device, info, ownership);
-    state->image = image;
+    state->handle = image;
     state->cleanup = std::move(cleanup);
     return Image(std::move(state));
 }
@@ -346,21 +341,23 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
-    auto state = detail::adopted_state<&detail::ImageViewState::image, &detail::ImageViewState::view>(
-        "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
+    auto state =
+        detail::adopted_state<detail::ImageViewState, &detail::ImageViewState::image, &detail::ImageViewState::view>(
+            "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
     return ImageView(std::move(state));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    return BufferView(detail::adopted_state<&detail::BufferViewState::buffer, &detail::BufferViewState::view>(
-        "vkrc::BufferView::adopt", buffer, "Buffer", view, "VkBufferView", ownership));
+    return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer,
+                                            &detail::BufferViewState::view>("vkrc::BufferView::adopt", buffer, "Buffer",
+                                                                            view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    return Sampler(detail::adopted_state<&detail::SamplerState::device, &detail::SamplerState::sampler>(
-        "vkrc::Sampler::adopt", device, "Device", sampler, "VkSampler", ownership));
+    return Sampler(detail::adopted_state<detail::SamplerState>("vkrc::Sampler::adopt", device, "Device", sampler,
+                                                               "VkSampler", ownership));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
@@ -385,7 +382,7 @@ Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     ci.borderColor = info.border_color;
     ci.unnormalizedCoordinates = info.unnormalized_coordinates ? VK_TRUE : VK_FALSE;
     detail::Ref<detail::SamplerState> state(new detail::SamplerState);
-    check(device.fn().vkCreateSampler(device.vk(), &ci, nullptr, &state->sampler), "vkCreateSampler");
+    check(device.fn().vkCreateSampler(device.vk(), &ci, nullptr, &state->handle), "vkCreateSampler");
     state->device = device;
     state->ycbcr_conversion = info.ycbcr_conversion;
     return Sampler(std::move(state));

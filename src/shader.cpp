@@ -12,10 +12,7 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-ShaderModuleState::~ShaderModuleState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyShaderModule>(*device.state(), module, serial());
-}
+ShaderModuleState::~ShaderModuleState() { destroy_owned<&DeviceFunctions::vkDestroyShaderModule>(); }
 }  // namespace detail
 
 namespace {
@@ -41,7 +38,7 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
     ci.pCode = static_cast<const std::uint32_t*>(code);
     s = detail::Ref<detail::ShaderModuleState>(new detail::ShaderModuleState);
     s->device = device;
-    check(device.fn().vkCreateShaderModule(device.vk(), &ci, nullptr, &s->module), "vkCreateShaderModule");
+    check(device.fn().vkCreateShaderModule(device.vk(), &ci, nullptr, &s->handle), "vkCreateShaderModule");
 }
 }  // namespace
 
@@ -61,8 +58,8 @@ ShaderModule ShaderModule::create(const Device& device, Span<const std::byte> sp
 }
 
 ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
-    return ShaderModule(detail::adopted_state<&detail::ShaderModuleState::device, &detail::ShaderModuleState::module>(
-        "vkrc::ShaderModule::adopt", device, "Device", module, "VkShaderModule", ownership));
+    return ShaderModule(detail::adopted_state<detail::ShaderModuleState>("vkrc::ShaderModule::adopt", device, "Device",
+                                                                         module, "VkShaderModule", ownership));
 }
 
 ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {

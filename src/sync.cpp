@@ -12,10 +12,7 @@ void require_device(const Device& device, const char* who) {
 
 // After a wait or a status query: a signalled fence is no longer in flight.
 VkResult finish_fence_query(detail::FenceState& s, VkResult r, const char* name) {
-    if (r == VK_SUCCESS) {
-        s.in_flight = false;
-        s.note_signalled();
-    }
+    if (r == VK_SUCCESS) s.note_signalled();
     return s.device.state()->finish_call(r, name);
 }
 }  // namespace
@@ -33,25 +30,15 @@ void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t s
 }
 
 FenceState::~FenceState() {
-    if (ownership != Ownership::owned) return;
-    if (in_flight) {
-        destroy_submitted_fence(*device.state(), fence, serial());
+    if (in_flight && ownership == Ownership::owned) {
+        destroy_submitted_fence(*device.state(), handle, serial());
     } else {
-        defer_destroy<&DeviceFunctions::vkDestroyFence>(*device.state(), fence, serial());
+        destroy_owned<&DeviceFunctions::vkDestroyFence>();
     }
 }
-SemaphoreState::~SemaphoreState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroySemaphore>(*device.state(), semaphore, serial());
-}
-EventState::~EventState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyEvent>(*device.state(), event, serial());
-}
-QueryPoolState::~QueryPoolState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyQueryPool>(*device.state(), pool, serial());
-}
+SemaphoreState::~SemaphoreState() { destroy_owned<&DeviceFunctions::vkDestroySemaphore>(); }
+EventState::~EventState() { destroy_owned<&DeviceFunctions::vkDestroyEvent>(); }
+QueryPoolState::~QueryPoolState() { destroy_owned<&DeviceFunctions::vkDestroyQueryPool>(); }
 }  // namespace detail
 
 Fence Fence::create(const Device& device, bool signaled) {
@@ -60,7 +47,7 @@ Fence Fence::create(const Device& device, bool signaled) {
     if (signaled) ci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
     detail::Ref<detail::FenceState> s(new detail::FenceState);
     s->device = device;
-    check(device.fn().vkCreateFence(device.vk(), &ci, nullptr, &s->fence), "vkCreateFence");
+    check(device.fn().vkCreateFence(device.vk(), &ci, nullptr, &s->handle), "vkCreateFence");
     return Fence(std::move(s));
 }
 
@@ -69,27 +56,26 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
     if (fence == VK_NULL_HANDLE) throw UsageError("vkrc::Fence::adopt: the VkFence is VK_NULL_HANDLE");
     detail::Ref<detail::FenceState> s(new detail::FenceState);
     s->device = device;
-    s->fence = fence;
+    s->handle = fence;
     s->ownership = ownership;
     return Fence(std::move(s));
 }
 
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
-    return finish_fence_query(*state_, d.fn().vkWaitForFences(d.vk(), 1, &state_->fence, VK_TRUE, timeout_ns),
+    return finish_fence_query(*state_, d.fn().vkWaitForFences(d.vk(), 1, &state_->handle, VK_TRUE, timeout_ns),
                               "vkWaitForFences");
 }
 
 VkResult Fence::status() const {
     const auto& d = state_->device;
-    return finish_fence_query(*state_, d.fn().vkGetFenceStatus(d.vk(), state_->fence), "vkGetFenceStatus");
+    return finish_fence_query(*state_, d.fn().vkGetFenceStatus(d.vk(), state_->handle), "vkGetFenceStatus");
 }
 
 void Fence::unsignal() const {
     const auto& d = state_->device;
-    check(d.fn().vkResetFences(d.vk(), 1, &state_->fence), "vkResetFences");
-    state_->queue = nullptr;
-    state_->in_flight = false;
+    check(d.fn().vkResetFences(d.vk(), 1, &state_->handle), "vkResetFences");
+    state_->note_unsignalled();
 }
 
 namespace {
@@ -102,7 +88,7 @@ void make_semaphore(const Device& device, SemaphoreType type, std::uint64_t init
     if (type == SemaphoreType::timeline) ci.pNext = &type_info;
     s->device = device;
     s->type = type;
-    check(device.fn().vkCreateSemaphore(device.vk(), &ci, nullptr, &s->semaphore), "vkCreateSemaphore");
+    check(device.fn().vkCreateSemaphore(device.vk(), &ci, nullptr, &s->handle), "vkCreateSemaphore");
 }
 }  // namespace
 
@@ -125,7 +111,7 @@ Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, Semaphor
     if (semaphore == VK_NULL_HANDLE) throw UsageError("vkrc::Semaphore::adopt: the VkSemaphore is VK_NULL_HANDLE");
     detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
     s->device = device;
-    s->semaphore = semaphore;
+    s->handle = semaphore;
     s->type = type;
     s->ownership = ownership;
     return Semaphore(std::move(s));
@@ -142,8 +128,7 @@ std::uint64_t Semaphore::value() const {
     require_timeline(*this, "vkrc::Semaphore::value");
     const auto& d = state_->device;
     std::uint64_t v = 0;
-    d.state()->finish_call(d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->semaphore, &v),
-                           "vkGetSemaphoreCounterValue");
+    d.state()->finish_call(d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->handle, &v), "vkGetSemaphoreCounterValue");
     return v;
 }
 
@@ -151,7 +136,7 @@ void Semaphore::signal(std::uint64_t value) const {
     require_timeline(*this, "vkrc::Semaphore::signal");
     const auto& d = state_->device;
     VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
-    info.semaphore = state_->semaphore;
+    info.semaphore = state_->handle;
     info.value = value;
     check(d.fn().vkSignalSemaphore(d.vk(), &info), "vkSignalSemaphore");
 }
@@ -161,7 +146,7 @@ VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
     const auto& d = state_->device;
     VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
     info.semaphoreCount = 1;
-    info.pSemaphores = &state_->semaphore;
+    info.pSemaphores = &state_->handle;
     info.pValues = &value;
     return d.state()->finish_call(d.fn().vkWaitSemaphores(d.vk(), &info, timeout_ns), "vkWaitSemaphores");
 }
@@ -172,7 +157,7 @@ Event Event::create(const Device& device, bool device_only) {
     if (device_only) ci.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
     detail::Ref<detail::EventState> s(new detail::EventState);
     s->device = device;
-    check(device.fn().vkCreateEvent(device.vk(), &ci, nullptr, &s->event), "vkCreateEvent");
+    check(device.fn().vkCreateEvent(device.vk(), &ci, nullptr, &s->handle), "vkCreateEvent");
     return Event(std::move(s));
 }
 
@@ -181,22 +166,22 @@ Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {
     if (event == VK_NULL_HANDLE) throw UsageError("vkrc::Event::adopt: the VkEvent is VK_NULL_HANDLE");
     detail::Ref<detail::EventState> s(new detail::EventState);
     s->device = device;
-    s->event = event;
+    s->handle = event;
     s->ownership = ownership;
     return Event(std::move(s));
 }
 
 void Event::set() const {
     const auto& d = state_->device;
-    check(d.fn().vkSetEvent(d.vk(), state_->event), "vkSetEvent");
+    check(d.fn().vkSetEvent(d.vk(), state_->handle), "vkSetEvent");
 }
 void Event::unset() const {
     const auto& d = state_->device;
-    check(d.fn().vkResetEvent(d.vk(), state_->event), "vkResetEvent");
+    check(d.fn().vkResetEvent(d.vk(), state_->handle), "vkResetEvent");
 }
 VkResult Event::status() const {
     const auto& d = state_->device;
-    return check(d.fn().vkGetEventStatus(d.vk(), state_->event), "vkGetEventStatus");
+    return check(d.fn().vkGetEventStatus(d.vk(), state_->handle), "vkGetEventStatus");
 }
 
 namespace {
@@ -222,7 +207,7 @@ QueryPool QueryPool::adopt(const Device& device, VkQueryPool pool, const QueryPo
                            Ownership ownership) {
     auto s = query_pool_state(device, info, "vkrc::QueryPool::adopt");
     if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::QueryPool::adopt: the VkQueryPool is VK_NULL_HANDLE");
-    s->pool = pool;
+    s->handle = pool;
     s->ownership = ownership;
     return QueryPool(std::move(s));
 }
@@ -234,7 +219,7 @@ QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& inf
     ci.queryType = info.query_type;
     ci.queryCount = info.query_count;
     ci.pipelineStatistics = info.pipeline_statistics;
-    check(device.fn().vkCreateQueryPool(device.vk(), &ci, nullptr, &s->pool), "vkCreateQueryPool");
+    check(device.fn().vkCreateQueryPool(device.vk(), &ci, nullptr, &s->handle), "vkCreateQueryPool");
     return QueryPool(std::move(s));
 }
 
@@ -247,7 +232,7 @@ VkResult QueryPool::results(std::uint32_t first_query, Span<std::uint64_t> out, 
                          std::to_string(count) + " exceed the pool's " + std::to_string(state_->count));
     }
     const auto& d = state_->device;
-    VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->pool, first_query, static_cast<std::uint32_t>(count),
+    VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->handle, first_query, static_cast<std::uint32_t>(count),
                                               out.size_bytes(), out.data(), stride_words * sizeof(std::uint64_t),
                                               flags | VK_QUERY_RESULT_64_BIT);
     return d.state()->finish_call(r, "vkGetQueryPoolResults");

@@ -9,8 +9,7 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
-    if (device && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroySamplerYcbcrConversion>(*device.state(), conversion, serial());
+    destroy_owned<&DeviceFunctions::vkDestroySamplerYcbcrConversion>();
 }
 
 }  // namespace detail
@@ -20,9 +19,8 @@ SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSam
     constexpr const char* who = "vkrc::SamplerYcbcrConversion::adopt";
     // Before the state exists: once it holds an owned conversion, a throw would destroy it.
     if (format == VK_FORMAT_UNDEFINED) throw UsageError(std::string(who) + ": format is VK_FORMAT_UNDEFINED");
-    auto state = detail::adopted_state<&detail::SamplerYcbcrConversionState::device,
-                                       &detail::SamplerYcbcrConversionState::conversion>(
-        who, device, "Device", conversion, "VkSamplerYcbcrConversion", ownership);
+    auto state = detail::adopted_state<detail::SamplerYcbcrConversionState>(who, device, "Device", conversion,
+                                                                            "VkSamplerYcbcrConversion", ownership);
     state->format = format;
     return SamplerYcbcrConversion(std::move(state));
 }
@@ -43,7 +41,7 @@ SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
     ci.chromaFilter = info.chroma_filter;
     ci.forceExplicitReconstruction = info.force_explicit_reconstruction ? VK_TRUE : VK_FALSE;
     detail::Ref<detail::SamplerYcbcrConversionState> state(new detail::SamplerYcbcrConversionState);
-    check(device.fn().vkCreateSamplerYcbcrConversion(device.vk(), &ci, nullptr, &state->conversion),
+    check(device.fn().vkCreateSamplerYcbcrConversion(device.vk(), &ci, nullptr, &state->handle),
           "vkCreateSamplerYcbcrConversion");
     state->device = device;
     state->format = info.format;

@@ -37,9 +37,8 @@ class CommandBuffer;
 // allocate, reset, begin and end (never per recorded command), so that the
 // frees vkrc does on its own when a command buffer is dropped (on any thread)
 // never race with them.
-class CommandPool : public Handle<detail::CommandPoolState> {
+class CommandPool : public DeviceChild<detail::CommandPoolState, VkCommandPool> {
 public:
-    CommandPool() noexcept = default;
     static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
     // Wraps a pool made elsewhere from device for queue_family_index. With
     // Ownership::owned vkrc destroys it once the GPU is done. Borrowed, its
@@ -48,8 +47,6 @@ public:
     static CommandPool adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
                              Ownership ownership);
 
-    VkCommandPool vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t queue_family_index() const VKRC_UNCHECKED_NOEXCEPT;
 
     CommandBuffer allocate(VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY) const;
@@ -60,7 +57,7 @@ public:
     std::size_t pending_free_count() const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // What a secondary command buffer inherits (VkCommandBufferInheritanceInfo,
@@ -923,8 +920,9 @@ namespace detail {
 // (OpenCommandBuffers), whose held drops then wait for that submission.
 void close_submitted(Span<const CommandBuffer> command_buffers) noexcept;
 
-class CommandPoolState final : public RefCounted {
+class CommandPoolState final : public DeviceChildState<VkCommandPool> {
 public:
+    static constexpr const char* type_name = "vkrc::CommandPool";
     ~CommandPoolState() override;
     // Under mutex: frees the dropped command buffers the GPU is done with.
     // Inline: a frame loop's begin and reset find nothing pending.
@@ -933,10 +931,7 @@ public:
     }
     void free_ready();
 
-    Device device;
-    VkCommandPool pool = VK_NULL_HANDLE;
     std::uint32_t queue_family_index = 0;
-    Ownership ownership = Ownership::owned;
     mutable Mutex mutex;
     PoolFreeList<VkCommandBuffer> pending;  // under mutex
     List<VkCommandBuffer> scratch;          // under mutex
@@ -956,10 +951,6 @@ public:
 
 }  // namespace detail
 
-inline VkCommandPool CommandPool::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::CommandPool::vk").pool; }
-inline const Device& CommandPool::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::CommandPool::device").device;
-}
 inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::CommandPool::queue_family_index").queue_family_index;
 }

@@ -46,9 +46,8 @@ struct DescriptorSetLayoutCreateInfo {
     const void* next = nullptr;
 };
 
-class DescriptorSetLayout : public Handle<detail::DescriptorSetLayoutState> {
+class DescriptorSetLayout : public DeviceChild<detail::DescriptorSetLayoutState, VkDescriptorSetLayout> {
 public:
-    DescriptorSetLayout() noexcept = default;
     static DescriptorSetLayout create(const Device& device, const DescriptorSetLayoutCreateInfo& info);
     // A layout made by other code; info describes it as its creation did (the
     // bindings are copied to check writes; next is ignored). Owned: vkrc
@@ -56,11 +55,9 @@ public:
     // every vkrc handle to it has gone.
     static DescriptorSetLayout adopt(const Device& device, VkDescriptorSetLayout layout,
                                      const DescriptorSetLayoutCreateInfo& info, Ownership ownership);
-    VkDescriptorSetLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkDescriptorPoolCreateInfo. With VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT
@@ -83,17 +80,14 @@ class DescriptorUpdateTemplate;
 
 // Externally synchronised like VkDescriptorPool: allocate() and reset_sets() take
 // the pool's lock under the multi-thread policy.
-class DescriptorPool : public Handle<detail::DescriptorPoolState> {
+class DescriptorPool : public DeviceChild<detail::DescriptorPoolState, VkDescriptorPool> {
 public:
-    DescriptorPool() noexcept = default;
     static DescriptorPool create(const Device& device, const DescriptorPoolCreateInfo& info);
     // A pool made by other code with these creation flags (FREE_DESCRIPTOR_SET
     // decides whether dropped sets are freed). Ownership as for DescriptorSetLayout::adopt.
     static DescriptorPool adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
                                 Ownership ownership);
 
-    VkDescriptorPool vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // variable_descriptor_count: for a layout whose last binding has
     // VARIABLE_DESCRIPTOR_COUNT, how many descriptors the set's binding gets
     // (at most its descriptor_count; VkDescriptorSetVariableDescriptorCountAllocateInfo).
@@ -106,7 +100,7 @@ public:
     std::size_t pending_free_count() const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // A descriptor set; keeps its pool alive.
@@ -158,12 +152,10 @@ private:
 
 namespace detail {
 
-class DescriptorSetLayoutState final : public RefCounted {
+class DescriptorSetLayoutState final : public DeviceChildState<VkDescriptorSetLayout> {
 public:
+    static constexpr const char* type_name = "vkrc::DescriptorSetLayout";
     ~DescriptorSetLayoutState() override;
-    Device device;
-    VkDescriptorSetLayout layout = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     // For checking writes against the layout.
     List<DescriptorSetLayoutBinding> bindings;
     // The binding with VARIABLE_DESCRIPTOR_COUNT, if any.
@@ -171,12 +163,10 @@ public:
     std::uint32_t variable_binding = 0;
 };
 
-class DescriptorPoolState final : public RefCounted {
+class DescriptorPoolState final : public DeviceChildState<VkDescriptorPool> {
 public:
+    static constexpr const char* type_name = "vkrc::DescriptorPool";
     ~DescriptorPoolState() override;
-    Device device;
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     bool can_free_sets = false;
     mutable Mutex mutex;
     // Under mutex: sets dropped while in use, and how many resets happened
@@ -198,18 +188,6 @@ public:
 
 }  // namespace detail
 
-inline VkDescriptorSetLayout DescriptorSetLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorSetLayout::vk").layout;
-}
-inline const Device& DescriptorSetLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorSetLayout::device").device;
-}
-inline VkDescriptorPool DescriptorPool::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorPool::vk").pool;
-}
-inline const Device& DescriptorPool::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorPool::device").device;
-}
 inline VkDescriptorSet DescriptorSet::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::DescriptorSet::vk").set; }
 inline const DescriptorPool& DescriptorSet::pool() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::DescriptorSet::pool").pool;

@@ -36,9 +36,8 @@ struct DescriptorUpdateTemplateCreateInfo {
 };
 
 // A VkDescriptorUpdateTemplate; keeps its layouts (and so its Device) alive.
-class DescriptorUpdateTemplate : public Handle<detail::DescriptorUpdateTemplateState> {
+class DescriptorUpdateTemplate : public DeviceChild<detail::DescriptorUpdateTemplateState, VkDescriptorUpdateTemplate> {
 public:
-    DescriptorUpdateTemplate() noexcept = default;
     // Throws UsageError for no entries, a missing layout, a push template
     // without a pipeline layout or without VK_KHR_push_descriptor, or
     // layouts of another device.
@@ -51,8 +50,6 @@ public:
     static DescriptorUpdateTemplate adopt(const Device& device, VkDescriptorUpdateTemplate update_template,
                                           const DescriptorUpdateTemplateCreateInfo& info, Ownership ownership);
 
-    VkDescriptorUpdateTemplate vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     VkDescriptorUpdateTemplateType template_type() const VKRC_UNCHECKED_NOEXCEPT;
     const DescriptorSetLayout& descriptor_set_layout() const VKRC_UNCHECKED_NOEXCEPT;
     // For push templates: the pipeline layout and set they push to (empty / 0 otherwise).
@@ -60,17 +57,15 @@ public:
     std::uint32_t set() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 namespace detail {
 
-class DescriptorUpdateTemplateState final : public RefCounted {
+class DescriptorUpdateTemplateState final : public DeviceChildState<VkDescriptorUpdateTemplate> {
 public:
+    static constexpr const char* type_name = "vkrc::DescriptorUpdateTemplate";
     ~DescriptorUpdateTemplateState() override;
-    Device device;
-    VkDescriptorUpdateTemplate update_template = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     VkDescriptorUpdateTemplateType type = VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET;
     DescriptorSetLayout set_layout;
     PipelineLayout pipeline_layout;
@@ -79,12 +74,6 @@ public:
 
 }  // namespace detail
 
-inline VkDescriptorUpdateTemplate DescriptorUpdateTemplate::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorUpdateTemplate::vk").update_template;
-}
-inline const Device& DescriptorUpdateTemplate::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DescriptorUpdateTemplate::device").device;
-}
 inline VkDescriptorUpdateTemplateType DescriptorUpdateTemplate::template_type() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::DescriptorUpdateTemplate::template_type").type;
 }

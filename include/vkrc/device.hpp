@@ -494,7 +494,39 @@ void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) n
                              serial);
 }
 
+// The state of most objects made from a Device: the device (kept alive), the
+// raw handle and whether vkrc destroys it. Each family's state derives from
+// it, adds its own fields, names its wrapper in type_name (for an empty
+// handle's UsageError), and calls destroy_owned in its destructor.
+template <class VkHandle>
+class DeviceChildState : public RefCounted {
+public:
+    Device device;
+    VkHandle handle = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
+
+protected:
+    // Queues destroy (a vkDestroy* member of DeviceFunctions) of an owned
+    // handle for after the GPU; nothing for a borrowed one or a failed creation.
+    template <auto destroy>
+    void destroy_owned() noexcept {
+        if (device && ownership == Ownership::owned) defer_destroy<destroy>(*device.state(), handle, serial());
+    }
+};
+
 }  // namespace detail
+
+// Base of the wrappers of a DeviceChildState: the raw handle and the device.
+template <class State, class VkHandle>
+class DeviceChild : public Handle<State> {
+public:
+    VkHandle vk() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "vk").handle; }
+    const Device& device() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "device").device; }
+
+protected:
+    DeviceChild() noexcept = default;
+    explicit DeviceChild(detail::Ref<State> state) noexcept : Handle<State>(moves::move(state)) {}
+};
 
 inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::vk").device; }
 inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::fn").fn; }

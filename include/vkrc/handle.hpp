@@ -241,6 +241,8 @@ private:
 namespace detail {
 // Throws UsageError: call (e.g. "vkrc::Buffer::vk") was made through an empty handle.
 [[noreturn]] void throw_empty_handle(const char* call);
+// The same for the call type::member.
+[[noreturn]] void throw_empty_handle(const char* type, const char* member);
 }  // namespace detail
 
 // Accessors and recording methods through an empty handle: with
@@ -281,6 +283,14 @@ protected:
     // names the call in the UsageError an empty handle gets.
     State& live([[maybe_unused]] const char* who) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE(who);
+        return *state_;
+    }
+    // The same, naming the call type::member (the accessors of a shared base).
+    State& live([[maybe_unused]] const char* type, [[maybe_unused]] const char* member) const VKRC_UNCHECKED_NOEXCEPT {
+#if VKRC_RUNTIME_CHECKS
+        if (!state_) [[unlikely]]
+            detail::throw_empty_handle(type, member);
+#endif
         return *state_;
     }
     detail::Ref<State> state_;

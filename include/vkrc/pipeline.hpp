@@ -28,19 +28,16 @@ struct PipelineLayoutCreateInfo {
     const void* next = nullptr;
 };
 
-class PipelineLayout : public Handle<detail::PipelineLayoutState> {
+class PipelineLayout : public DeviceChild<detail::PipelineLayoutState, VkPipelineLayout> {
 public:
-    PipelineLayout() noexcept = default;
     static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
     static PipelineLayout create(const Device& device);  // no sets, no push constants
     // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
     static PipelineLayout adopt(const Device& device, VkPipelineLayout layout, Ownership ownership);
-    VkPipelineLayout vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkSubpassDescription (graphics subpasses).
@@ -68,20 +65,17 @@ struct RenderPassCreateInfo {
     const void* next = nullptr;
 };
 
-class RenderPass : public Handle<detail::RenderPassState> {
+class RenderPass : public DeviceChild<detail::RenderPassState, VkRenderPass> {
 public:
-    RenderPass() noexcept = default;
     static RenderPass create(const Device& device, const RenderPassCreateInfo& info);
     // Wraps one made elsewhere from device; color_attachment_counts: each
     // subpass's (copied). Ownership as for PipelineLayout::adopt.
     static RenderPass adopt(const Device& device, VkRenderPass render_pass,
                             Span<const std::uint32_t> color_attachment_counts, Ownership ownership);
-    VkRenderPass vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t color_attachment_count(std::uint32_t subpass) const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkFramebufferCreateInfo.
@@ -120,9 +114,8 @@ private:
 };
 
 // A driver's compiled-pipeline cache, persisted between runs.
-class PipelineCache : public Handle<detail::PipelineCacheState> {
+class PipelineCache : public DeviceChild<detail::PipelineCacheState, VkPipelineCache> {
 public:
-    PipelineCache() noexcept = default;
     // An empty cache, or one primed with data from save().
     static PipelineCache create(const Device& device, Span<const std::byte> initial_data = {});
     // Primes the cache from a file written by save(). A missing, truncated,
@@ -133,7 +126,6 @@ public:
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
     static PipelineCache adopt(const Device& device, VkPipelineCache cache, Ownership ownership);
 
-    VkPipelineCache vk() const VKRC_UNCHECKED_NOEXCEPT;
     bool loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT;
     // vkGetPipelineCacheData.
     List<std::byte> data() const;
@@ -141,7 +133,7 @@ public:
     void save(const char* file) const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Specialization constants of one shader stage (VkSpecializationInfo). The
@@ -381,20 +373,16 @@ private:
 
 namespace detail {
 
-class PipelineLayoutState final : public RefCounted {
+class PipelineLayoutState final : public DeviceChildState<VkPipelineLayout> {
 public:
+    static constexpr const char* type_name = "vkrc::PipelineLayout";
     ~PipelineLayoutState() override;
-    Device device;
-    VkPipelineLayout layout = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
 };
 
-class RenderPassState final : public RefCounted {
+class RenderPassState final : public DeviceChildState<VkRenderPass> {
 public:
+    static constexpr const char* type_name = "vkrc::RenderPass";
     ~RenderPassState() override;
-    Device device;
-    VkRenderPass render_pass = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     List<std::uint32_t> color_counts;  // per subpass
 };
 
@@ -408,12 +396,10 @@ public:
     VkExtent2D extent{};
 };
 
-class PipelineCacheState final : public RefCounted {
+class PipelineCacheState final : public DeviceChildState<VkPipelineCache> {
 public:
+    static constexpr const char* type_name = "vkrc::PipelineCache";
     ~PipelineCacheState() override;
-    Device device;
-    VkPipelineCache cache = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     bool loaded_from_file = false;
 };
 
@@ -428,16 +414,6 @@ public:
 
 }  // namespace detail
 
-inline VkPipelineLayout PipelineLayout::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PipelineLayout::vk").layout;
-}
-inline const Device& PipelineLayout::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PipelineLayout::device").device;
-}
-inline VkRenderPass RenderPass::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::RenderPass::vk").render_pass; }
-inline const Device& RenderPass::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::RenderPass::device").device;
-}
 inline VkFramebuffer Framebuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Framebuffer::vk").framebuffer;
 }
@@ -446,9 +422,6 @@ inline VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT {
 }
 inline const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Framebuffer::render_pass").render_pass;
-}
-inline VkPipelineCache PipelineCache::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PipelineCache::vk").cache;
 }
 inline bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::PipelineCache::loaded_from_file").loaded_from_file;

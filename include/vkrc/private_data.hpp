@@ -21,15 +21,11 @@ struct PrivateDataSlotCreateInfo {
 
 // A VkPrivateDataSlot; keeps its Device alive. Vulkan synchronises set and
 // get internally, so any thread may call them.
-class PrivateDataSlot : public Handle<detail::PrivateDataSlotState> {
+class PrivateDataSlot : public DeviceChild<detail::PrivateDataSlotState, VkPrivateDataSlot> {
 public:
-    PrivateDataSlot() noexcept = default;
     static PrivateDataSlot create(const Device& device, const PrivateDataSlotCreateInfo& info = {});
     // A slot made by other code. Ownership as for SamplerYcbcrConversion::adopt.
     static PrivateDataSlot adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership);
-
-    VkPrivateDataSlot vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkSetPrivateData / vkGetPrivateData for a raw handle of this slot's
     // device (or the VkDevice itself) of object_type, e.g.
@@ -45,28 +41,19 @@ public:
     }
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
     void set_bits(VkObjectType object_type, std::uint64_t object, std::uint64_t data) const;
     std::uint64_t get_bits(VkObjectType object_type, std::uint64_t object) const;
 };
 
 namespace detail {
 
-class PrivateDataSlotState final : public RefCounted {
+class PrivateDataSlotState final : public DeviceChildState<VkPrivateDataSlot> {
 public:
+    static constexpr const char* type_name = "vkrc::PrivateDataSlot";
     ~PrivateDataSlotState() override;
-    Device device;
-    VkPrivateDataSlot slot = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail
-
-inline VkPrivateDataSlot PrivateDataSlot::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PrivateDataSlot::vk").slot;
-}
-inline const Device& PrivateDataSlot::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PrivateDataSlot::device").device;
-}
 
 VKRC_END_NAMESPACE

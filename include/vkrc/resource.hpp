@@ -40,9 +40,8 @@ struct BufferCreateInfo {
 };
 
 // A buffer bound to its own Allocation; keeps its Device and memory alive.
-class Buffer : public Handle<detail::BufferState> {
+class Buffer : public DeviceChild<detail::BufferState, VkBuffer> {
 public:
-    Buffer() noexcept = default;
     static Buffer create(const Device& device, const BufferCreateInfo& info);
     // Wraps a buffer made elsewhere, its memory bound by its maker: the
     // result has no Allocation. With Ownership::owned vkrc destroys it.
@@ -51,10 +50,8 @@ public:
     static Buffer adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
                         Ownership ownership, Function<void()> cleanup = {});
 
-    VkBuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkDeviceSize size() const VKRC_UNCHECKED_NOEXCEPT;
     VkBufferUsageFlags usage() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // The buffer's address for shaders (vkGetBufferDeviceAddress, read once
     // at creation); 0, never a valid address, without SHADER_DEVICE_ADDRESS usage.
     VkDeviceAddress device_address() const VKRC_UNCHECKED_NOEXCEPT;
@@ -64,7 +61,7 @@ public:
     const Allocation& allocation() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkImageCreateInfo, plus where its memory comes from.
@@ -102,9 +99,8 @@ struct ImageCreateInfo {
 };
 
 // An image bound to its own Allocation; keeps its Device and memory alive.
-class Image : public Handle<detail::ImageState> {
+class Image : public DeviceChild<detail::ImageState, VkImage> {
 public:
-    Image() noexcept = default;
     static Image create(const Device& device, const ImageCreateInfo& info);
     // Wraps an image made elsewhere (a swapchain's, with Ownership::borrowed);
     // info describes it (its memory and allocator fields are ignored). The
@@ -113,7 +109,6 @@ public:
     static Image adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership,
                        Function<void()> cleanup = {});
 
-    VkImage vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkImageType image_type() const VKRC_UNCHECKED_NOEXCEPT;
     VkFormat format() const VKRC_UNCHECKED_NOEXCEPT;
     VkExtent3D extent() const VKRC_UNCHECKED_NOEXCEPT;
@@ -123,11 +118,10 @@ public:
     std::uint32_t array_layers() const VKRC_UNCHECKED_NOEXCEPT;
     VkSampleCountFlagBits samples() const VKRC_UNCHECKED_NOEXCEPT;
     VkImageUsageFlags usage() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     const Allocation& allocation() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkImageViewCreateInfo (the image is the parent).
@@ -224,19 +218,15 @@ struct SamplerCreateInfo {
     const void* next = nullptr;
 };
 
-class Sampler : public Handle<detail::SamplerState> {
+class Sampler : public DeviceChild<detail::SamplerState, VkSampler> {
 public:
-    Sampler() noexcept = default;
     static Sampler create(const Device& device, const SamplerCreateInfo& info = {});
     // Wraps one made elsewhere from the same device. With Ownership::owned vkrc
     // destroys it once the GPU is done; borrowed, its maker does (after vkrc's last use).
     static Sampler adopt(const Device& device, VkSampler sampler, Ownership ownership);
 
-    VkSampler vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
-
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // The aspects of a format: depth and/or stencil, or colour.
@@ -247,24 +237,21 @@ namespace detail {
 // Queues cleanup to run once the GPU is done with what was dropped before it.
 void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t serial) noexcept;
 
-class BufferState final : public RefCounted {
+class BufferState final : public DeviceChildState<VkBuffer> {
 public:
+    static constexpr const char* type_name = "vkrc::Buffer";
     ~BufferState() override;
-    Device device;
-    VkBuffer buffer = VK_NULL_HANDLE;
     VkDeviceSize size = 0;
     VkBufferUsageFlags usage = 0;
     VkDeviceAddress device_address = 0;
-    Ownership ownership = Ownership::owned;
     Allocation allocation;       // released after the buffer's destruction is queued
     Function<void()> cleanup{};  // an adopted buffer's, queued after its destruction
 };
 
-class ImageState final : public RefCounted {
+class ImageState final : public DeviceChildState<VkImage> {
 public:
+    static constexpr const char* type_name = "vkrc::Image";
     ~ImageState() override;
-    Device device;
-    VkImage image = VK_NULL_HANDLE;
     VkImageType image_type = VK_IMAGE_TYPE_2D;
     VkFormat format = VK_FORMAT_UNDEFINED;
     VkExtent3D extent{};
@@ -273,7 +260,6 @@ public:
     VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
     VkImageUsageFlags usage = 0;
     VkImageCreateFlags flags = 0;
-    Ownership ownership = Ownership::owned;
     Allocation allocation;
     Function<void()> cleanup{};  // an adopted image's, queued after its destruction
     // What a borrowed image belongs to and keeps alive (a swapchain's images
@@ -300,21 +286,17 @@ public:
     Ownership ownership = Ownership::owned;
 };
 
-class SamplerState final : public RefCounted {
+class SamplerState final : public DeviceChildState<VkSampler> {
 public:
+    static constexpr const char* type_name = "vkrc::Sampler";
     ~SamplerState() override;
-    Device device;
-    VkSampler sampler = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     SamplerYcbcrConversion ycbcr_conversion;  // if made with one
 };
 
 }  // namespace detail
 
-inline VkBuffer Buffer::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::vk").buffer; }
 inline VkDeviceSize Buffer::size() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::size").size; }
 inline VkBufferUsageFlags Buffer::usage() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::usage").usage; }
-inline const Device& Buffer::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Buffer::device").device; }
 inline VkDeviceAddress Buffer::device_address() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Buffer::device_address").device_address;
 }
@@ -322,7 +304,6 @@ inline const Allocation& Buffer::allocation() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Buffer::allocation").allocation;
 }
 
-inline VkImage Image::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::vk").image; }
 inline VkImageType Image::image_type() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Image::image_type").image_type;
 }
@@ -344,7 +325,6 @@ inline VkSampleCountFlagBits Image::samples() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Image::samples").samples;
 }
 inline VkImageUsageFlags Image::usage() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::usage").usage; }
-inline const Device& Image::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Image::device").device; }
 inline const Allocation& Image::allocation() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Image::allocation").allocation;
 }
@@ -360,8 +340,5 @@ inline VkBufferView BufferView::vk() const VKRC_UNCHECKED_NOEXCEPT { return live
 inline const Buffer& BufferView::buffer() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::BufferView::buffer").buffer;
 }
-
-inline VkSampler Sampler::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Sampler::vk").sampler; }
-inline const Device& Sampler::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Sampler::device").device; }
 
 VKRC_END_NAMESPACE

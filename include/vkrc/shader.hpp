@@ -12,9 +12,8 @@ namespace detail {
 class ShaderModuleState;
 }
 
-class ShaderModule : public Handle<detail::ShaderModuleState> {
+class ShaderModule : public DeviceChild<detail::ShaderModuleState, VkShaderModule> {
 public:
-    ShaderModule() noexcept = default;
     // Throws UsageError for an empty module or a wrong SPIR-V magic number.
     static ShaderModule create(const Device& device, Span<const std::uint32_t> spirv);
     // Bytes of a .spv file; also rejects a size that is not a multiple of 4.
@@ -24,26 +23,16 @@ public:
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
     static ShaderModule adopt(const Device& device, VkShaderModule module, Ownership ownership);
 
-    VkShaderModule vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
-
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 namespace detail {
-class ShaderModuleState final : public RefCounted {
+class ShaderModuleState final : public DeviceChildState<VkShaderModule> {
 public:
+    static constexpr const char* type_name = "vkrc::ShaderModule";
     ~ShaderModuleState() override;
-    Device device;
-    VkShaderModule module = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
 };
 }  // namespace detail
-
-inline VkShaderModule ShaderModule::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ShaderModule::vk").module; }
-inline const Device& ShaderModule::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::ShaderModule::device").device;
-}
 
 VKRC_END_NAMESPACE

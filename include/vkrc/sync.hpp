@@ -19,15 +19,12 @@ class QueryPoolState;
 
 inline constexpr std::uint64_t wait_forever = UINT64_MAX;
 
-class Fence : public Handle<detail::FenceState> {
+class Fence : public DeviceChild<detail::FenceState, VkFence> {
 public:
-    Fence() noexcept = default;
     // signaled: created in the signalled state (VK_FENCE_CREATE_SIGNALED_BIT).
     static Fence create(const Device& device, bool signaled = false);
     static Fence adopt(const Device& device, VkFence fence, Ownership ownership);
 
-    VkFence vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
     // After VK_SUCCESS for a fence given to vkrc::submit, every object dropped
     // before that submission has been destroyed.
@@ -38,21 +35,18 @@ public:
     void unsignal() const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 enum class SemaphoreType : std::uint8_t { binary, timeline };
 
-class Semaphore : public Handle<detail::SemaphoreState> {
+class Semaphore : public DeviceChild<detail::SemaphoreState, VkSemaphore> {
 public:
-    Semaphore() noexcept = default;
     static Semaphore create_binary(const Device& device);
     static Semaphore create_timeline(const Device& device, std::uint64_t initial_value = 0);
     static Semaphore adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership);
 
-    VkSemaphore vk() const VKRC_UNCHECKED_NOEXCEPT;
     SemaphoreType type() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
 
     // Timeline semaphores only (UsageError otherwise).
     // vkGetSemaphoreCounterValue.
@@ -63,19 +57,17 @@ public:
     VkResult wait(std::uint64_t value, std::uint64_t timeout_ns = wait_forever) const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
-class Event : public Handle<detail::EventState> {
+class Event : public DeviceChild<detail::EventState, VkEvent> {
 public:
-    Event() noexcept = default;
     // device_only: VK_EVENT_CREATE_DEVICE_ONLY_BIT (no host set/reset/status).
     static Event create(const Device& device, bool device_only = false);
     // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
     static Event adopt(const Device& device, VkEvent event, Ownership ownership);
 
-    VkEvent vk() const VKRC_UNCHECKED_NOEXCEPT;
     // vkSetEvent / vkResetEvent (reset() drops the handle, as on every handle).
     void set() const;
     void unset() const;
@@ -83,7 +75,7 @@ public:
     VkResult status() const;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 // Mirrors VkQueryPoolCreateInfo.
@@ -98,16 +90,14 @@ struct QueryPoolCreateInfo {
     const void* next = nullptr;
 };
 
-class QueryPool : public Handle<detail::QueryPoolState> {
+class QueryPool : public DeviceChild<detail::QueryPoolState, VkQueryPool> {
 public:
-    QueryPool() noexcept = default;
     static QueryPool create(const Device& device, const QueryPoolCreateInfo& info);
     // Wraps a pool made elsewhere from device; info: what it was made with
     // (read during the call). Ownership as for Event::adopt.
     static QueryPool adopt(const Device& device, VkQueryPool pool, const QueryPoolCreateInfo& info,
                            Ownership ownership);
 
-    VkQueryPool vk() const VKRC_UNCHECKED_NOEXCEPT;
     std::uint32_t query_count() const VKRC_UNCHECKED_NOEXCEPT;
     // Reset queries before use with CommandBuffer::reset_query_pool.
     // vkGetQueryPoolResults as 64-bit values into out (one per query, or
@@ -122,17 +112,15 @@ public:
     std::uint32_t values_per_query() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 namespace detail {
 
-class FenceState final : public RefCounted {
+class FenceState final : public DeviceChildState<VkFence> {
 public:
+    static constexpr const char* type_name = "vkrc::Fence";
     ~FenceState() override;
-    Device device;
-    VkFence fence = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     // Set by vkrc::submit: the fenced submission's queue and number. Once the
     // fence is seen signalled, all work submitted on that queue up to it has
     // completed (a fence signal covers everything before it in submission
@@ -155,7 +143,13 @@ public:
     }
     // After a successful wait or status: records the submission as complete.
     void note_signalled() noexcept {
+        in_flight = false;
         if (queue) queue->timeline.note_completed(submit_number);
+    }
+    // Fence::unsignal reset the fence: it stands for no submission any more.
+    void note_unsignalled() noexcept {
+        queue = nullptr;
+        in_flight = false;
     }
 };
 
@@ -164,29 +158,23 @@ public:
 // (at once in practice; a lost device returns at once too), then destroys it.
 void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t serial) noexcept;
 
-class SemaphoreState final : public RefCounted {
+class SemaphoreState final : public DeviceChildState<VkSemaphore> {
 public:
+    static constexpr const char* type_name = "vkrc::Semaphore";
     ~SemaphoreState() override;
-    Device device;
-    VkSemaphore semaphore = VK_NULL_HANDLE;
     SemaphoreType type = SemaphoreType::binary;
-    Ownership ownership = Ownership::owned;
 };
 
-class EventState final : public RefCounted {
+class EventState final : public DeviceChildState<VkEvent> {
 public:
+    static constexpr const char* type_name = "vkrc::Event";
     ~EventState() override;
-    Device device;
-    VkEvent event = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
 };
 
-class QueryPoolState final : public RefCounted {
+class QueryPoolState final : public DeviceChildState<VkQueryPool> {
 public:
+    static constexpr const char* type_name = "vkrc::QueryPool";
     ~QueryPoolState() override;
-    Device device;
-    VkQueryPool pool = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     std::uint32_t count = 0;
     VkQueryType type = VK_QUERY_TYPE_TIMESTAMP;
     std::uint32_t values_per_query = 1;
@@ -194,15 +182,7 @@ public:
 
 }  // namespace detail
 
-inline VkFence Fence::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Fence::vk").fence; }
-inline const Device& Fence::device() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Fence::device").device; }
-inline VkSemaphore Semaphore::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Semaphore::vk").semaphore; }
 inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Semaphore::type").type; }
-inline const Device& Semaphore::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::Semaphore::device").device;
-}
-inline VkEvent Event::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Event::vk").event; }
-inline VkQueryPool QueryPool::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::QueryPool::vk").pool; }
 inline std::uint32_t QueryPool::query_count() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::QueryPool::query_count").count;
 }

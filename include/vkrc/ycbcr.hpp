@@ -35,42 +35,31 @@ struct SamplerYcbcrConversionCreateInfo {
 };
 
 // A VkSamplerYcbcrConversion; keeps its Device alive.
-class SamplerYcbcrConversion : public Handle<detail::SamplerYcbcrConversionState> {
+class SamplerYcbcrConversion : public DeviceChild<detail::SamplerYcbcrConversionState, VkSamplerYcbcrConversion> {
 public:
-    SamplerYcbcrConversion() noexcept = default;
     static SamplerYcbcrConversion create(const Device& device, const SamplerYcbcrConversionCreateInfo& info);
     // A conversion made by other code for format. Owned: vkrc destroys it
     // after the GPU is done; borrowed: its maker does, after every vkrc handle to it has gone.
     static SamplerYcbcrConversion adopt(const Device& device, VkSamplerYcbcrConversion conversion, VkFormat format,
                                         Ownership ownership);
 
-    VkSamplerYcbcrConversion vk() const VKRC_UNCHECKED_NOEXCEPT;
-    const Device& device() const VKRC_UNCHECKED_NOEXCEPT;
     VkFormat format() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using DeviceChild::DeviceChild;
 };
 
 namespace detail {
 
-class SamplerYcbcrConversionState final : public RefCounted {
+class SamplerYcbcrConversionState final : public DeviceChildState<VkSamplerYcbcrConversion> {
 public:
+    static constexpr const char* type_name = "vkrc::SamplerYcbcrConversion";
     ~SamplerYcbcrConversionState() override;
-    Device device;
-    VkSamplerYcbcrConversion conversion = VK_NULL_HANDLE;
     VkFormat format = VK_FORMAT_UNDEFINED;
-    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail
 
-inline VkSamplerYcbcrConversion SamplerYcbcrConversion::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::SamplerYcbcrConversion::vk").conversion;
-}
-inline const Device& SamplerYcbcrConversion::device() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::SamplerYcbcrConversion::device").device;
-}
 inline VkFormat SamplerYcbcrConversion::format() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::SamplerYcbcrConversion::format").format;
 }
