@@ -134,6 +134,55 @@ long long integer(const std::string& option, const std::string& value, long long
 
 int positive(const std::string& option, const std::string& value) { return int(integer(option, value, 1, 1000000)); }
 
+// --variants a,b,...: known names, each once.
+std::vector<std::string> parse_variants(const std::string& list) {
+    std::vector<std::string> variants;
+    std::stringstream names(list);
+    for (std::string name; std::getline(names, name, ',');) {
+        bool known = false;
+        for (const auto& entry : variant_registry()) known |= entry.name == name;
+        if (!known) usage("unknown variant '" + name + "'");
+        if (std::find(variants.begin(), variants.end(), name) == variants.end()) variants.push_back(name);
+    }
+    if (variants.empty()) usage("--variants is empty");
+    return variants;
+}
+
+// --threads N[,N...]: each count once.
+std::vector<int> parse_threads(const std::string& option, const std::string& list) {
+    std::vector<int> threads;
+    std::stringstream counts(list);
+    for (std::string count; std::getline(counts, count, ',');) {
+        const int n = int(integer(option, count, 1, 64));
+        if (std::find(threads.begin(), threads.end(), n) == threads.end()) threads.push_back(n);
+    }
+    if (threads.empty()) usage("--threads is empty");
+    return threads;
+}
+
+void parse_size(const std::string& option, const std::string& value, Config& config) {
+    auto x = value.find('x');
+    if (x == std::string::npos) usage("--size needs WxH");
+    config.width = std::uint32_t(positive(option, value.substr(0, x)));
+    config.height = std::uint32_t(positive(option, value.substr(x + 1)));
+}
+
+// What the options leave to defaults, and the reference first, then its
+// control (timing runs): every ratio has its denominator and every image its
+// comparison.
+void complete(Options& o, bool variants_given) {
+    if (!variants_given)
+        for (const auto& entry : variant_registry()) o.variants.emplace_back(entry.name);
+    std::erase(o.variants, std::string(reference_name));
+    std::erase(o.variants, std::string(control_name));
+    if (!o.instructions) o.variants.insert(o.variants.begin(), control_name);
+    o.variants.insert(o.variants.begin(), reference_name);
+    if (o.instructions && o.threads.size() > 1) usage("--instructions takes one --threads count");
+    o.config.threads = o.threads.front();
+    if (o.out_dir.empty()) o.out_dir = default_out_dir();
+    if (o.csv.empty()) o.csv = o.out_dir + "/teapot.csv";
+}
+
 Options parse(int argc, char** argv) {
     Options o;
     bool variants_given = false;
@@ -148,57 +197,25 @@ Options parse(int argc, char** argv) {
         else if (a == "--seed") o.seed = std::uint64_t(integer(a, value(), 0, (1LL << 62)));
         else if (a == "--variants") {
             variants_given = true;
-            o.variants.clear();
-            std::stringstream list(value());
-            for (std::string name; std::getline(list, name, ',');) {
-                bool known = false;
-                for (const auto& entry : variant_registry()) known |= entry.name == name;
-                if (!known) usage("unknown variant '" + name + "'");
-                if (std::find(o.variants.begin(), o.variants.end(), name) == o.variants.end())
-                    o.variants.push_back(name);
-            }
-            if (o.variants.empty()) usage("--variants is empty");
+            o.variants = parse_variants(value());
         } else if (a == "--teapots") o.config.teapots = positive(a, value());
         else if (a == "--frames-in-flight") o.config.frames_in_flight = positive(a, value());
         else if (a == "--uniform-writes") o.config.uniform_writes = positive(a, value());
         else if (a == "--tessellation") o.config.tessellation = positive(a, value());
-        else if (a == "--threads") {
-            o.threads.clear();
-            std::stringstream list(value());
-            for (std::string count; std::getline(list, count, ',');) {
-                const int n = int(integer(a, count, 1, 64));
-                if (std::find(o.threads.begin(), o.threads.end(), n) == o.threads.end()) o.threads.push_back(n);
-            }
-            if (o.threads.empty()) usage("--threads is empty");
-        } else if (a == "--sweep") o.sweep = true;
+        else if (a == "--threads") o.threads = parse_threads(a, value());
+        else if (a == "--sweep") o.sweep = true;
         else if (a == "--instructions") o.instructions = true;
         else if (a == "--csv") o.csv = value();
         else if (a == "--out-dir" || a == "--png-dir") o.out_dir = value();
-        else if (a == "--size") {
-            std::string v = value();
-            auto x = v.find('x');
-            if (x == std::string::npos) usage("--size needs WxH");
-            o.config.width = std::uint32_t(positive(a, v.substr(0, x)));
-            o.config.height = std::uint32_t(positive(a, v.substr(x + 1)));
-        } else if (a == "--validation") o.config.validation = true;
+        else if (a == "--size") parse_size(a, value(), o.config);
+        else if (a == "--validation") o.config.validation = true;
         else if (a == "--window") o.config.window = true;
         else if (a == "--worker-out") o.worker_out = value();
         else if (a == "--worker-index") o.worker_index = int(integer(a, value(), 0, 1000000));
         else if (a == "--help" || a == "-h") usage("help");
         else usage("unknown option '" + a + "'");
     }
-    if (!variants_given)
-        for (const auto& entry : variant_registry()) o.variants.emplace_back(entry.name);
-    // The reference first, then its control (timing runs): every ratio has
-    // its denominator and every image its comparison.
-    std::erase(o.variants, std::string(reference_name));
-    std::erase(o.variants, std::string(control_name));
-    if (!o.instructions) o.variants.insert(o.variants.begin(), control_name);
-    o.variants.insert(o.variants.begin(), reference_name);
-    if (o.instructions && o.threads.size() > 1) usage("--instructions takes one --threads count");
-    o.config.threads = o.threads.front();
-    if (o.out_dir.empty()) o.out_dir = default_out_dir();
-    if (o.csv.empty()) o.csv = o.out_dir + "/teapot.csv";
+    complete(o, variants_given);
     return o;
 }
 
@@ -388,110 +405,142 @@ std::vector<std::size_t> shuffled_order(std::size_t n, Rng& rng) {
     return order;
 }
 
-ConfigRun measure_configuration(const Options& options, const PlannedConfig& planned, std::map<int, Mesh>& meshes,
-                                std::mt19937_64& rng, int index, int total, std::string& device) {
-    const Config& config = planned.config;
-    auto mesh_it = meshes.find(config.tessellation);
-    if (mesh_it == meshes.end())
-        mesh_it = meshes.emplace(config.tessellation, tessellate(newell_teapot(), config.tessellation)).first;
-    // The recording threads, shared by the variants (destroyed after them).
-    std::optional<ThreadPool> recorders;
-    if (config.threads > 1) recorders.emplace(config.threads);
-    SceneData scene{&mesh_it->second, camera(config.teapots, config.width, config.height),
-                    recorders ? &*recorders : nullptr};
+// A compared frame: counted, and a mismatch when it differs.
+void note_image(VariantRun& r, std::pair<std::size_t, int> comparison) {
+    const auto [differing, channel] = comparison;
+    ++r.image_blocks;
+    if (differing) ++r.image_mismatch_blocks;
+    r.worst_pixels = std::max(r.worst_pixels, differing);
+    r.worst_channel = std::max(r.worst_channel, channel);
+}
 
+// The mesh of a tessellation level, made once per process.
+const Mesh& mesh_for(std::map<int, Mesh>& meshes, int tessellation) {
+    auto it = meshes.find(tessellation);
+    if (it == meshes.end()) it = meshes.emplace(tessellation, tessellate(newell_teapot(), tessellation)).first;
+    return it->second;
+}
+
+// One configuration while it is measured: its variants, alive together
+// (their blocks interleave), in the order of result.variants.
+struct Measurement {
+    const Config& config;
+    std::mt19937_64& rng;
+    std::vector<std::unique_ptr<Variant>> variants;
     ConfigRun result;
-    result.config = config;
-    result.frames = planned.frames;
-    const std::vector<std::string> names = variants_for(options, config);
-    const std::size_t n = names.size();
-    std::vector<std::unique_ptr<Variant>> variants(n);
-    for (const std::string& name : names) result.variants.push_back({.name = name});
+};
 
-    // preinit: an untimed round first (the process's first instance pays for
-    // loading the driver), then preinit_rounds timed ones, each in a
-    // shuffled device-creation order, tearing down all but the last round's.
+// preinit: an untimed round first (the process's first instance pays for
+// loading the driver), then preinit_rounds timed ones, each in a shuffled
+// device-creation order, tearing down all but the last round's.
+void preinit(Measurement& m, const SceneData& scene) {
+    const std::size_t n = m.result.variants.size();
+    m.variants.resize(n);
     for (int round = 0; round <= preinit_rounds; ++round)
-        for (std::size_t v : shuffled_order(n, rng)) {
-            variants[v].reset();
-            variants[v] = make_variant(names[v]);
+        for (std::size_t v : shuffled_order(n, m.rng)) {
+            m.variants[v].reset();
+            m.variants[v] = make_variant(m.result.variants[v].name);
             auto start = std::chrono::steady_clock::now();
-            variants[v]->init(config, scene);
+            m.variants[v]->init(m.config, scene);
             double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
-            if (round > 0) result.variants[v].blocks[0].push_back({us});
+            if (round > 0) m.result.variants[v].blocks[0].push_back({us});
         }
+}
 
-    // Windowed: the variant about to run goes on top (harness/window.hpp says why).
-    auto bring_to_front = [&](std::size_t v) {
-        if (!config.window) return;
-        variants[v]->window()->raise();
-        poll_window_events();
-    };
+// Windowed: the variant about to run goes on top (harness/window.hpp says why).
+void bring_to_front(const Measurement& m, std::size_t v) {
+    if (!m.config.window) return;
+    m.variants[v]->window()->raise();
+    poll_window_events();
+}
 
-    Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
-    for (std::size_t v : shuffled_order(n, rng)) {
-        bring_to_front(v);
-        variants[v]->update(0.0);
-        for (int f = 0; f < warmup_frames; ++f) timed_frame(*variants[v], double(f + 1) * frame_step);
-        variants[v]->drain();
+void warm_up(Measurement& m) {
+    for (std::size_t v : shuffled_order(m.variants.size(), m.rng)) {
+        bring_to_front(m, v);
+        m.variants[v]->update(0.0);
+        for (int f = 0; f < warmup_frames; ++f) timed_frame(*m.variants[v], double(f + 1) * frame_step);
+        m.variants[v]->drain();
     }
-    // Interleaved blocks in a shuffled order per round. Every variant
-    // renders the same times in a round, starting on an idle device, so the
-    // first frames_in_flight frames (refilling the queue) are not recorded.
-    // After the round, each variant's last timed frame (all at the same t)
-    // is read back and compared with the reference's.
-    const int blocks = (planned.frames + block_frames - 1) / block_frames;
+}
+
+// One variant's block: frames_run frames from t_round on an idle device; the
+// first frames_in_flight (refilling the queue) are not recorded.
+void time_block(Measurement& m, std::size_t v, double t_round, int frames_run) {
+    Variant& variant = *m.variants[v];
+    variant.update(t_round);
+    Block block[stage_count];
+    for (int f = 0; f < frames_run; ++f) {
+        FrameTimes times = timed_frame(variant, t_round + double(f + 1) * frame_step);
+        if (f < m.config.frames_in_flight) continue;
+        for (int s = 1; s < stage_count; ++s) block[s].push_back(times.stage_us[s]);
+    }
+    variant.drain();
+    for (int s = 1; s < stage_count; ++s) m.result.variants[v].blocks[s].push_back(std::move(block[s]));
+}
+
+// After a round: each variant's last timed frame (all at t_last) against the
+// reference's. Windowed, the reference's presented frame must also be its
+// offscreen frame at that t.
+void check_last_frames(Measurement& m, double t_last) {
+    const std::vector<std::uint8_t> reference = m.variants[0]->read_back_last_frame(t_last);
+    note_image(m.result.variants[0],
+               compare_images(m.config.window ? m.variants[0]->render_reference_frame(t_last) : reference, reference));
+    for (std::size_t v = 1; v < m.variants.size(); ++v)
+        note_image(m.result.variants[v], compare_images(m.variants[v]->read_back_last_frame(t_last), reference));
+}
+
+// Interleaved blocks in a shuffled order per round. Every variant renders
+// the same times in a round, starting on an idle device; after the round the
+// last frames are compared.
+void time_rounds(Measurement& m, int frames, Progress& progress) {
+    const int blocks = (frames + block_frames - 1) / block_frames;
     double t_round = double(warmup_frames) * frame_step;
     for (int b = 0; b < blocks; ++b) {
-        const int in_block = std::min(block_frames, planned.frames - b * block_frames);
-        const int frames_run = config.frames_in_flight + in_block;
-        for (std::size_t v : shuffled_order(n, rng)) {
-            bring_to_front(v);  // untimed, between blocks
-            Variant& variant = *variants[v];
-            variant.update(t_round);
-            Block block[stage_count];
-            for (int f = 0; f < frames_run; ++f) {
-                FrameTimes times = timed_frame(variant, t_round + double(f + 1) * frame_step);
-                if (f < config.frames_in_flight) continue;
-                for (int s = 1; s < stage_count; ++s) block[s].push_back(times.stage_us[s]);
-            }
-            variant.drain();
-            for (int s = 1; s < stage_count; ++s) result.variants[v].blocks[s].push_back(std::move(block[s]));
+        const int in_block = std::min(block_frames, frames - b * block_frames);
+        const int frames_run = m.config.frames_in_flight + in_block;
+        for (std::size_t v : shuffled_order(m.variants.size(), m.rng)) {
+            bring_to_front(m, v);  // untimed, between blocks
+            time_block(m, v, t_round, frames_run);
         }
-        const double t_last = t_round + double(frames_run - 1) * frame_step;
-        const std::vector<std::uint8_t> reference = variants[0]->read_back_last_frame(t_last);
-        if (config.window) {
-            // The presented image must also be the offscreen frame at that t.
-            auto [differing, channel] = compare_images(variants[0]->render_reference_frame(t_last), reference);
-            if (differing) ++result.variants[0].image_mismatch_blocks;
-            result.variants[0].worst_pixels = std::max(result.variants[0].worst_pixels, differing);
-            result.variants[0].worst_channel = std::max(result.variants[0].worst_channel, channel);
-        }
-        for (std::size_t v = 0; v < n; ++v) {
-            VariantRun& r = result.variants[v];
-            auto [differing, channel] =
-                compare_images(v ? variants[v]->read_back_last_frame(t_last) : reference, reference);
-            ++r.image_blocks;
-            if (differing) ++r.image_mismatch_blocks;
-            r.worst_pixels = std::max(r.worst_pixels, differing);
-            r.worst_channel = std::max(r.worst_channel, channel);
-        }
+        check_last_frames(m, t_round + double(frames_run - 1) * frame_step);
         t_round += double(frames_run + 1) * frame_step;
         progress.show(b + 1, blocks);
     }
+}
 
-    for (std::size_t v = 0; v < n; ++v) {
-        result.variants[v].presentation = variants[v]->presentation();
-        result.variants[v].image = variants[v]->render_reference_frame(reference_time);
-        auto [differing, channel] = compare_images(result.variants[v].image, result.variants[0].image);
-        ++result.variants[v].image_blocks;
-        if (differing) ++result.variants[v].image_mismatch_blocks;
-        result.variants[v].worst_pixels = std::max(result.variants[v].worst_pixels, differing);
-        result.variants[v].worst_channel = std::max(result.variants[v].worst_channel, channel);
+// Each variant's reference frame (kept for the PNGs and the sweep) against
+// the reference variant's.
+void check_reference_frames(Measurement& m) {
+    for (std::size_t v = 0; v < m.variants.size(); ++v) {
+        VariantRun& r = m.result.variants[v];
+        r.presentation = m.variants[v]->presentation();
+        r.image = m.variants[v]->render_reference_frame(reference_time);
+        note_image(r, compare_images(r.image, m.result.variants[0].image));
     }
-    if (device.empty()) device = variants[0]->device_name();
-    variants.clear();  // teardown, inside the validation check
-    return result;
+}
+
+// One configuration in this process: its variants' preinit, warm-up, timed
+// rounds (each followed by the image check) and reference frames.
+ConfigRun measure_configuration(const Options& options, const PlannedConfig& planned, std::map<int, Mesh>& meshes,
+                                std::mt19937_64& rng, int index, int total, std::string& device) {
+    const Config& config = planned.config;
+    const Mesh& mesh = mesh_for(meshes, config.tessellation);
+    // The recording threads, shared by the variants (destroyed after them).
+    std::optional<ThreadPool> recorders;
+    if (config.threads > 1) recorders.emplace(config.threads);
+    const SceneData scene{&mesh, camera(config.teapots, config.width, config.height),
+                          recorders ? &*recorders : nullptr};
+    Measurement m{config, rng, {}, {.config = config, .frames = planned.frames}};
+    for (const std::string& name : variants_for(options, config)) m.result.variants.push_back({.name = name});
+
+    preinit(m, scene);
+    Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
+    warm_up(m);
+    time_rounds(m, planned.frames, progress);
+    check_reference_frames(m);
+    if (device.empty()) device = m.variants[0]->device_name();
+    m.variants.clear();  // teardown, inside the validation check
+    return std::move(m.result);
 }
 
 void write_frames(const std::string& dir, const ConfigRun& r) {
@@ -511,13 +560,7 @@ void check_threaded_images(RunData& data) {
             return config_tag(other.config) == config_tag(one_thread(r.config));
         });
         if (base == data.configs.end()) continue;
-        for (VariantRun& v : r.variants) {
-            auto [differing, channel] = compare_images(v.image, base->variants.at(0).image);
-            ++v.image_blocks;
-            if (differing) ++v.image_mismatch_blocks;
-            v.worst_pixels = std::max(v.worst_pixels, differing);
-            v.worst_channel = std::max(v.worst_channel, channel);
-        }
+        for (VariantRun& v : r.variants) note_image(v, compare_images(v.image, base->variants.at(0).image));
     }
 }
 
@@ -753,78 +796,104 @@ void add_speedups(const std::vector<RunData>& runs, std::vector<ConfigAnalysis>&
     }
 }
 
+// A configuration's names and settings, from the first run.
+ConfigAnalysis describe(const ConfigRun& base, int runs) {
+    ConfigAnalysis a;
+    a.config = base.config;
+    a.frames = base.frames;
+    a.runs = runs;
+    a.image_error_pixels = base.image_error_pixels;
+    a.image_error_channel = base.image_error_channel;
+    for (const VariantRun& v : base.variants) {
+        a.variants.push_back(v.name);
+        a.presentations.push_back(v.presentation);
+    }
+    for (int s = 0; s < stage_count; ++s) a.samples[s].resize(base.variants.size());
+    return a;
+}
+
+// Configuration c's image counts and samples, all runs pooled.
+void pool_runs(ConfigAnalysis& a, const std::vector<RunData>& runs, std::size_t c) {
+    for (std::size_t v = 0; v < a.variants.size(); ++v) {
+        VariantImages images{a.variants[v]};
+        for (const RunData& run : runs) {
+            const VariantRun& vr = run.configs.at(c).variants.at(v);
+            if (vr.name != images.name) throw std::runtime_error("runs disagree on the variants");
+            images.blocks += vr.image_blocks;
+            images.mismatches += vr.image_mismatch_blocks;
+            images.worst_pixels = std::max(images.worst_pixels, vr.worst_pixels);
+            images.worst_channel = std::max(images.worst_channel, vr.worst_channel);
+            for (int s = 0; s < stage_count; ++s)
+                for (const Block& block : vr.blocks[s])
+                    a.samples[s][v].insert(a.samples[s][v].end(), block.begin(), block.end());
+        }
+        a.images.push_back(images);
+    }
+}
+
+// One row per stage and variant: summary, ratios to the reference (and to
+// raw, where it ran), the floor and the target.
+void add_stage_rows(ConfigAnalysis& a, const std::vector<RunData>& runs, std::size_t c) {
+    auto raw_it = std::find(a.variants.begin(), a.variants.end(), "raw");
+    std::optional<std::size_t> raw;
+    if (raw_it != a.variants.end()) raw = std::size_t(raw_it - a.variants.begin());
+    const double floor_us = quantile(a.samples[floor_stage][0], 0.5);
+    for (int s = 0; s < stage_count; ++s)
+        for (std::size_t v = 0; v < a.variants.size(); ++v) {
+            StageRow row;
+            row.variant = a.variants[v];
+            row.stage = s;
+            row.samples = a.samples[s][v].size();
+            row.summary = summarize(a.samples[s][v]);
+            auto ref_ratios = block_ratios(runs, {c, v}, {c, 0}, s);
+            for (const auto& run : ref_ratios) row.blocks += run.size();
+            row.to_ref = block_bootstrap_ratio(ref_ratios);
+            if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, {c, v}, {c, *raw}, s));
+            row.floor_us = floor_us;
+            if (s >= 1 && s <= frame_stages) row.above_floor_ns = (row.summary.median - floor_us) * 1000.0;
+            row.target = target_ratio(row.variant, s);
+            a.rows.push_back(row);
+        }
+}
+
+// Verdicts, only where the control's interval lies in 1 +- 0.01: met when
+// the variant's whole interval is within the target, not met when it is
+// wholly above it (scripts/gen_bench_docs.py judges the same way).
+void judge(ConfigAnalysis& a) {
+    for (StageRow& row : a.rows) {
+        if (!row.target) continue;
+        const StageRow* control = nullptr;
+        for (const StageRow& other : a.rows)
+            if (other.variant == control_name && other.stage == row.stage) control = &other;
+        const bool resolved = control && control->to_ref.low >= 0.99 && control->to_ref.high <= 1.01;
+        row.verdict = !resolved                        ? "not resolved"
+                      : row.to_ref.high <= *row.target ? "met"
+                      : row.to_ref.low > *row.target   ? "not met"
+                                                       : "not resolved";
+    }
+}
+
+// The tessellation's geometric error, for the configurations that differ
+// from the given one in tessellation only (the sweep's levels).
+void add_geometric_error(ConfigAnalysis& a, const Options& options, std::map<int, Mesh>& meshes) {
+    const Config& given = options.config;
+    if (a.config.teapots != given.teapots || a.config.frames_in_flight != given.frames_in_flight ||
+        a.config.uniform_writes != given.uniform_writes || a.config.threads != given.threads)
+        return;
+    a.geometric = geometric_error(newell_teapot(), mesh_for(meshes, a.config.tessellation));
+    a.error_pixels = a.geometric->max * pixels_per_unit(a.config);
+}
+
 std::vector<ConfigAnalysis> analyse(const std::vector<RunData>& runs, const Options& options) {
     std::vector<ConfigAnalysis> out;
     std::map<int, Mesh> meshes;
     const RunData& first = runs.at(0);
     for (std::size_t c = 0; c < first.configs.size(); ++c) {
-        const ConfigRun& base = first.configs[c];
-        ConfigAnalysis a;
-        a.config = base.config;
-        a.frames = base.frames;
-        a.runs = int(runs.size());
-        a.image_error_pixels = base.image_error_pixels;
-        a.image_error_channel = base.image_error_channel;
-        std::optional<std::size_t> raw;
-        for (std::size_t v = 0; v < base.variants.size(); ++v) {
-            a.variants.push_back(base.variants[v].name);
-            a.presentations.push_back(base.variants[v].presentation);
-            if (base.variants[v].name == "raw") raw = v;
-        }
-        for (int s = 0; s < stage_count; ++s) a.samples[s].resize(base.variants.size());
-        for (std::size_t v = 0; v < base.variants.size(); ++v) {
-            VariantImages images{base.variants[v].name};
-            for (const RunData& run : runs) {
-                const VariantRun& vr = run.configs.at(c).variants.at(v);
-                if (vr.name != images.name) throw std::runtime_error("runs disagree on the variants");
-                images.blocks += vr.image_blocks;
-                images.mismatches += vr.image_mismatch_blocks;
-                images.worst_pixels = std::max(images.worst_pixels, vr.worst_pixels);
-                images.worst_channel = std::max(images.worst_channel, vr.worst_channel);
-                for (int s = 0; s < stage_count; ++s)
-                    for (const Block& block : vr.blocks[s])
-                        a.samples[s][v].insert(a.samples[s][v].end(), block.begin(), block.end());
-            }
-            a.images.push_back(images);
-        }
-        const double floor_us = quantile(a.samples[floor_stage][0], 0.5);
-        for (int s = 0; s < stage_count; ++s)
-            for (std::size_t v = 0; v < base.variants.size(); ++v) {
-                StageRow row;
-                row.variant = a.variants[v];
-                row.stage = s;
-                row.samples = a.samples[s][v].size();
-                row.summary = summarize(a.samples[s][v]);
-                auto ref_ratios = block_ratios(runs, {c, v}, {c, 0}, s);
-                for (const auto& run : ref_ratios) row.blocks += run.size();
-                row.to_ref = block_bootstrap_ratio(ref_ratios);
-                if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, {c, v}, {c, *raw}, s));
-                row.floor_us = floor_us;
-                if (s >= 1 && s <= frame_stages) row.above_floor_ns = (row.summary.median - floor_us) * 1000.0;
-                row.target = target_ratio(row.variant, s);
-                a.rows.push_back(row);
-            }
-        // Verdicts, only where the control's interval lies in 1 +- 0.01: met
-        // when the variant's whole interval is within the target, not met when
-        // it is wholly above it (scripts/gen_bench_docs.py judges the same way).
-        for (StageRow& row : a.rows) {
-            if (!row.target) continue;
-            const StageRow* control = nullptr;
-            for (const StageRow& other : a.rows)
-                if (other.variant == control_name && other.stage == row.stage) control = &other;
-            const bool resolved = control && control->to_ref.low >= 0.99 && control->to_ref.high <= 1.01;
-            row.verdict = !resolved                        ? "not resolved"
-                          : row.to_ref.high <= *row.target ? "met"
-                          : row.to_ref.low > *row.target   ? "not met"
-                                                           : "not resolved";
-        }
-        if (a.config.teapots == options.config.teapots &&
-            a.config.frames_in_flight == options.config.frames_in_flight &&
-            a.config.uniform_writes == options.config.uniform_writes && a.config.threads == options.config.threads) {
-            auto it = meshes.emplace(a.config.tessellation, tessellate(newell_teapot(), a.config.tessellation)).first;
-            a.geometric = geometric_error(newell_teapot(), it->second);
-            a.error_pixels = a.geometric->max * pixels_per_unit(a.config);
-        }
+        ConfigAnalysis a = describe(first.configs[c], int(runs.size()));
+        pool_runs(a, runs, c);
+        add_stage_rows(a, runs, c);
+        judge(a);
+        add_geometric_error(a, options, meshes);
         out.push_back(std::move(a));
     }
     add_speedups(runs, out);
@@ -927,6 +996,39 @@ void print_sweep(const std::vector<ConfigAnalysis>& results, const Options& opti
                     options.config.height);
 }
 
+// "%.4f,%.4f,%.4f" of a ratio and its interval, empty columns without one.
+std::string ratio_columns(const std::optional<Ratio>& r) {
+    if (!r) return ",,";
+    char text[96];
+    std::snprintf(text, sizeof text, "%.4f,%.4f,%.4f", r->ratio, r->low, r->high);
+    return text;
+}
+
+// The geometric and image error columns: filled for the sweep's levels.
+std::string error_columns(const ConfigAnalysis& r) {
+    if (!r.geometric) return ",,,,";
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6g,%.6g,%.6g,", r.geometric->max, r.geometric->rms, r.error_pixels);
+    return text + (r.image_error_pixels
+                       ? std::to_string(*r.image_error_pixels) + "," + std::to_string(r.image_error_channel)
+                       : ",");
+}
+
+// A stage row's columns up to the error columns.
+std::string stage_columns(const StageRow& row, const ConfigAnalysis& r) {
+    const Config& c = r.config;
+    std::string above = row.above_floor_ns ? std::to_string(int(std::lround(*row.above_floor_ns))) : "";
+    char target[32] = "";
+    if (row.target) std::snprintf(target, sizeof target, "%.2f", *row.target);
+    char line[768];
+    std::snprintf(line, sizeof line, "%s,%s,%d,%d,%d,%d,%zu,%.3f,%.3f,%.3f,%s,%.4f,%.4f,%.4f,%s,%.0f,%s,%s,%s,%d,%zu,",
+                  row.variant.c_str(), stage_names[row.stage], c.teapots, c.frames_in_flight, c.uniform_writes,
+                  c.tessellation, row.samples, row.summary.median, row.summary.p5, row.summary.p95, reference_name,
+                  row.to_ref.ratio, row.to_ref.low, row.to_ref.high, ratio_columns(row.to_raw).c_str(),
+                  row.floor_us * 1000.0, above.c_str(), target, row.verdict.c_str(), r.runs, row.blocks);
+    return line;
+}
+
 // One row per variant and stage, then an image row per variant (median_us
 // holds the number of last frames that differed). frames is the number of
 // samples behind the row, blocks the number of block ratios. threads is the
@@ -945,47 +1047,14 @@ void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& resul
     char line[768];
     for (const ConfigAnalysis& r : results) {
         const Config& c = r.config;
-        std::string extra = ",,,,";
-        if (r.geometric) {
-            std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,", r.geometric->max, r.geometric->rms, r.error_pixels);
-            extra = line;
-            extra += r.image_error_pixels
-                         ? std::to_string(*r.image_error_pixels) + "," + std::to_string(r.image_error_channel)
-                         : ",";
-        }
-        for (const StageRow& row : r.rows) {
-            std::string raw = ",,";
-            if (row.to_raw) {
-                std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f", row.to_raw->ratio, row.to_raw->low,
-                              row.to_raw->high);
-                raw = line;
-            }
-            std::string above = row.above_floor_ns ? std::to_string(int(std::lround(*row.above_floor_ns))) : "";
-            std::string target = "";
-            if (row.target) {
-                std::snprintf(line, sizeof line, "%.2f", *row.target);
-                target = line;
-            }
-            std::snprintf(
-                line, sizeof line, "%s,%s,%d,%d,%d,%d,%zu,%.3f,%.3f,%.3f,%s,%.4f,%.4f,%.4f,%s,%.0f,%s,%s,%s,%d,%zu,",
-                row.variant.c_str(), stage_names[row.stage], c.teapots, c.frames_in_flight, c.uniform_writes,
-                c.tessellation, row.samples, row.summary.median, row.summary.p5, row.summary.p95, reference_name,
-                row.to_ref.ratio, row.to_ref.low, row.to_ref.high, raw.c_str(), row.floor_us * 1000.0, above.c_str(),
-                target.c_str(), row.verdict.c_str(), r.runs, row.blocks);
-            const std::string line_start = line;
-            std::string speedup = ",,";
-            if (row.speedup) {
-                std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f", row.speedup->ratio, row.speedup->low,
-                              row.speedup->high);
-                speedup = line;
-            }
-            out << line_start << extra << "," << c.threads << "," << speedup << "\n";
-        }
+        const std::string errors = error_columns(r);
+        for (const StageRow& row : r.rows)
+            out << stage_columns(row, r) << errors << "," << c.threads << "," << ratio_columns(row.speedup) << "\n";
         for (const VariantImages& image : r.images) {
             std::snprintf(line, sizeof line, "%s,image,%d,%d,%d,%d,%d,%d,,,%s,,,,,,,,,,,%d,%d,", image.name.c_str(),
                           c.teapots, c.frames_in_flight, c.uniform_writes, c.tessellation, image.blocks,
                           image.mismatches, reference_name, r.runs, image.blocks);
-            out << line << extra << "," << c.threads << ",,,\n";
+            out << line << errors << "," << c.threads << ",,,\n";
         }
     }
 }

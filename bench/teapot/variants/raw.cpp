@@ -4,6 +4,11 @@
 // trampolines (the floor for any wrapper). One template, Direct selects the
 // dispatch at compile time so `raw` keeps plain direct calls. Windowed
 // (--window), both present with their own VkSurfaceKHR/VkSwapchainKHR code.
+//
+// Laid out as C would be: plain structs (instance and device, buffers and
+// images, pipeline, frame slots, swapchain), free functions that create and
+// destroy them, and a variant that holds them and runs the per-frame stages
+// (its acquire .. update: the baseline every other variant is compared with).
 #include "harness/thread_pool.hpp"
 #include "harness/variant.hpp"
 #include "harness/window.hpp"
@@ -14,18 +19,29 @@
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
 
-#include <array>
-#include <cstdio>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 namespace teapot {
 namespace {
 
-void check(VkResult result, const char* call) {
+// Never inlined: the stages call it, and their code (the baseline's
+// instruction counts) must not change with how much else this file holds.
+[[gnu::noinline]] void check(VkResult result, const char* call) {
     if (result != VK_SUCCESS)
         throw std::runtime_error(std::string(call) + " failed: VkResult " + std::to_string(result));
+}
+
+// The two-call enumeration: the count, then the items.
+template <typename T, typename Enumerate>
+std::vector<T> enumerate(const char* name, Enumerate&& call) {
+    std::uint32_t count = 0;
+    check(call(&count, static_cast<T*>(nullptr)), name);
+    std::vector<T> items(count);
+    check(call(&count, items.data()), name);
+    return items;
 }
 
 // clang-format off
@@ -54,13 +70,191 @@ struct DeviceFunctions {
 #undef TEAPOT_MEMBER
 };
 
-// A buffer or image with its own allocation.
-struct Allocation {
-    VkDeviceMemory memory = VK_NULL_HANDLE;
-    void* mapped = nullptr;
+// ---- Instance and device ----------------------------------------------------
+
+// The instance, the device and what the rest needs to know of them.
+struct Gpu {
+    VkInstance instance = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;  // --validation
+    VkSurfaceKHR surface = VK_NULL_HANDLE;                // windowed
+    VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+    VkPhysicalDeviceMemoryProperties memory_properties{};
+    std::string name;
+    VkDeviceSize uniform_alignment = 1;
+    std::uint32_t queue_family = 0;
+    VkDevice device = VK_NULL_HANDLE;
+    DeviceFunctions fn;  // raw-direct's hot path and every untimed helper
+    VkQueue queue = VK_NULL_HANDLE;
 };
 
+VkDebugUtilsMessengerCreateInfoEXT messenger_info() {
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = validation_severities;
+    info.messageType = validation_types;
+    info.pfnUserCallback = validation_callback;
+    return info;
+}
+
+// The instance; windowed, the window's surface; --validation, the layer and
+// a messenger (chained to the create info too, to see the creation itself).
+void create_instance(Gpu& gpu, const Config& config, const BenchWindow& window) {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "teapot";
+    app.apiVersion = VK_API_VERSION_1_3;
+    const VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info();
+    std::vector<const char*> extensions;
+    if (config.window) extensions = window_instance_extensions();
+    if (config.validation) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    info.pApplicationInfo = &app;
+    info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    info.ppEnabledExtensionNames = extensions.data();
+    if (config.validation) {
+        info.pNext = &messenger;
+        info.enabledLayerCount = 1;
+        info.ppEnabledLayerNames = &validation_layer;
+    }
+    check(vkCreateInstance(&info, nullptr, &gpu.instance), "vkCreateInstance");
+    if (config.window)
+        check(glfwCreateWindowSurface(gpu.instance, window.get(), nullptr, &gpu.surface), "glfwCreateWindowSurface");
+    if (config.validation) {
+        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(gpu.instance, "vkCreateDebugUtilsMessengerEXT"));
+        check(create(gpu.instance, &messenger, nullptr, &gpu.messenger), "vkCreateDebugUtilsMessengerEXT");
+    }
+}
+
+// candidate's first graphics queue family (windowed: one that also presents
+// to the surface).
+std::optional<std::uint32_t> graphics_family(const Gpu& gpu, VkPhysicalDevice candidate) {
+    std::uint32_t count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(candidate, &count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(count);
+    vkGetPhysicalDeviceQueueFamilyProperties(candidate, &count, families.data());
+    for (std::uint32_t i = 0; i < count; ++i) {
+        VkBool32 presents = VK_TRUE;
+        if (gpu.surface)
+            check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, gpu.surface, &presents),
+                  "vkGetPhysicalDeviceSurfaceSupportKHR");
+        if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && presents) return i;
+    }
+    return std::nullopt;
+}
+
+// The first Vulkan 1.3 device with such a queue family.
+void pick_physical_device(Gpu& gpu) {
+    const auto devices = enumerate<VkPhysicalDevice>("vkEnumeratePhysicalDevices", [&](auto* count, auto* items) {
+        return vkEnumeratePhysicalDevices(gpu.instance, count, items);
+    });
+    for (VkPhysicalDevice candidate : devices) {
+        VkPhysicalDeviceProperties properties;
+        vkGetPhysicalDeviceProperties(candidate, &properties);
+        if (properties.apiVersion < VK_API_VERSION_1_3) continue;
+        const std::optional<std::uint32_t> family = graphics_family(gpu, candidate);
+        if (!family) continue;
+        gpu.physical_device = candidate;
+        gpu.queue_family = *family;
+        gpu.name = properties.deviceName;
+        gpu.uniform_alignment = properties.limits.minUniformBufferOffsetAlignment;
+        vkGetPhysicalDeviceMemoryProperties(candidate, &gpu.memory_properties);
+        return;
+    }
+    throw std::runtime_error(gpu.surface ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
+                                         : "no Vulkan 1.3 device with a graphics queue");
+}
+
+bool supports_device_extension(VkPhysicalDevice physical_device, const char* name) {
+    const auto extensions =
+        enumerate<VkExtensionProperties>("vkEnumerateDeviceExtensionProperties", [&](auto* count, auto* items) {
+            return vkEnumerateDeviceExtensionProperties(physical_device, nullptr, count, items);
+        });
+    for (const VkExtensionProperties& e : extensions)
+        if (std::strcmp(e.extensionName, name) == 0) return true;
+    return false;
+}
+
+// The device with the features and extensions vkrc::Device enables (setup
+// parity): synchronization2, dynamicRendering, maintenance4,
+// timelineSemaphore, VK_EXT_memory_budget where supported; windowed, the
+// swapchain. Then its functions and its queue.
+void create_device(Gpu& gpu) {
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    queue_info.queueFamilyIndex = gpu.queue_family;
+    queue_info.queueCount = 1;
+    queue_info.pQueuePriorities = &priority;
+    VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+    features13.synchronization2 = VK_TRUE;
+    features13.dynamicRendering = VK_TRUE;
+    features13.maintenance4 = VK_TRUE;
+    VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    features12.pNext = &features13;
+    features12.timelineSemaphore = VK_TRUE;
+    std::vector<const char*> extensions;
+    if (gpu.surface) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    if (supports_device_extension(gpu.physical_device, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME))
+        extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    info.pNext = &features12;
+    info.queueCreateInfoCount = 1;
+    info.pQueueCreateInfos = &queue_info;
+    info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    info.ppEnabledExtensionNames = extensions.data();
+    check(vkCreateDevice(gpu.physical_device, &info, nullptr, &gpu.device), "vkCreateDevice");
+#define TEAPOT_LOAD(name) gpu.fn.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(gpu.device, #name));
+    TEAPOT_DEVICE_FUNCTIONS(TEAPOT_LOAD)
+#undef TEAPOT_LOAD
+    gpu.fn.vkGetDeviceQueue(gpu.device, gpu.queue_family, 0, &gpu.queue);
+}
+
+// Everything made from the device is destroyed before.
+void destroy_gpu(Gpu& gpu) {
+    if (gpu.device) gpu.fn.vkDestroyDevice(gpu.device, nullptr);
+    if (gpu.surface) vkDestroySurfaceKHR(gpu.instance, gpu.surface, nullptr);
+    if (gpu.messenger) {
+        auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(gpu.instance, "vkDestroyDebugUtilsMessengerEXT"));
+        destroy_messenger(gpu.instance, gpu.messenger, nullptr);
+    }
+    if (gpu.instance) vkDestroyInstance(gpu.instance, nullptr);
+    gpu = {};
+}
+
+// ---- Commands and synchronisation ------------------------------------------
 // The helpers a careful C programmer writes once.
+
+VkCommandPool create_command_pool(const Gpu& gpu) {
+    VkCommandPoolCreateInfo info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
+    info.queueFamilyIndex = gpu.queue_family;
+    VkCommandPool pool = VK_NULL_HANDLE;
+    check(gpu.fn.vkCreateCommandPool(gpu.device, &info, nullptr, &pool), "vkCreateCommandPool");
+    return pool;
+}
+
+VkCommandBuffer allocate_command_buffer(const Gpu& gpu, VkCommandPool pool, VkCommandBufferLevel level) {
+    VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    allocate.commandPool = pool;
+    allocate.level = level;
+    allocate.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    check(gpu.fn.vkAllocateCommandBuffers(gpu.device, &allocate, &cmd), "vkAllocateCommandBuffers");
+    return cmd;
+}
+
+VkFence create_fence(const Gpu& gpu) {
+    VkFenceCreateInfo info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence fence = VK_NULL_HANDLE;
+    check(gpu.fn.vkCreateFence(gpu.device, &info, nullptr, &fence), "vkCreateFence");
+    return fence;
+}
+
+VkSemaphore create_semaphore(const Gpu& gpu) {
+    VkSemaphoreCreateInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
+    VkSemaphore semaphore = VK_NULL_HANDLE;
+    check(gpu.fn.vkCreateSemaphore(gpu.device, &info, nullptr, &semaphore), "vkCreateSemaphore");
+    return semaphore;
+}
 
 // An image barrier on the first mip level and layer of one aspect.
 VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkImageLayout old_layout,
@@ -81,7 +275,22 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, Vk
     return b;
 }
 
-// Records the image barriers into cmd with vkCmdPipelineBarrier2.
+// A barrier after a copy that wrote the whole buffer.
+VkBufferMemoryBarrier2 after_copy_barrier(VkBuffer buffer, VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
+    VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    b.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.dstStageMask = dst_stage;
+    b.dstAccessMask = dst_access;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.buffer = buffer;
+    b.size = VK_WHOLE_SIZE;
+    return b;
+}
+
+// Records the barriers into cmd with vkCmdPipelineBarrier2 (the loader's or
+// the device's, as the caller dispatches).
 void pipeline_barrier(PFN_vkCmdPipelineBarrier2 barrier, VkCommandBuffer cmd,
                       std::span<const VkImageMemoryBarrier2> images,
                       std::span<const VkBufferMemoryBarrier2> buffers = {}) {
@@ -93,104 +302,654 @@ void pipeline_barrier(PFN_vkCmdPipelineBarrier2 barrier, VkCommandBuffer cmd,
     barrier(cmd, &dependency);
 }
 
-// Begins a one-time-submit recording of cmd after resetting its pool.
 // Copies the first mip level of a colour image (already in TRANSFER_SRC
 // layout) to a host-visible buffer and makes the bytes visible to the host;
 // after_copy, when given, rides in the same barrier (a layout change back).
-void copy_image_to_host(const DeviceFunctions& fn, VkCommandBuffer cmd, VkImage image, VkExtent2D extent,
-                        VkBuffer buffer, std::span<const VkImageMemoryBarrier2> after_copy = {}) {
+void copy_image_to_host(const Gpu& gpu, VkCommandBuffer cmd, VkImage image, VkExtent2D extent, VkBuffer buffer,
+                        std::span<const VkImageMemoryBarrier2> after_copy = {}) {
     VkBufferImageCopy region{};
     region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
     region.imageExtent = {extent.width, extent.height, 1};
-    fn.vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
-    VkBufferMemoryBarrier2 to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-    to_host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    to_host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    to_host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-    to_host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-    to_host.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    to_host.buffer = buffer;
-    to_host.size = VK_WHOLE_SIZE;
-    pipeline_barrier(fn.vkCmdPipelineBarrier2, cmd, after_copy, {&to_host, 1});
+    gpu.fn.vkCmdCopyImageToBuffer(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, 1, &region);
+    const VkBufferMemoryBarrier2 to_host =
+        after_copy_barrier(buffer, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    pipeline_barrier(gpu.fn.vkCmdPipelineBarrier2, cmd, after_copy, {&to_host, 1});
 }
 
-void begin_one_time(const DeviceFunctions& fn, VkDevice device, VkCommandPool pool, VkCommandBuffer cmd) {
-    check(fn.vkResetCommandPool(device, pool, 0), "vkResetCommandPool");
+// Begins a one-time-submit recording of cmd after resetting its pool.
+void begin_one_time(const Gpu& gpu, VkCommandPool pool, VkCommandBuffer cmd) {
+    check(gpu.fn.vkResetCommandPool(gpu.device, pool, 0), "vkResetCommandPool");
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(fn.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+    check(gpu.fn.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
 }
 
-// Ends cmd, submits it signalling fence, waits for the fence and resets it.
-void submit_and_wait(const DeviceFunctions& fn, VkDevice device, VkQueue queue, VkCommandBuffer cmd, VkFence fence) {
-    check(fn.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+void wait_and_reset(const Gpu& gpu, VkFence fence) {
+    check(gpu.fn.vkWaitForFences(gpu.device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    check(gpu.fn.vkResetFences(gpu.device, 1, &fence), "vkResetFences");
+}
+
+// Submits the recorded cmd signalling fence, waits for the fence and resets
+// it. A frame's submission may wait on an acquire semaphore and signal a
+// render-done one, at the submit stage's pipeline stages.
+void submit_and_wait(const Gpu& gpu, VkCommandBuffer cmd, VkFence fence, VkSemaphore wait = VK_NULL_HANDLE,
+                     VkSemaphore signal = VK_NULL_HANDLE) {
     VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
     cmd_info.commandBuffer = cmd;
+    VkSemaphoreSubmitInfo wait_info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    wait_info.semaphore = wait;
+    wait_info.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+    VkSemaphoreSubmitInfo signal_info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+    signal_info.semaphore = signal;
+    signal_info.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
     VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    if (wait) {
+        submit.waitSemaphoreInfoCount = 1;
+        submit.pWaitSemaphoreInfos = &wait_info;
+    }
     submit.commandBufferInfoCount = 1;
     submit.pCommandBufferInfos = &cmd_info;
-    check(fn.vkQueueSubmit2(queue, 1, &submit, fence), "vkQueueSubmit2");
-    check(fn.vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-    check(fn.vkResetFences(device, 1, &fence), "vkResetFences");
+    if (signal) {
+        submit.signalSemaphoreInfoCount = 1;
+        submit.pSignalSemaphoreInfos = &signal_info;
+    }
+    check(gpu.fn.vkQueueSubmit2(gpu.queue, 1, &submit, fence), "vkQueueSubmit2");
+    wait_and_reset(gpu, fence);
 }
+
+// Ends a one-off recording, then submit_and_wait.
+void end_submit_and_wait(const Gpu& gpu, VkCommandBuffer cmd, VkFence fence, VkSemaphore signal = VK_NULL_HANDLE) {
+    check(gpu.fn.vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+    submit_and_wait(gpu, cmd, fence, VK_NULL_HANDLE, signal);
+}
+
+// ---- Buffers and images -----------------------------------------------------
+
+// A buffer with its own allocation; mapped when host-visible.
+struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+};
+
+struct Image {
+    VkImage image = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+};
+
+std::uint32_t memory_type(const Gpu& gpu, std::uint32_t bits, VkMemoryPropertyFlags wanted) {
+    const VkPhysicalDeviceMemoryProperties& memory = gpu.memory_properties;
+    for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i)
+        if ((bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
+    return UINT32_MAX;
+}
+
+// Memory for requirements, of a type with the preferred properties where
+// there is one, else with the fallback's.
+VkDeviceMemory allocate_memory(const Gpu& gpu, const VkMemoryRequirements& requirements,
+                               VkMemoryPropertyFlags preferred, VkMemoryPropertyFlags fallback) {
+    std::uint32_t type = memory_type(gpu, requirements.memoryTypeBits, preferred);
+    if (type == UINT32_MAX) type = memory_type(gpu, requirements.memoryTypeBits, fallback);
+    VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    allocate.allocationSize = requirements.size;
+    allocate.memoryTypeIndex = type;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    check(gpu.fn.vkAllocateMemory(gpu.device, &allocate, nullptr, &memory), "vkAllocateMemory");
+    return memory;
+}
+
+void create_buffer(const Gpu& gpu, VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags preferred,
+                   VkMemoryPropertyFlags fallback, VkBuffer& buffer, VkDeviceMemory& memory) {
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = size;
+    info.usage = usage;
+    check(gpu.fn.vkCreateBuffer(gpu.device, &info, nullptr, &buffer), "vkCreateBuffer");
+    VkMemoryRequirements requirements;
+    gpu.fn.vkGetBufferMemoryRequirements(gpu.device, buffer, &requirements);
+    memory = allocate_memory(gpu, requirements, preferred, fallback);
+    check(gpu.fn.vkBindBufferMemory(gpu.device, buffer, memory, 0), "vkBindBufferMemory");
+}
+
+// A mapped buffer in memory the host writes directly: device-local as well
+// where the device offers that (integrated GPUs, lavapipe, resizable BAR).
+void create_host_buffer(const Gpu& gpu, VkDeviceSize size, VkBufferUsageFlags usage, Buffer& buffer) {
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    create_buffer(gpu, size, usage, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host, buffer.buffer, buffer.memory);
+    check(gpu.fn.vkMapMemory(gpu.device, buffer.memory, 0, VK_WHOLE_SIZE, 0, &buffer.mapped), "vkMapMemory");
+}
+
+void destroy_buffer(const Gpu& gpu, VkBuffer buffer, VkDeviceMemory memory) {
+    gpu.fn.vkDestroyBuffer(gpu.device, buffer, nullptr);
+    gpu.fn.vkFreeMemory(gpu.device, memory, nullptr);  // unmaps implicitly
+}
+
+// Fills a buffer through a host-visible staging buffer (what
+// vkrc::upload_buffer does), with a one-off command pool and fence. The data
+// is visible to every later command (vertex input and index reads).
+void upload(const Gpu& gpu, VkBuffer destination, const void* data, VkDeviceSize size) {
+    Buffer staging;
+    create_host_buffer(gpu, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, staging);
+    std::memcpy(staging.mapped, data, size);
+    const VkCommandPool pool = create_command_pool(gpu);
+    const VkCommandBuffer cmd = allocate_command_buffer(gpu, pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    const VkFence fence = create_fence(gpu);
+    begin_one_time(gpu, pool, cmd);
+    VkBufferCopy region{0, 0, size};
+    gpu.fn.vkCmdCopyBuffer(cmd, staging.buffer, destination, 1, &region);
+    const VkBufferMemoryBarrier2 to_read =
+        after_copy_barrier(destination, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+    pipeline_barrier(gpu.fn.vkCmdPipelineBarrier2, cmd, {}, {&to_read, 1});
+    end_submit_and_wait(gpu, cmd, fence);
+    gpu.fn.vkDestroyFence(gpu.device, fence, nullptr);
+    gpu.fn.vkDestroyCommandPool(gpu.device, pool, nullptr);
+    destroy_buffer(gpu, staging.buffer, staging.memory);
+}
+
+// A device-local buffer holding data.
+template <typename T>
+void create_filled_buffer(const Gpu& gpu, const std::vector<T>& data, VkBufferUsageFlags usage, VkBuffer& buffer,
+                          VkDeviceMemory& memory) {
+    const VkDeviceSize size = data.size() * sizeof(T);
+    create_buffer(gpu, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, buffer,
+                  memory);
+    upload(gpu, buffer, data.data(), size);
+}
+
+VkImageView create_view(const Gpu& gpu, VkImage image, VkFormat format, VkImageAspectFlags aspect) {
+    VkImageViewCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    info.image = image;
+    info.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    info.format = format;
+    info.subresourceRange = {aspect, 0, 1, 0, 1};
+    VkImageView view = VK_NULL_HANDLE;
+    check(gpu.fn.vkCreateImageView(gpu.device, &info, nullptr, &view), "vkCreateImageView");
+    return view;
+}
+
+// A 2D device-local image with one mip level and its view.
+void create_image(const Gpu& gpu, VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                  VkExtent2D extent, Image& image) {
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = format;
+    info.extent = {extent.width, extent.height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = usage;
+    check(gpu.fn.vkCreateImage(gpu.device, &info, nullptr, &image.image), "vkCreateImage");
+    VkMemoryRequirements requirements;
+    gpu.fn.vkGetImageMemoryRequirements(gpu.device, image.image, &requirements);
+    image.memory = allocate_memory(gpu, requirements, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    check(gpu.fn.vkBindImageMemory(gpu.device, image.image, image.memory, 0), "vkBindImageMemory");
+    image.view = create_view(gpu, image.image, format, aspect);
+}
+
+void destroy_image(const Gpu& gpu, Image& image) {
+    gpu.fn.vkDestroyImageView(gpu.device, image.view, nullptr);
+    gpu.fn.vkDestroyImage(gpu.device, image.image, nullptr);
+    gpu.fn.vkFreeMemory(gpu.device, image.memory, nullptr);
+    image = {};
+}
+
+// ---- Scene and render targets -----------------------------------------------
+
+// The mesh: three device-local buffers filled by a staging upload. The
+// handles lie side by side, as the command stage has always read them (both
+// vertex buffers in one load: the baseline's instruction count).
+struct MeshBuffers {
+    VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE, indices = VK_NULL_HANDLE;
+    VkDeviceMemory positions_memory = VK_NULL_HANDLE, normals_memory = VK_NULL_HANDLE, indices_memory = VK_NULL_HANDLE;
+    std::uint32_t index_count = 0;
+};
+
+void create_mesh(const Gpu& gpu, const Mesh& mesh, MeshBuffers& buffers) {
+    create_filled_buffer(gpu, mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, buffers.positions,
+                         buffers.positions_memory);
+    create_filled_buffer(gpu, mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, buffers.normals, buffers.normals_memory);
+    create_filled_buffer(gpu, mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, buffers.indices, buffers.indices_memory);
+    buffers.index_count = static_cast<std::uint32_t>(mesh.indices.size());
+}
+
+void destroy_mesh(const Gpu& gpu, MeshBuffers& buffers) {
+    destroy_buffer(gpu, buffers.positions, buffers.positions_memory);
+    destroy_buffer(gpu, buffers.normals, buffers.normals_memory);
+    destroy_buffer(gpu, buffers.indices, buffers.indices_memory);
+    buffers = {};
+}
+
+// What frames render into besides a swapchain's images: the headless ring
+// (windowed: the one offscreen image of the reference frame), a depth image
+// covering every target, and the buffer the image check reads back into.
+struct Targets {
+    VkFormat format = colour_format;  // windowed: the swapchain's, so that one pipeline serves both
+    std::vector<Image> ring;
+    Image depth;
+    VkExtent2D depth_extent{};
+    Buffer readback;
+};
+
+void create_ring(const Gpu& gpu, const Config& config, Targets& targets) {
+    targets.ring.resize(config.window ? 1 : config.frames_in_flight + 1);
+    for (Image& image : targets.ring)
+        create_image(gpu, targets.format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                     VK_IMAGE_ASPECT_COLOR_BIT, {config.width, config.height}, image);
+}
+
+// The depth image, as large as the ring's images and the swapchain's.
+void create_depth(const Gpu& gpu, const Config& config, VkExtent2D swapchain_extent, Targets& targets) {
+    targets.depth_extent = {std::max(config.width, swapchain_extent.width),
+                            std::max(config.height, swapchain_extent.height)};
+    create_image(gpu, depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+                 targets.depth_extent, targets.depth);
+}
+
+void destroy_targets(const Gpu& gpu, Targets& targets) {
+    for (Image& image : targets.ring) destroy_image(gpu, image);
+    destroy_image(gpu, targets.depth);
+    destroy_buffer(gpu, targets.readback.buffer, targets.readback.memory);
+}
+
+// The readback buffer's pixels of an extent, as RGBA.
+std::vector<std::uint8_t> read_pixels(const Targets& targets, VkExtent2D extent) {
+    const auto* pixels = static_cast<const std::uint8_t*>(targets.readback.mapped);
+    std::vector<std::uint8_t> bytes(pixels, pixels + std::size_t(extent.width) * extent.height * 4);
+    to_rgba(bytes, targets.format);
+    return bytes;
+}
+
+// ---- Pipeline ---------------------------------------------------------------
+
+// The pipeline's fixed state, constant as in C: positions and normals in two
+// bindings, triangle lists, depth test, viewport and scissor dynamic.
+const VkVertexInputBindingDescription vertex_bindings[2] = {{0, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX},
+                                                            {1, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX}};
+const VkVertexInputAttributeDescription vertex_attributes[2] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
+                                                                {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0}};
+const VkPipelineVertexInputStateCreateInfo vertex_input{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+    .vertexBindingDescriptionCount = 2,
+    .pVertexBindingDescriptions = vertex_bindings,
+    .vertexAttributeDescriptionCount = 2,
+    .pVertexAttributeDescriptions = vertex_attributes};
+const VkPipelineInputAssemblyStateCreateInfo input_assembly{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+    .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
+const VkPipelineViewportStateCreateInfo viewport_state{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO, .viewportCount = 1, .scissorCount = 1};
+const VkPipelineRasterizationStateCreateInfo rasterization{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+    .polygonMode = VK_POLYGON_MODE_FILL,
+    .cullMode = VK_CULL_MODE_NONE,  // the spout and lid openings show inner faces
+    .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+    .lineWidth = 1.0f};
+const VkPipelineMultisampleStateCreateInfo multisample{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO, .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
+const VkPipelineDepthStencilStateCreateInfo depth_test{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+    .depthTestEnable = VK_TRUE,
+    .depthWriteEnable = VK_TRUE,
+    .depthCompareOp = VK_COMPARE_OP_LESS};
+const VkPipelineColorBlendAttachmentState blend_attachment{.colorWriteMask =
+                                                               VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                                               VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT};
+const VkPipelineColorBlendStateCreateInfo colour_blend{
+    .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+    .attachmentCount = 1,
+    .pAttachments = &blend_attachment};
+const VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+const VkPipelineDynamicStateCreateInfo dynamic_state{.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+                                                     .dynamicStateCount = 2,
+                                                     .pDynamicStates = dynamic_states};
+
+struct Pipeline {
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;  // binding 0: the camera uniforms
+    VkPipelineLayout layout = VK_NULL_HANDLE;           // that set and the per-teapot push constants
+    VkPipeline pipeline = VK_NULL_HANDLE;
+};
+
+void create_layouts(const Gpu& gpu, Pipeline& pipeline) {
+    VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo set_layout{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    set_layout.bindingCount = 1;
+    set_layout.pBindings = &binding;
+    check(gpu.fn.vkCreateDescriptorSetLayout(gpu.device, &set_layout, nullptr, &pipeline.set_layout),
+          "vkCreateDescriptorSetLayout");
+    VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)};
+    VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layout.setLayoutCount = 1;
+    layout.pSetLayouts = &pipeline.set_layout;
+    layout.pushConstantRangeCount = 1;
+    layout.pPushConstantRanges = &push;
+    check(gpu.fn.vkCreatePipelineLayout(gpu.device, &layout, nullptr, &pipeline.layout), "vkCreatePipelineLayout");
+}
+
+VkShaderModule create_shader(const Gpu& gpu, std::span<const std::uint32_t> code) {
+    VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    info.codeSize = code.size_bytes();
+    info.pCode = code.data();
+    VkShaderModule module;
+    check(gpu.fn.vkCreateShaderModule(gpu.device, &info, nullptr, &module), "vkCreateShaderModule");
+    return module;
+}
+
+VkPipelineShaderStageCreateInfo shader_stage(VkShaderStageFlagBits stage, VkShaderModule module) {
+    return {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, stage, module, "main", nullptr};
+}
+
+// The layouts and the pipeline, for dynamic rendering into colour and
+// depth_format.
+void create_pipeline(const Gpu& gpu, VkFormat colour, Pipeline& pipeline) {
+    create_layouts(gpu, pipeline);
+    const VkShaderModule vert = create_shader(gpu, vkrc_shaders::teapot_vert);
+    const VkShaderModule frag = create_shader(gpu, vkrc_shaders::teapot_frag);
+    const VkPipelineShaderStageCreateInfo stages[2] = {shader_stage(VK_SHADER_STAGE_VERTEX_BIT, vert),
+                                                       shader_stage(VK_SHADER_STAGE_FRAGMENT_BIT, frag)};
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachmentFormats = &colour;
+    rendering.depthAttachmentFormat = depth_format;
+    VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    info.pNext = &rendering;
+    info.stageCount = 2;
+    info.pStages = stages;
+    info.pVertexInputState = &vertex_input;
+    info.pInputAssemblyState = &input_assembly;
+    info.pViewportState = &viewport_state;
+    info.pRasterizationState = &rasterization;
+    info.pMultisampleState = &multisample;
+    info.pDepthStencilState = &depth_test;
+    info.pColorBlendState = &colour_blend;
+    info.pDynamicState = &dynamic_state;
+    info.layout = pipeline.layout;
+    VkResult result =
+        gpu.fn.vkCreateGraphicsPipelines(gpu.device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline.pipeline);
+    gpu.fn.vkDestroyShaderModule(gpu.device, vert, nullptr);
+    gpu.fn.vkDestroyShaderModule(gpu.device, frag, nullptr);
+    check(result, "vkCreateGraphicsPipelines");
+}
+
+void destroy_pipeline(const Gpu& gpu, Pipeline& pipeline) {
+    gpu.fn.vkDestroyPipeline(gpu.device, pipeline.pipeline, nullptr);
+    gpu.fn.vkDestroyPipelineLayout(gpu.device, pipeline.layout, nullptr);
+    gpu.fn.vkDestroyDescriptorSetLayout(gpu.device, pipeline.set_layout, nullptr);
+    pipeline = {};
+}
+
+// ---- Frame slots ------------------------------------------------------------
+
+struct Frame {
+    VkCommandPool pool = VK_NULL_HANDLE;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
+    VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
+    bool submitted = false;
+    // --threads N > 1: per thread, a pool and its secondary.
+    std::vector<VkCommandPool> thread_pools;
+    std::vector<VkCommandBuffer> secondaries;
+};
+
+// The slots, the pool of their descriptor sets and the uniform buffer they
+// share, one region per slot.
+struct Frames {
+    std::vector<Frame> slots;
+    VkDescriptorPool descriptor_pool = VK_NULL_HANDLE;
+    Buffer uniforms;
+    VkDeviceSize uniform_stride = 0;  // the region's size rounded up to the device's alignment
+};
+
+void create_uniforms(const Gpu& gpu, const Config& config, Frames& frames) {
+    const VkDeviceSize alignment = gpu.uniform_alignment;
+    frames.uniform_stride = (sizeof(CameraUniforms) + alignment - 1) / alignment * alignment;
+    create_host_buffer(gpu, frames.uniform_stride * config.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                       frames.uniforms);
+}
+
+void create_descriptor_pool(const Gpu& gpu, std::uint32_t slots, Frames& frames) {
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
+    VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    info.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;  // as every variant's pool
+    info.maxSets = slots;
+    info.poolSizeCount = 1;
+    info.pPoolSizes = &size;
+    check(gpu.fn.vkCreateDescriptorPool(gpu.device, &info, nullptr, &frames.descriptor_pool), "vkCreateDescriptorPool");
+}
+
+// A slot's command pool and primary; per recording thread, a pool and a
+// secondary.
+void create_command_buffers(const Gpu& gpu, int threads, Frame& f) {
+    f.pool = create_command_pool(gpu);
+    f.cmd = allocate_command_buffer(gpu, f.pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    for (int t = 0; t < threads; ++t) {
+        f.thread_pools.push_back(create_command_pool(gpu));
+        f.secondaries.push_back(allocate_command_buffer(gpu, f.thread_pools.back(), VK_COMMAND_BUFFER_LEVEL_SECONDARY));
+    }
+}
+
+// Slot i's descriptor set, bound to its region of the uniform buffer.
+void create_descriptor_set(const Gpu& gpu, const Frames& frames, VkDescriptorSetLayout layout, std::uint32_t i,
+                           Frame& f) {
+    VkDescriptorSetAllocateInfo set{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    set.descriptorPool = frames.descriptor_pool;
+    set.descriptorSetCount = 1;
+    set.pSetLayouts = &layout;
+    check(gpu.fn.vkAllocateDescriptorSets(gpu.device, &set, &f.descriptor_set), "vkAllocateDescriptorSets");
+    VkDescriptorBufferInfo buffer{frames.uniforms.buffer, i * frames.uniform_stride, sizeof(CameraUniforms)};
+    VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    write.dstSet = f.descriptor_set;
+    write.descriptorCount = 1;
+    write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    write.pBufferInfo = &buffer;
+    gpu.fn.vkUpdateDescriptorSets(gpu.device, 1, &write, 0, nullptr);
+}
+
+// The slots, after create_uniforms: threads recording threads (0: the
+// primary is recorded directly), windowed an acquire semaphore each.
+void create_frames(const Gpu& gpu, const Config& config, int threads, VkDescriptorSetLayout layout, Frames& frames) {
+    const auto slots = static_cast<std::uint32_t>(config.frames_in_flight);
+    create_descriptor_pool(gpu, slots, frames);
+    frames.slots.resize(slots);
+    for (std::uint32_t i = 0; i < slots; ++i) {
+        Frame& f = frames.slots[i];
+        create_command_buffers(gpu, threads, f);
+        f.fence = create_fence(gpu);
+        if (config.window) f.acquire_semaphore = create_semaphore(gpu);
+        create_descriptor_set(gpu, frames, layout, i, f);
+    }
+}
+
+void destroy_frames(const Gpu& gpu, Frames& frames) {
+    for (Frame& f : frames.slots) {
+        gpu.fn.vkDestroySemaphore(gpu.device, f.acquire_semaphore, nullptr);
+        gpu.fn.vkDestroyFence(gpu.device, f.fence, nullptr);
+        gpu.fn.vkDestroyCommandPool(gpu.device, f.pool, nullptr);
+        for (VkCommandPool pool : f.thread_pools) gpu.fn.vkDestroyCommandPool(gpu.device, pool, nullptr);
+    }
+    gpu.fn.vkDestroyDescriptorPool(gpu.device, frames.descriptor_pool, nullptr);
+    destroy_buffer(gpu, frames.uniforms.buffer, frames.uniforms.memory);
+    frames = {};
+}
+
+// ---- Window swapchain -------------------------------------------------------
+
+// Windowed: the swapchain by the convention's rule and its per-image objects.
+struct Swapchain {
+    VkSurfaceFormatKHR surface_format{};
+    VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
+    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+    VkExtent2D extent{};
+    std::vector<VkImage> images;
+    std::vector<VkImageView> views;
+    std::vector<VkSemaphore> render_done;  // one per swapchain image
+    bool stale = false;                    // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
+};
+
+// Format and present mode, chosen once: the pipeline is made for the format.
+void choose_format_and_mode(const Gpu& gpu, Swapchain& sc) {
+    sc.surface_format = choose_window_format(
+        enumerate<VkSurfaceFormatKHR>("vkGetPhysicalDeviceSurfaceFormatsKHR", [&](auto* count, auto* items) {
+            return vkGetPhysicalDeviceSurfaceFormatsKHR(gpu.physical_device, gpu.surface, count, items);
+        }));
+    sc.present_mode = choose_present_mode(
+        enumerate<VkPresentModeKHR>("vkGetPhysicalDeviceSurfacePresentModesKHR", [&](auto* count, auto* items) {
+            return vkGetPhysicalDeviceSurfacePresentModesKHR(gpu.physical_device, gpu.surface, count, items);
+        }));
+}
+
+void destroy_swapchain(const Gpu& gpu, Swapchain& sc) {
+    for (VkImageView view : sc.views) gpu.fn.vkDestroyImageView(gpu.device, view, nullptr);
+    for (VkSemaphore semaphore : sc.render_done) gpu.fn.vkDestroySemaphore(gpu.device, semaphore, nullptr);
+    sc.views.clear();
+    sc.render_done.clear();
+    sc.images.clear();
+    if (sc.swapchain) gpu.fn.vkDestroySwapchainKHR(gpu.device, sc.swapchain, nullptr);
+    sc.swapchain = VK_NULL_HANDLE;
+}
+
+VkSwapchainCreateInfoKHR swapchain_info(const Gpu& gpu, const Config& config, const Swapchain& sc,
+                                        const VkSurfaceCapabilitiesKHR& caps, VkExtent2D extent) {
+    VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
+    info.surface = gpu.surface;
+    info.minImageCount = swapchain_image_request(config, caps);
+    info.imageFormat = sc.surface_format.format;
+    info.imageColorSpace = sc.surface_format.colorSpace;
+    info.imageExtent = extent;
+    info.imageArrayLayers = 1;
+    info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check
+    info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    info.preTransform = caps.currentTransform;
+    info.compositeAlpha = composite_alpha(caps);
+    info.presentMode = sc.present_mode;
+    info.clipped = VK_TRUE;
+    info.oldSwapchain = sc.swapchain;
+    return info;
+}
+
+// A swapchain for the surface's current extent, retiring the previous one
+// (the device is idle), with a view and a render-done semaphore per image;
+// false while the surface has no area.
+bool build_swapchain(const Gpu& gpu, const Config& config, Swapchain& sc) {
+    VkSurfaceCapabilitiesKHR caps;
+    check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(gpu.physical_device, gpu.surface, &caps),
+          "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
+    const VkExtent2D extent = swapchain_extent(config, caps);
+    if (extent.width == 0 || extent.height == 0) return false;
+    const VkSwapchainCreateInfoKHR info = swapchain_info(gpu, config, sc, caps, extent);
+    VkSwapchainKHR swapchain = VK_NULL_HANDLE;
+    const VkResult result = gpu.fn.vkCreateSwapchainKHR(gpu.device, &info, nullptr, &swapchain);
+    destroy_swapchain(gpu, sc);  // retired even if the creation failed
+    check(result, "vkCreateSwapchainKHR");
+    sc.swapchain = swapchain;
+    sc.images = enumerate<VkImage>("vkGetSwapchainImagesKHR", [&](auto* count, auto* items) {
+        return gpu.fn.vkGetSwapchainImagesKHR(gpu.device, sc.swapchain, count, items);
+    });
+    for (VkImage image : sc.images) {
+        sc.views.push_back(create_view(gpu, image, sc.surface_format.format, VK_IMAGE_ASPECT_COLOR_BIT));
+        sc.render_done.push_back(create_semaphore(gpu));
+    }
+    sc.extent = extent;
+    return true;
+}
+
+// build_swapchain, waiting while the window is minimised. Never inlined: the
+// acquire stage re-creates through it, and inlined its loop would hold
+// registers (pushed and popped) on every headless acquire too.
+[[gnu::noinline]] void build_swapchain_when_visible(const Gpu& gpu, const Config& config, Swapchain& sc) {
+    while (!build_swapchain(gpu, config, sc)) wait_window_events();
+}
+
+void create_swapchain(const Gpu& gpu, const Config& config, Swapchain& sc) {
+    choose_format_and_mode(gpu, sc);
+    build_swapchain_when_visible(gpu, config, sc);
+}
+
+// ---- The variant ------------------------------------------------------------
+
+// What this frame renders into: a ring image or a swapchain image.
+struct Target {
+    VkImage image = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    VkExtent2D extent{};
+    VkImageLayout present_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+};
 
 template <bool Direct>
 class RawVariant final : public Variant {
-    struct Frame;  // per frame slot, below
 public:
-    ~RawVariant() override { destroy(); }
+    ~RawVariant() override {
+        if (gpu_.device) {
+            gpu_.fn.vkDeviceWaitIdle(gpu_.device);
+            destroy_swapchain(gpu_, swapchain_);
+            destroy_frames(gpu_, frames_);
+            destroy_pipeline(gpu_, pipeline_);
+            destroy_targets(gpu_, targets_);
+            destroy_mesh(gpu_, mesh_);
+        }
+        destroy_gpu(gpu_);  // the surface before the window (a member) goes
+    }
 
     void init(const Config& config, const SceneData& scene) override {
         config_ = config;
         recorders_ = config.threads > 1 ? scene.recorders : nullptr;
         draws_.resize(config.teapots);
-        mesh_.index_count = static_cast<std::uint32_t>(scene.mesh->indices.size());
         present_to_window_ = config.window;
-        create_instance();
-        create_device();
-        if (config.window) create_swapchain();
-        create_geometry(*scene.mesh);
-        create_images();
-        create_pipeline();
-        create_frames();
+        if (config.window) window_ = BenchWindow(config);
+        create_instance(gpu_, config, window_);
+        pick_physical_device(gpu_);
+        create_device(gpu_);
+        if (config.window) {
+            create_swapchain(gpu_, config, swapchain_);
+            targets_.format = swapchain_.surface_format.format;
+        }
+        create_mesh(gpu_, *scene.mesh, mesh_);
+        create_uniforms(gpu_, config, frames_);
+        create_host_buffer(gpu_, VkDeviceSize(config.width) * config.height * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                           targets_.readback);
+        create_ring(gpu_, config, targets_);
+        create_depth(gpu_, config, swapchain_.extent, targets_);
+        create_pipeline(gpu_, targets_.format, pipeline_);
+        create_frames(gpu_, config, recorders_ ? recorders_->size() : 0, pipeline_.set_layout, frames_);
     }
 
     void acquire() override {
         slot_ = static_cast<std::uint32_t>(frame_ % config_.frames_in_flight);
         if (!present_to_window_) {
-            image_ = static_cast<std::uint32_t>(frame_ % ring_.size());
-            target_ = {ring_[image_].image,
-                       ring_[image_].view,
+            image_ = static_cast<std::uint32_t>(frame_ % targets_.ring.size());
+            target_ = {targets_.ring[image_].image,
+                       targets_.ring[image_].view,
                        {config_.width, config_.height},
                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
             return;
         }
         for (;;) {
-            if (window_sc_.stale) recreate_swapchain();
+            if (swapchain_.stale) recreate_swapchain();
             VkResult result = call(&DeviceFunctions::vkAcquireNextImageKHR, ::vkAcquireNextImageKHR)(
-                device_, window_sc_.swapchain, UINT64_MAX, frames_[slot_].acquire_semaphore, VK_NULL_HANDLE, &image_);
+                gpu_.device, swapchain_.swapchain, UINT64_MAX, frames_.slots[slot_].acquire_semaphore, VK_NULL_HANDLE,
+                &image_);
             if (result == VK_ERROR_OUT_OF_DATE_KHR) {
-                window_sc_.stale = true;
+                swapchain_.stale = true;
                 continue;
             }
             if (result == VK_SUBOPTIMAL_KHR)
-                window_sc_.stale = true;  // the image is still usable: re-created after its present
+                swapchain_.stale = true;  // the image is still usable: re-created after its present
             else check(result, "vkAcquireNextImageKHR");
             break;
         }
-        target_ = {window_sc_.images[image_], window_sc_.views[image_], window_sc_.extent,
+        target_ = {swapchain_.images[image_], swapchain_.views[image_], swapchain_.extent,
                    VK_IMAGE_LAYOUT_PRESENT_SRC_KHR};
     }
 
     void uniform() override {
-        write_camera_uniforms(static_cast<char*>(uniform_.mapped) + slot_ * uniform_stride_, camera_,
+        write_camera_uniforms(static_cast<char*>(frames_.uniforms.mapped) + slot_ * frames_.uniform_stride, camera_,
                               config_.uniform_writes);
     }
 
     void command() override {
-        Frame& f = frames_[slot_];
-        check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.pool, 0),
+        Frame& f = frames_.slots[slot_];
+        check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(gpu_.device, f.pool, 0),
               "vkResetCommandPool");
         VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
         begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -204,6 +963,101 @@ public:
         end_target(cmd);
     }
 
+    void submit() override {
+        Frame& f = frames_.slots[slot_];
+        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmd_info.commandBuffer = f.cmd;
+        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+        submit.commandBufferInfoCount = 1;
+        submit.pCommandBufferInfos = &cmd_info;
+        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
+        if (present_to_window_) {
+            wait.semaphore = f.acquire_semaphore;
+            wait.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+            signal.semaphore = swapchain_.render_done[image_];
+            signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
+            submit.waitSemaphoreInfoCount = 1;
+            submit.pWaitSemaphoreInfos = &wait;
+            submit.signalSemaphoreInfoCount = 1;
+            submit.pSignalSemaphoreInfos = &signal;
+        }
+        check(call(&DeviceFunctions::vkQueueSubmit2, ::vkQueueSubmit2)(gpu_.queue, 1, &submit, f.fence),
+              "vkQueueSubmit2");
+        f.submitted = true;
+    }
+
+    void present() override {
+        if (present_to_window_) {
+            VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
+            info.waitSemaphoreCount = 1;
+            info.pWaitSemaphores = &swapchain_.render_done[image_];
+            info.swapchainCount = 1;
+            info.pSwapchains = &swapchain_.swapchain;
+            info.pImageIndices = &image_;
+            VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(gpu_.queue, &info);
+            if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
+                swapchain_.stale = true;  // re-created at the next acquire
+            else check(result, "vkQueuePresentKHR");
+        }
+        presented_image_ = image_;
+        ++frame_;
+    }
+
+    void wait() override {
+        Frame& next = frames_.slots[frame_ % config_.frames_in_flight];
+        if (!next.submitted) return;
+        check(call(&DeviceFunctions::vkWaitForFences, ::vkWaitForFences)(gpu_.device, 1, &next.fence, VK_TRUE,
+                                                                         UINT64_MAX),
+              "vkWaitForFences");
+        check(call(&DeviceFunctions::vkResetFences, ::vkResetFences)(gpu_.device, 1, &next.fence), "vkResetFences");
+        next.submitted = false;
+    }
+
+    void update(double t) override { update_scene(config_, t, draws_, camera_); }
+
+    void drain() override { check(gpu_.fn.vkDeviceWaitIdle(gpu_.device), "vkDeviceWaitIdle"); }
+
+    std::vector<std::uint8_t> render_reference_frame(double t) override {
+        drain();
+        update(t);
+        // Offscreen in both modes, through the headless path of the stages.
+        present_to_window_ = false;
+        acquire();
+        uniform();
+        command();
+        submit();
+        present();
+        wait();  // the other slot's last frame: every slot is free afterwards
+        present_to_window_ = config_.window;
+        return read_back_ring_image();
+    }
+
+    std::vector<std::uint8_t> read_back_last_frame(double t) override {
+        if (config_.window) return read_back_presented_frame(t);
+        return read_back_ring_image();
+    }
+
+    std::string device_name() const override { return gpu_.name; }
+
+    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
+
+    std::string presentation() const override {
+        return config_.window
+                   ? swapchain_presentation(targets_.format, swapchain_.present_mode, swapchain_.images.size(),
+                                            swapchain_.extent)
+                   : headless_presentation(targets_.ring.size(), targets_.format, {config_.width, config_.height});
+    }
+
+private:
+    // The device-level function: the loader's export for raw, the device's
+    // own pointer for raw-direct. Resolved at compile time.
+    template <typename Pfn>
+    Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
+        if constexpr (Direct) return gpu_.fn.*member;
+        else return exported;
+    }
+
     // The barriers into the attachment layouts and the rendering's begin.
     void begin_target(VkCommandBuffer cmd, VkRenderingFlags flags) const {
         const VkPipelineStageFlags2 depth_stages =
@@ -213,7 +1067,7 @@ public:
                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, 0,
                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
             image_barrier(
-                depth_.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                targets_.depth.image, VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                 depth_stages,
                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT)};
@@ -226,7 +1080,7 @@ public:
         colour.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
         std::memcpy(colour.clearValue.color.float32, clear_colour, sizeof clear_colour);
         VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-        depth.imageView = depth_.view;
+        depth.imageView = targets_.depth.view;
         depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
         depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
         depth.storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE;
@@ -244,13 +1098,14 @@ public:
     // The state every draw needs, then the draws of range: into the primary,
     // or one thread's slice into its secondary (which inherits no state).
     void record_draws(VkCommandBuffer cmd, const Frame& f, DrawRange range) const {
-        call(&DeviceFunctions::vkCmdBindPipeline, ::vkCmdBindPipeline)(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_);
+        call(&DeviceFunctions::vkCmdBindPipeline, ::vkCmdBindPipeline)(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                                                                       pipeline_.pipeline);
         VkViewport viewport{0, 0, float(target_.extent.width), float(target_.extent.height), 0, 1};
         call(&DeviceFunctions::vkCmdSetViewport, ::vkCmdSetViewport)(cmd, 0, 1, &viewport);
         VkRect2D scissor{{0, 0}, target_.extent};
         call(&DeviceFunctions::vkCmdSetScissor, ::vkCmdSetScissor)(cmd, 0, 1, &scissor);
         call(&DeviceFunctions::vkCmdBindDescriptorSets, ::vkCmdBindDescriptorSets)(
-            cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_layout_, 0, 1, &f.descriptor_set, 0, nullptr);
+            cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline_.layout, 0, 1, &f.descriptor_set, 0, nullptr);
         VkBuffer vertex_buffers[2] = {mesh_.positions, mesh_.normals};
         VkDeviceSize offsets[2] = {0, 0};
         call(&DeviceFunctions::vkCmdBindVertexBuffers, ::vkCmdBindVertexBuffers)(cmd, 0, 2, vertex_buffers, offsets);
@@ -259,7 +1114,7 @@ public:
         auto push = call(&DeviceFunctions::vkCmdPushConstants, ::vkCmdPushConstants);
         auto draw = call(&DeviceFunctions::vkCmdDrawIndexed, ::vkCmdDrawIndexed);
         for (std::size_t i = range.first; i < range.last; ++i) {
-            push(cmd, pipeline_layout_, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants), &draws_[i]);
+            push(cmd, pipeline_.layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants), &draws_[i]);
             draw(cmd, mesh_.index_count, 1, 0, 0, 0);
         }
     }
@@ -270,12 +1125,12 @@ public:
         const int threads = int(f.secondaries.size());
         auto record = [&](int i) {
             const auto t = std::size_t(i);
-            check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(device_, f.thread_pools[t], 0),
+            check(call(&DeviceFunctions::vkResetCommandPool, ::vkResetCommandPool)(gpu_.device, f.thread_pools[t], 0),
                   "vkResetCommandPool");
             VkCommandBufferInheritanceRenderingInfo rendering{
                 VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO};
             rendering.colorAttachmentCount = 1;
-            rendering.pColorAttachmentFormats = &colour_format_;
+            rendering.pColorAttachmentFormats = &targets_.format;
             rendering.depthAttachmentFormat = depth_format;
             rendering.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
             VkCommandBufferInheritanceInfo inheritance{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
@@ -306,818 +1161,101 @@ public:
         check(call(&DeviceFunctions::vkEndCommandBuffer, ::vkEndCommandBuffer)(cmd), "vkEndCommandBuffer");
     }
 
-    void submit() override {
-        Frame& f = frames_[slot_];
-        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmd_info.commandBuffer = f.cmd;
-        VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        submit.commandBufferInfoCount = 1;
-        submit.pCommandBufferInfos = &cmd_info;
-        VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        if (present_to_window_) {
-            wait.semaphore = f.acquire_semaphore;
-            wait.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-            signal.semaphore = window_sc_.render_done[image_];
-            signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-            submit.waitSemaphoreInfoCount = 1;
-            submit.pWaitSemaphoreInfos = &wait;
-            submit.signalSemaphoreInfoCount = 1;
-            submit.pSignalSemaphoreInfos = &signal;
+    // Out of the per-frame path: the device idle, a new swapchain for the
+    // surface's extent and, where it grew past it, a larger depth image.
+    void recreate_swapchain() {
+        check(gpu_.fn.vkDeviceWaitIdle(gpu_.device), "vkDeviceWaitIdle");
+        build_swapchain_when_visible(gpu_, config_, swapchain_);
+        if (swapchain_.extent.width > targets_.depth_extent.width ||
+            swapchain_.extent.height > targets_.depth_extent.height) {
+            destroy_image(gpu_, targets_.depth);
+            create_depth(gpu_, config_, swapchain_.extent, targets_);
         }
-        check(call(&DeviceFunctions::vkQueueSubmit2, ::vkQueueSubmit2)(queue_, 1, &submit, f.fence), "vkQueueSubmit2");
-        f.submitted = true;
-    }
-
-    void present() override {
-        if (present_to_window_) {
-            VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};
-            info.waitSemaphoreCount = 1;
-            info.pWaitSemaphores = &window_sc_.render_done[image_];
-            info.swapchainCount = 1;
-            info.pSwapchains = &window_sc_.swapchain;
-            info.pImageIndices = &image_;
-            VkResult result = call(&DeviceFunctions::vkQueuePresentKHR, ::vkQueuePresentKHR)(queue_, &info);
-            if (result == VK_ERROR_OUT_OF_DATE_KHR || result == VK_SUBOPTIMAL_KHR)
-                window_sc_.stale = true;  // re-created at the next acquire
-            else check(result, "vkQueuePresentKHR");
-        }
-        presented_image_ = image_;
-        ++frame_;
-    }
-
-    void wait() override {
-        Frame& next = frames_[frame_ % config_.frames_in_flight];
-        if (!next.submitted) return;
-        check(call(&DeviceFunctions::vkWaitForFences, ::vkWaitForFences)(device_, 1, &next.fence, VK_TRUE, UINT64_MAX),
-              "vkWaitForFences");
-        check(call(&DeviceFunctions::vkResetFences, ::vkResetFences)(device_, 1, &next.fence), "vkResetFences");
-        next.submitted = false;
-    }
-
-    void update(double t) override { update_scene(config_, t, draws_, camera_); }
-
-    void drain() override { check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle"); }
-
-    std::vector<std::uint8_t> render_reference_frame(double t) override {
-        drain();
-        update(t);
-        // Offscreen in both modes, through the headless path of the stages.
-        present_to_window_ = false;
-        acquire();
-        uniform();
-        command();
-        submit();
-        present();
-        wait();  // the other slot's last frame: every slot is free afterwards
-        present_to_window_ = config_.window;
-        return read_back_ring_image();
-    }
-
-    std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return read_back_presented_frame(t);
-        return read_back_ring_image();
-    }
-
-    // Windowed: one more frame at time t through the window's stages, its
-    // swapchain image copied to the readback buffer (the swapchain has
-    // TRANSFER_SRC usage) between its rendering and its presentation: the
-    // submission renders (waiting on the acquire semaphore), then a one-off
-    // copy goes PRESENT_SRC -> TRANSFER_SRC -> PRESENT_SRC and signals the
-    // render-done semaphore that present waits on.
-    std::vector<std::uint8_t> read_back_presented_frame(double t) {
-        drain();
-        update(t);
-        acquire();
-        uniform();
-        command();
-        if (window_sc_.extent.width != config_.width || window_sc_.extent.height != config_.height)
-            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
-        Frame& f = frames_[slot_];
-        VkCommandBufferSubmitInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmd_info.commandBuffer = f.cmd;
-        VkSemaphoreSubmitInfo wait_info{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        wait_info.semaphore = f.acquire_semaphore;
-        wait_info.stageMask = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-        VkSubmitInfo2 render{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        render.waitSemaphoreInfoCount = 1;
-        render.pWaitSemaphoreInfos = &wait_info;
-        render.commandBufferInfoCount = 1;
-        render.pCommandBufferInfos = &cmd_info;
-        check(fn_.vkQueueSubmit2(queue_, 1, &render, f.fence), "vkQueueSubmit2");
-        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
-
-        begin_one_time(fn_, device_, f.pool, f.cmd);
-        const VkImage image = window_sc_.images[image_];
-        const VkImageMemoryBarrier2 to_copy = image_barrier(
-            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
-        const VkImageMemoryBarrier2 back = image_barrier(
-            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-            VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
-        copy_image_to_host(fn_, f.cmd, image, window_sc_.extent, readback_buffer_, {&back, 1});
-        check(fn_.vkEndCommandBuffer(f.cmd), "vkEndCommandBuffer");
-        cmd_info.commandBuffer = f.cmd;
-        VkSemaphoreSubmitInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
-        signal.semaphore = window_sc_.render_done[image_];
-        signal.stageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-        VkSubmitInfo2 copy{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-        copy.commandBufferInfoCount = 1;
-        copy.pCommandBufferInfos = &cmd_info;
-        copy.signalSemaphoreInfoCount = 1;
-        copy.pSignalSemaphoreInfos = &signal;
-        check(fn_.vkQueueSubmit2(queue_, 1, &copy, f.fence), "vkQueueSubmit2");
-        check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-        check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
-        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        std::vector<std::uint8_t> bytes(pixels,
-                                        pixels + std::size_t(window_sc_.extent.width) * window_sc_.extent.height * 4);
-        to_rgba(bytes, colour_format_);
-        present();
-        wait();
-        drain();
-        return bytes;
-    }
-
-    std::string device_name() const override { return device_name_; }
-
-    const BenchWindow* window() const override { return config_.window ? &window_ : nullptr; }
-
-    std::string presentation() const override {
-        return config_.window ? swapchain_presentation(colour_format_, window_sc_.present_mode,
-                                                       window_sc_.images.size(), window_sc_.extent)
-                              : headless_presentation(ring_.size(), colour_format_, {config_.width, config_.height});
-    }
-
-private:
-    struct Image {
-        VkImage image = VK_NULL_HANDLE;
-        VkImageView view = VK_NULL_HANDLE;
-        VkDeviceMemory memory = VK_NULL_HANDLE;
-    };
-    struct Frame {
-        VkCommandPool pool = VK_NULL_HANDLE;
-        VkCommandBuffer cmd = VK_NULL_HANDLE;
-        VkFence fence = VK_NULL_HANDLE;
-        VkDescriptorSet descriptor_set = VK_NULL_HANDLE;
-        VkSemaphore acquire_semaphore = VK_NULL_HANDLE;  // windowed only
-        bool submitted = false;
-        // --threads N > 1: per thread, a pool and its secondary.
-        std::vector<VkCommandPool> thread_pools;
-        std::vector<VkCommandBuffer> secondaries;
-    };
-    // The mesh: three device-local buffers filled by a staging upload.
-    struct MeshBuffers {
-        VkBuffer positions = VK_NULL_HANDLE, normals = VK_NULL_HANDLE, indices = VK_NULL_HANDLE;
-        Allocation positions_memory, normals_memory, indices_memory;
-        std::uint32_t index_count = 0;
-    };
-    // Windowed: the surface, the swapchain by the convention's rule and its
-    // per-image objects.
-    struct WindowSwapchain {
-        VkSurfaceKHR surface = VK_NULL_HANDLE;
-        VkSurfaceFormatKHR surface_format{};
-        VkPresentModeKHR present_mode = VK_PRESENT_MODE_FIFO_KHR;
-        VkSwapchainKHR swapchain = VK_NULL_HANDLE;
-        VkExtent2D extent{};
-        std::vector<VkImage> images;
-        std::vector<VkImageView> views;
-        std::vector<VkSemaphore> render_done;  // one per swapchain image
-        bool stale = false;                    // OUT_OF_DATE or SUBOPTIMAL seen: re-create at the next acquire
-    };
-    // What this frame renders into: a ring image or a swapchain image.
-    struct Target {
-        VkImage image = VK_NULL_HANDLE;
-        VkImageView view = VK_NULL_HANDLE;
-        VkExtent2D extent{};
-        VkImageLayout present_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    };
-
-    // The device-level function: the loader's export for raw, the device's
-    // own pointer for raw-direct. Resolved at compile time.
-    template <typename Pfn>
-    Pfn call(Pfn DeviceFunctions::*member, Pfn exported) const {
-        if constexpr (Direct) return fn_.*member;
-        else return exported;
+        swapchain_.stale = false;
     }
 
     // Drains, then copies the ring image last presented to the readback
     // buffer with a one-off command buffer from the last frame's slot.
     std::vector<std::uint8_t> read_back_ring_image() {
         drain();
-        Frame& f = frames_[slot_];
+        Frame& f = frames_.slots[slot_];
         if (f.submitted) {
-            check(fn_.vkWaitForFences(device_, 1, &f.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-            check(fn_.vkResetFences(device_, 1, &f.fence), "vkResetFences");
+            wait_and_reset(gpu_, f.fence);
             f.submitted = false;
         }
-        begin_one_time(fn_, device_, f.pool, f.cmd);
-        const VkImage image = ring_[presented_image_].image;
+        begin_one_time(gpu_, f.pool, f.cmd);
+        const VkImage image = targets_.ring[presented_image_].image;
         const VkImageMemoryBarrier2 to_copy = image_barrier(
             image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-        pipeline_barrier(fn_.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
-        copy_image_to_host(fn_, f.cmd, image, {config_.width, config_.height}, readback_buffer_);
-        submit_and_wait(fn_, device_, queue_, f.cmd, f.fence);
-        const auto* pixels = static_cast<const std::uint8_t*>(readback_.mapped);
-        std::vector<std::uint8_t> image_bytes(pixels, pixels + std::size_t(config_.width) * config_.height * 4);
-        to_rgba(image_bytes, colour_format_);
-        return image_bytes;
+        pipeline_barrier(gpu_.fn.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
+        copy_image_to_host(gpu_, f.cmd, image, {config_.width, config_.height}, targets_.readback.buffer);
+        end_submit_and_wait(gpu_, f.cmd, f.fence);
+        return read_pixels(targets_, {config_.width, config_.height});
     }
 
-    void create_instance() {
-        VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
-        app.pApplicationName = "teapot";
-        app.apiVersion = VK_API_VERSION_1_3;
-        VkDebugUtilsMessengerCreateInfoEXT messenger{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-        messenger.messageSeverity = validation_severities;
-        messenger.messageType = validation_types;
-        messenger.pfnUserCallback = validation_callback;
-        std::vector<const char*> extensions;
-        if (config_.window) {
-            window_ = BenchWindow(config_);
-            extensions = window_instance_extensions();
-        }
-        if (config_.validation) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
-        info.pApplicationInfo = &app;
-        info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
-        info.ppEnabledExtensionNames = extensions.data();
-        if (config_.validation) {
-            info.pNext = &messenger;
-            info.enabledLayerCount = 1;
-            info.ppEnabledLayerNames = &validation_layer;
-        }
-        check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
-        if (config_.window)
-            check(glfwCreateWindowSurface(instance_, window_.get(), nullptr, &window_sc_.surface),
-                  "glfwCreateWindowSurface");
-        if (config_.validation) {
-            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
-                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-            check(create(instance_, &messenger, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
-        }
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied to the readback buffer (the swapchain has
+    // TRANSFER_SRC usage) between its rendering and its presentation: the
+    // submission renders (waiting on the acquire semaphore), then a one-off
+    // copy (copy_presented_image) signals the render-done semaphore that
+    // present waits on.
+    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+        drain();
+        update(t);
+        acquire();
+        uniform();
+        command();
+        if (swapchain_.extent.width != config_.width || swapchain_.extent.height != config_.height)
+            throw std::runtime_error("windowed image check: the swapchain's extent is not --size");
+        const Frame& f = frames_.slots[slot_];
+        submit_and_wait(gpu_, f.cmd, f.fence, f.acquire_semaphore);
+        copy_presented_image(f);
+        std::vector<std::uint8_t> bytes = read_pixels(targets_, swapchain_.extent);
+        present();
+        wait();
+        drain();
+        return bytes;
     }
 
-    void create_device() {
-        // The first device with a graphics queue and Vulkan 1.3 (windowed:
-        // a graphics queue that presents to the surface).
-        std::uint32_t count = 0;
-        check(vkEnumeratePhysicalDevices(instance_, &count, nullptr), "vkEnumeratePhysicalDevices");
-        std::vector<VkPhysicalDevice> devices(count);
-        check(vkEnumeratePhysicalDevices(instance_, &count, devices.data()), "vkEnumeratePhysicalDevices");
-        for (VkPhysicalDevice candidate : devices) {
-            VkPhysicalDeviceProperties properties;
-            vkGetPhysicalDeviceProperties(candidate, &properties);
-            if (properties.apiVersion < VK_API_VERSION_1_3) continue;
-            std::uint32_t family_count = 0;
-            vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, nullptr);
-            std::vector<VkQueueFamilyProperties> families(family_count);
-            vkGetPhysicalDeviceQueueFamilyProperties(candidate, &family_count, families.data());
-            for (std::uint32_t i = 0; i < family_count; ++i) {
-                VkBool32 presents = VK_TRUE;
-                if (config_.window)
-                    check(vkGetPhysicalDeviceSurfaceSupportKHR(candidate, i, window_sc_.surface, &presents),
-                          "vkGetPhysicalDeviceSurfaceSupportKHR");
-                if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && presents) {
-                    physical_device_ = candidate;
-                    queue_family_ = i;
-                    device_name_ = properties.deviceName;
-                    uniform_alignment_ = properties.limits.minUniformBufferOffsetAlignment;
-                    break;
-                }
-            }
-            if (physical_device_) break;
-        }
-        if (!physical_device_)
-            throw std::runtime_error(config_.window
-                                         ? "no Vulkan 1.3 device with a graphics queue that presents to the window"
-                                         : "no Vulkan 1.3 device with a graphics queue");
-        vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_properties_);
-
-        float priority = 1.0f;
-        VkDeviceQueueCreateInfo queue_info{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-        queue_info.queueFamilyIndex = queue_family_;
-        queue_info.queueCount = 1;
-        queue_info.pQueuePriorities = &priority;
-        // The features and extensions vkrc::Device enables (setup parity):
-        // synchronization2, dynamicRendering, maintenance4, timelineSemaphore,
-        // VK_EXT_memory_budget where supported.
-        VkPhysicalDeviceVulkan13Features features13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
-        features13.synchronization2 = VK_TRUE;
-        features13.dynamicRendering = VK_TRUE;
-        features13.maintenance4 = VK_TRUE;
-        VkPhysicalDeviceVulkan12Features features12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
-        features12.pNext = &features13;
-        features12.timelineSemaphore = VK_TRUE;
-        VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-        info.pNext = &features12;
-        info.queueCreateInfoCount = 1;
-        info.pQueueCreateInfos = &queue_info;
-        std::vector<const char*> extensions;
-        if (config_.window) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
-        if (supports_device_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME))
-            extensions.push_back(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
-        info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
-        info.ppEnabledExtensionNames = extensions.data();
-        check(vkCreateDevice(physical_device_, &info, nullptr, &device_), "vkCreateDevice");
-        // The pointers for raw-direct's hot path and for the untimed helpers.
-#define TEAPOT_LOAD(name) fn_.name = reinterpret_cast<PFN_##name>(vkGetDeviceProcAddr(device_, #name));
-        TEAPOT_DEVICE_FUNCTIONS(TEAPOT_LOAD)
-#undef TEAPOT_LOAD
-        fn_.vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    // The acquired image PRESENT_SRC -> TRANSFER_SRC, copied, -> PRESENT_SRC.
+    void copy_presented_image(const Frame& f) {
+        begin_one_time(gpu_, f.pool, f.cmd);
+        const VkImage image = swapchain_.images[image_];
+        const VkImageMemoryBarrier2 to_copy = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        pipeline_barrier(gpu_.fn.vkCmdPipelineBarrier2, f.cmd, {&to_copy, 1});
+        const VkImageMemoryBarrier2 back = image_barrier(
+            image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+            VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_NONE, 0);
+        copy_image_to_host(gpu_, f.cmd, image, swapchain_.extent, targets_.readback.buffer, {&back, 1});
+        end_submit_and_wait(gpu_, f.cmd, f.fence, swapchain_.render_done[image_]);
     }
 
-    bool supports_device_extension(const char* name) const {
-        std::uint32_t count = 0;
-        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, nullptr),
-              "vkEnumerateDeviceExtensionProperties");
-        std::vector<VkExtensionProperties> extensions(count);
-        check(vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &count, extensions.data()),
-              "vkEnumerateDeviceExtensionProperties");
-        for (const VkExtensionProperties& e : extensions)
-            if (std::strcmp(e.extensionName, name) == 0) return true;
-        return false;
-    }
-
-    std::uint32_t memory_type(std::uint32_t bits, VkMemoryPropertyFlags wanted) const {
-        for (std::uint32_t i = 0; i < memory_properties_.memoryTypeCount; ++i)
-            if ((bits & (1u << i)) && (memory_properties_.memoryTypes[i].propertyFlags & wanted) == wanted) return i;
-        return UINT32_MAX;
-    }
-
-    // A buffer in memory the host writes directly: device-local as well where
-    // the device offers that (integrated GPUs, lavapipe, resizable BAR).
-    VkBuffer create_buffer(VkDeviceSize size, VkBufferUsageFlags usage, Allocation& allocation) {
-        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-        info.size = size;
-        info.usage = usage;
-        VkBuffer buffer;
-        check(fn_.vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
-        VkMemoryRequirements requirements;
-        fn_.vkGetBufferMemoryRequirements(device_, buffer, &requirements);
-        const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-        std::uint32_t type = memory_type(requirements.memoryTypeBits, host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, host);
-        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-        allocate.allocationSize = requirements.size;
-        allocate.memoryTypeIndex = type;
-        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &allocation.memory), "vkAllocateMemory");
-        check(fn_.vkBindBufferMemory(device_, buffer, allocation.memory, 0), "vkBindBufferMemory");
-        check(fn_.vkMapMemory(device_, allocation.memory, 0, VK_WHOLE_SIZE, 0, &allocation.mapped), "vkMapMemory");
-        return buffer;
-    }
-
-    // A device-local buffer filled through a host-visible staging buffer
-    // (what vkrc::upload_buffer does), with a one-off command pool and fence.
-    template <typename T>
-    VkBuffer create_filled_buffer(const std::vector<T>& data, VkBufferUsageFlags usage, Allocation& allocation) {
-        const VkDeviceSize size = data.size() * sizeof(T);
-        VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-        info.size = size;
-        info.usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-        VkBuffer buffer;
-        check(fn_.vkCreateBuffer(device_, &info, nullptr, &buffer), "vkCreateBuffer");
-        VkMemoryRequirements requirements;
-        fn_.vkGetBufferMemoryRequirements(device_, buffer, &requirements);
-        std::uint32_t type = memory_type(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, 0);
-        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-        allocate.allocationSize = requirements.size;
-        allocate.memoryTypeIndex = type;
-        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &allocation.memory), "vkAllocateMemory");
-        check(fn_.vkBindBufferMemory(device_, buffer, allocation.memory, 0), "vkBindBufferMemory");
-
-        Allocation staging_memory;
-        VkBuffer staging = create_buffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, staging_memory);
-        std::memcpy(staging_memory.mapped, data.data(), size);
-        VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-        pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-        pool_info.queueFamilyIndex = queue_family_;
-        VkCommandPool pool;
-        check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &pool), "vkCreateCommandPool");
-        VkCommandBufferAllocateInfo cmd_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-        cmd_info.commandPool = pool;
-        cmd_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-        cmd_info.commandBufferCount = 1;
-        VkCommandBuffer cmd;
-        check(fn_.vkAllocateCommandBuffers(device_, &cmd_info, &cmd), "vkAllocateCommandBuffers");
-        VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        VkFence fence;
-        check(fn_.vkCreateFence(device_, &fence_info, nullptr, &fence), "vkCreateFence");
-        begin_one_time(fn_, device_, pool, cmd);
-        VkBufferCopy region{0, 0, size};
-        fn_.vkCmdCopyBuffer(cmd, staging, buffer, 1, &region);
-        // Visible to every later command (vertex input and index reads).
-        VkBufferMemoryBarrier2 to_read{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-        to_read.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-        to_read.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-        to_read.dstStageMask = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT;
-        to_read.dstAccessMask = VK_ACCESS_2_MEMORY_READ_BIT;
-        to_read.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_read.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        to_read.buffer = buffer;
-        to_read.size = VK_WHOLE_SIZE;
-        pipeline_barrier(fn_.vkCmdPipelineBarrier2, cmd, {}, {&to_read, 1});
-        submit_and_wait(fn_, device_, queue_, cmd, fence);
-        fn_.vkDestroyFence(device_, fence, nullptr);
-        fn_.vkDestroyCommandPool(device_, pool, nullptr);
-        fn_.vkDestroyBuffer(device_, staging, nullptr);
-        fn_.vkFreeMemory(device_, staging_memory.memory, nullptr);
-        return buffer;
-    }
-
-    void create_geometry(const Mesh& mesh) {
-        mesh_.positions =
-            create_filled_buffer(mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.positions_memory);
-        mesh_.normals = create_filled_buffer(mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, mesh_.normals_memory);
-        mesh_.indices = create_filled_buffer(mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, mesh_.indices_memory);
-        uniform_stride_ = (sizeof(CameraUniforms) + uniform_alignment_ - 1) / uniform_alignment_ * uniform_alignment_;
-        uniform_buffer_ =
-            create_buffer(uniform_stride_ * config_.frames_in_flight, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, uniform_);
-        readback_buffer_ = create_buffer(VkDeviceSize(config_.width) * config_.height * 4,
-                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, readback_);
-    }
-
-    VkImageView create_view(VkImage image, VkFormat format, VkImageAspectFlags aspect) {
-        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-        view.image = image;
-        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-        view.format = format;
-        view.subresourceRange = {aspect, 0, 1, 0, 1};
-        VkImageView handle;
-        check(fn_.vkCreateImageView(device_, &view, nullptr, &handle), "vkCreateImageView");
-        return handle;
-    }
-
-    Image create_image(VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect, VkExtent2D extent) {
-        Image image;
-        VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-        info.imageType = VK_IMAGE_TYPE_2D;
-        info.format = format;
-        info.extent = {extent.width, extent.height, 1};
-        info.mipLevels = 1;
-        info.arrayLayers = 1;
-        info.samples = VK_SAMPLE_COUNT_1_BIT;
-        info.tiling = VK_IMAGE_TILING_OPTIMAL;
-        info.usage = usage;
-        check(fn_.vkCreateImage(device_, &info, nullptr, &image.image), "vkCreateImage");
-        VkMemoryRequirements requirements;
-        fn_.vkGetImageMemoryRequirements(device_, image.image, &requirements);
-        std::uint32_t type = memory_type(requirements.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        if (type == UINT32_MAX) type = memory_type(requirements.memoryTypeBits, 0);
-        VkMemoryAllocateInfo allocate{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-        allocate.allocationSize = requirements.size;
-        allocate.memoryTypeIndex = type;
-        check(fn_.vkAllocateMemory(device_, &allocate, nullptr, &image.memory), "vkAllocateMemory");
-        check(fn_.vkBindImageMemory(device_, image.image, image.memory, 0), "vkBindImageMemory");
-        image.view = create_view(image.image, format, aspect);
-        return image;
-    }
-
-    void destroy_image(Image& image) {
-        fn_.vkDestroyImageView(device_, image.view, nullptr);
-        fn_.vkDestroyImage(device_, image.image, nullptr);
-        fn_.vkFreeMemory(device_, image.memory, nullptr);
-        image = {};
-    }
-
-    // The ring (windowed: the one offscreen image of the reference frame)
-    // and a depth image covering every target.
-    void create_images() {
-        ring_.resize(config_.window ? 1 : config_.frames_in_flight + 1);
-        for (Image& image : ring_)
-            image = create_image(colour_format_, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                 VK_IMAGE_ASPECT_COLOR_BIT, {config_.width, config_.height});
-        create_depth();
-    }
-
-    void create_depth() {
-        depth_extent_ = {std::max(config_.width, window_sc_.extent.width),
-                         std::max(config_.height, window_sc_.extent.height)};
-        depth_ = create_image(depth_format, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
-                              depth_extent_);
-    }
-
-    // The window's swapchain by the convention's rule. Format and present
-    // mode are chosen once: the pipeline is made for the format.
-    void create_swapchain() {
-        std::uint32_t count = 0;
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, nullptr),
-              "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        std::vector<VkSurfaceFormatKHR> formats(count);
-        check(vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device_, window_sc_.surface, &count, formats.data()),
-              "vkGetPhysicalDeviceSurfaceFormatsKHR");
-        window_sc_.surface_format = choose_window_format(formats);
-        colour_format_ = window_sc_.surface_format.format;
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, nullptr),
-              "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        std::vector<VkPresentModeKHR> modes(count);
-        check(vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device_, window_sc_.surface, &count, modes.data()),
-              "vkGetPhysicalDeviceSurfacePresentModesKHR");
-        window_sc_.present_mode = choose_present_mode(modes);
-        while (!build_swapchain()) wait_window_events();
-    }
-
-    // A swapchain for the surface's current extent, retiring the previous
-    // one (the device is idle); false while the surface has no area.
-    bool build_swapchain() {
-        VkSurfaceCapabilitiesKHR caps;
-        check(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(physical_device_, window_sc_.surface, &caps),
-              "vkGetPhysicalDeviceSurfaceCapabilitiesKHR");
-        const VkExtent2D extent = swapchain_extent(config_, caps);
-        if (extent.width == 0 || extent.height == 0) return false;
-        VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
-        info.surface = window_sc_.surface;
-        info.minImageCount = swapchain_image_request(config_, caps);
-        info.imageFormat = window_sc_.surface_format.format;
-        info.imageColorSpace = window_sc_.surface_format.colorSpace;
-        info.imageExtent = extent;
-        info.imageArrayLayers = 1;
-        info.imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // the image check
-        info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
-        info.preTransform = caps.currentTransform;
-        info.compositeAlpha = composite_alpha(caps);
-        info.presentMode = window_sc_.present_mode;
-        info.clipped = VK_TRUE;
-        info.oldSwapchain = window_sc_.swapchain;
-        VkSwapchainKHR swapchain = VK_NULL_HANDLE;
-        const VkResult result = fn_.vkCreateSwapchainKHR(device_, &info, nullptr, &swapchain);
-        destroy_swapchain();  // retired even if the creation failed
-        check(result, "vkCreateSwapchainKHR");
-        window_sc_.swapchain = swapchain;
-        std::uint32_t count = 0;
-        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, nullptr), "vkGetSwapchainImagesKHR");
-        window_sc_.images.resize(count);
-        check(fn_.vkGetSwapchainImagesKHR(device_, window_sc_.swapchain, &count, window_sc_.images.data()),
-              "vkGetSwapchainImagesKHR");
-        VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-        for (VkImage image : window_sc_.images) {
-            window_sc_.views.push_back(create_view(image, colour_format_, VK_IMAGE_ASPECT_COLOR_BIT));
-            window_sc_.render_done.push_back(VK_NULL_HANDLE);
-            check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &window_sc_.render_done.back()),
-                  "vkCreateSemaphore");
-        }
-        window_sc_.extent = extent;
-        return true;
-    }
-
-    void recreate_swapchain() {
-        check(fn_.vkDeviceWaitIdle(device_), "vkDeviceWaitIdle");
-        while (!build_swapchain()) wait_window_events();
-        if (window_sc_.extent.width > depth_extent_.width || window_sc_.extent.height > depth_extent_.height) {
-            destroy_image(depth_);
-            create_depth();
-        }
-        window_sc_.stale = false;
-    }
-
-    void destroy_swapchain() {
-        for (VkImageView view : window_sc_.views) fn_.vkDestroyImageView(device_, view, nullptr);
-        for (VkSemaphore semaphore : window_sc_.render_done) fn_.vkDestroySemaphore(device_, semaphore, nullptr);
-        window_sc_.views.clear();
-        window_sc_.render_done.clear();
-        window_sc_.images.clear();
-        if (window_sc_.swapchain) fn_.vkDestroySwapchainKHR(device_, window_sc_.swapchain, nullptr);
-        window_sc_.swapchain = VK_NULL_HANDLE;
-    }
-
-    VkShaderModule create_shader(std::span<const std::uint32_t> code) {
-        VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-        info.codeSize = code.size_bytes();
-        info.pCode = code.data();
-        VkShaderModule module;
-        check(fn_.vkCreateShaderModule(device_, &info, nullptr, &module), "vkCreateShaderModule");
-        return module;
-    }
-
-    void create_pipeline() {
-        VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT,
-                                             nullptr};
-        VkDescriptorSetLayoutCreateInfo set_layout{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-        set_layout.bindingCount = 1;
-        set_layout.pBindings = &binding;
-        check(fn_.vkCreateDescriptorSetLayout(device_, &set_layout, nullptr, &set_layout_),
-              "vkCreateDescriptorSetLayout");
-        VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)};
-        VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-        layout.setLayoutCount = 1;
-        layout.pSetLayouts = &set_layout_;
-        layout.pushConstantRangeCount = 1;
-        layout.pPushConstantRanges = &push;
-        check(fn_.vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
-
-        VkShaderModule vert = create_shader(vkrc_shaders::teapot_vert);
-        VkShaderModule frag = create_shader(vkrc_shaders::teapot_frag);
-        VkPipelineShaderStageCreateInfo stages[2]{};
-        stages[0] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                     nullptr,
-                     0,
-                     VK_SHADER_STAGE_VERTEX_BIT,
-                     vert,
-                     "main",
-                     nullptr};
-        stages[1] = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                     nullptr,
-                     0,
-                     VK_SHADER_STAGE_FRAGMENT_BIT,
-                     frag,
-                     "main",
-                     nullptr};
-        VkVertexInputBindingDescription bindings[2] = {{0, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX},
-                                                       {1, sizeof(glm::vec3), VK_VERTEX_INPUT_RATE_VERTEX}};
-        VkVertexInputAttributeDescription attributes[2] = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0},
-                                                           {1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0}};
-        VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-        vertex_input.vertexBindingDescriptionCount = 2;
-        vertex_input.pVertexBindingDescriptions = bindings;
-        vertex_input.vertexAttributeDescriptionCount = 2;
-        vertex_input.pVertexAttributeDescriptions = attributes;
-        VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-        assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-        VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-        viewport.viewportCount = 1;
-        viewport.scissorCount = 1;
-        VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-        raster.polygonMode = VK_POLYGON_MODE_FILL;
-        raster.cullMode = VK_CULL_MODE_NONE;  // the spout and lid openings show inner faces
-        raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-        raster.lineWidth = 1.0f;
-        VkPipelineMultisampleStateCreateInfo multisample{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-        multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-        VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-        depth.depthTestEnable = VK_TRUE;
-        depth.depthWriteEnable = VK_TRUE;
-        depth.depthCompareOp = VK_COMPARE_OP_LESS;
-        VkPipelineColorBlendAttachmentState blend_attachment{};
-        blend_attachment.colorWriteMask =
-            VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
-        VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-        blend.attachmentCount = 1;
-        blend.pAttachments = &blend_attachment;
-        VkDynamicState dynamic_states[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
-        VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-        dynamic.dynamicStateCount = 2;
-        dynamic.pDynamicStates = dynamic_states;
-        VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-        rendering.colorAttachmentCount = 1;
-        rendering.pColorAttachmentFormats = &colour_format_;
-        rendering.depthAttachmentFormat = depth_format;
-        VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-        info.pNext = &rendering;
-        info.stageCount = 2;
-        info.pStages = stages;
-        info.pVertexInputState = &vertex_input;
-        info.pInputAssemblyState = &assembly;
-        info.pViewportState = &viewport;
-        info.pRasterizationState = &raster;
-        info.pMultisampleState = &multisample;
-        info.pDepthStencilState = &depth;
-        info.pColorBlendState = &blend;
-        info.pDynamicState = &dynamic;
-        info.layout = pipeline_layout_;
-        VkResult result = fn_.vkCreateGraphicsPipelines(device_, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline_);
-        fn_.vkDestroyShaderModule(device_, vert, nullptr);
-        fn_.vkDestroyShaderModule(device_, frag, nullptr);
-        check(result, "vkCreateGraphicsPipelines");
-    }
-
-    VkCommandBuffer create_command_buffer(VkCommandPool pool, VkCommandBufferLevel level) {
-        VkCommandBufferAllocateInfo allocate{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-        allocate.commandPool = pool;
-        allocate.level = level;
-        allocate.commandBufferCount = 1;
-        VkCommandBuffer cmd = VK_NULL_HANDLE;
-        check(fn_.vkAllocateCommandBuffers(device_, &allocate, &cmd), "vkAllocateCommandBuffers");
-        return cmd;
-    }
-
-    void create_frames() {
-        auto slots = static_cast<std::uint32_t>(config_.frames_in_flight);
-        VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slots};
-        VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-        pool.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;  // as every variant's pool
-        pool.maxSets = slots;
-        pool.poolSizeCount = 1;
-        pool.pPoolSizes = &pool_size;
-        check(fn_.vkCreateDescriptorPool(device_, &pool, nullptr, &descriptor_pool_), "vkCreateDescriptorPool");
-        frames_.resize(slots);
-        for (std::uint32_t i = 0; i < slots; ++i) {
-            Frame& f = frames_[i];
-            VkCommandPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-            pool_info.flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT;
-            pool_info.queueFamilyIndex = queue_family_;
-            check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &f.pool), "vkCreateCommandPool");
-            f.cmd = create_command_buffer(f.pool, VK_COMMAND_BUFFER_LEVEL_PRIMARY);
-            for (int t = 0; recorders_ && t < recorders_->size(); ++t) {
-                f.thread_pools.push_back(VK_NULL_HANDLE);
-                check(fn_.vkCreateCommandPool(device_, &pool_info, nullptr, &f.thread_pools.back()),
-                      "vkCreateCommandPool");
-                f.secondaries.push_back(
-                    create_command_buffer(f.thread_pools.back(), VK_COMMAND_BUFFER_LEVEL_SECONDARY));
-            }
-            VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-            check(fn_.vkCreateFence(device_, &fence, nullptr, &f.fence), "vkCreateFence");
-            if (config_.window) {
-                VkSemaphoreCreateInfo semaphore{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
-                check(fn_.vkCreateSemaphore(device_, &semaphore, nullptr, &f.acquire_semaphore), "vkCreateSemaphore");
-            }
-            VkDescriptorSetAllocateInfo set{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-            set.descriptorPool = descriptor_pool_;
-            set.descriptorSetCount = 1;
-            set.pSetLayouts = &set_layout_;
-            check(fn_.vkAllocateDescriptorSets(device_, &set, &f.descriptor_set), "vkAllocateDescriptorSets");
-            VkDescriptorBufferInfo buffer{uniform_buffer_, i * uniform_stride_, sizeof(CameraUniforms)};
-            VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            write.dstSet = f.descriptor_set;
-            write.descriptorCount = 1;
-            write.descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-            write.pBufferInfo = &buffer;
-            fn_.vkUpdateDescriptorSets(device_, 1, &write, 0, nullptr);
-        }
-    }
-
-    void destroy() {
-        if (device_) {
-            fn_.vkDeviceWaitIdle(device_);
-            destroy_swapchain();
-            for (Frame& f : frames_) {
-                fn_.vkDestroySemaphore(device_, f.acquire_semaphore, nullptr);
-                fn_.vkDestroyFence(device_, f.fence, nullptr);
-                fn_.vkDestroyCommandPool(device_, f.pool, nullptr);
-                for (VkCommandPool pool : f.thread_pools) fn_.vkDestroyCommandPool(device_, pool, nullptr);
-            }
-            fn_.vkDestroyDescriptorPool(device_, descriptor_pool_, nullptr);
-            fn_.vkDestroyPipeline(device_, pipeline_, nullptr);
-            fn_.vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
-            fn_.vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
-            for (Image& image : ring_) destroy_image(image);
-            destroy_image(depth_);
-            auto destroy_buffer = [&](VkBuffer buffer, Allocation& allocation) {
-                fn_.vkDestroyBuffer(device_, buffer, nullptr);
-                fn_.vkFreeMemory(device_, allocation.memory, nullptr);  // unmaps implicitly
-            };
-            destroy_buffer(mesh_.positions, mesh_.positions_memory);
-            destroy_buffer(mesh_.normals, mesh_.normals_memory);
-            destroy_buffer(mesh_.indices, mesh_.indices_memory);
-            destroy_buffer(uniform_buffer_, uniform_);
-            destroy_buffer(readback_buffer_, readback_);
-            fn_.vkDestroyDevice(device_, nullptr);
-        }
-        if (window_sc_.surface)
-            vkDestroySurfaceKHR(instance_, window_sc_.surface, nullptr);  // before the window (a member) goes
-        if (messenger_) {
-            auto destroy_messenger = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
-                vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-            destroy_messenger(instance_, messenger_, nullptr);
-        }
-        if (instance_) vkDestroyInstance(instance_, nullptr);
-    }
-
+    // The scene, as every variant keeps it.
     Config config_;
     CameraUniforms camera_{};
     std::vector<PushConstants> draws_;
     ThreadPool* recorders_ = nullptr;  // --threads N > 1
 
-    BenchWindow window_;  // windowed only; outlives the surface (destroy() runs first)
-    VkInstance instance_ = VK_NULL_HANDLE;
-    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-    VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
-    VkPhysicalDeviceMemoryProperties memory_properties_{};
-    std::string device_name_;
-    VkDeviceSize uniform_alignment_ = 1;
-    std::uint32_t queue_family_ = 0;
-    VkDevice device_ = VK_NULL_HANDLE;
-    DeviceFunctions fn_;
-    VkQueue queue_ = VK_NULL_HANDLE;
-
+    // What init makes: the window, then the Vulkan objects in their C structs.
+    BenchWindow window_;  // windowed only; outlives the surface (the destructor's body runs first)
+    Gpu gpu_;
+    Swapchain swapchain_;  // windowed only
     MeshBuffers mesh_;
-    VkBuffer uniform_buffer_ = VK_NULL_HANDLE;
-    Allocation uniform_;
-    VkDeviceSize uniform_stride_ = 0;
-    VkBuffer readback_buffer_ = VK_NULL_HANDLE;
-    Allocation readback_;
-    std::vector<Image> ring_;
-    Image depth_;
-    VkExtent2D depth_extent_{};
-    VkFormat colour_format_ = colour_format;  // windowed: the swapchain's
+    Frames frames_;
+    Targets targets_;
+    Pipeline pipeline_;
 
-    WindowSwapchain window_sc_;       // windowed only
-    bool present_to_window_ = false;  // windowed, except for the reference frame
-    VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-    VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
-    VkPipeline pipeline_ = VK_NULL_HANDLE;
-    VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
-    std::vector<Frame> frames_;
-
+    // Where the frame loop is.
     std::uint64_t frame_ = 0;
     std::uint32_t slot_ = 0;
-    std::uint32_t image_ = 0;
+    std::uint32_t image_ = 0;  // in the ring, or in the swapchain
     std::uint32_t presented_image_ = 0;
     Target target_;
+    bool present_to_window_ = false;  // windowed, except for the reference frame
 };
 
 }  // namespace
