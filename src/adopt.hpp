@@ -11,19 +11,18 @@ namespace detail {
 
 // The state of an adopted handle: refuses an empty parent ("who: the
 // parent_name handle is empty") and a null handle ("who: the handle_name is
-// VK_NULL_HANDLE") with UsageError, then holds both and the ownership. The
-// members default to those of a DeviceChildState. The caller fills in the
-// rest; nothing it does after this may throw, or the state would destroy an
-// owned handle that adopt() did not take.
-template <class State, auto parent_member = &State::device, auto handle_member = &State::handle, class Parent,
-          class VkHandle>
+// VK_NULL_HANDLE") with UsageError, then holds both (the parent in
+// parent_member, by default a DeviceChildState's device) and the ownership.
+// The caller fills in the rest; nothing it does after this may throw, or the
+// state would destroy an owned handle that adopt() did not take.
+template <class State, auto parent_member = &State::device, class Parent, class VkHandle>
 Ref<State> adopted_state(const char* who, const Parent& parent, const char* parent_name, VkHandle handle,
                          const char* handle_name, Ownership ownership) {
     if (!parent) throw UsageError(std::string(who) + ": the " + parent_name + " handle is empty");
     if (handle == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the " + handle_name + " is VK_NULL_HANDLE");
     Ref<State> s(new State);
     (*s).*parent_member = parent;
-    (*s).*handle_member = handle;
+    s->handle = handle;
     s->ownership = ownership;
     return s;
 }

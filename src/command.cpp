@@ -16,7 +16,7 @@ void throw_too_many_color_attachments(std::size_t count) {
 CommandPoolState::~CommandPoolState() {
     // Destroying the pool frees its command buffers, the pending ones included;
     // it is deferred past the work submitted so far like any other object.
-    destroy_owned<&DeviceFunctions::vkDestroyCommandPool>();
+    destroy_owned<&DeviceFunctions::vkDestroyCommandPool>(*this, device);
 }
 
 void CommandPoolState::free_ready() {

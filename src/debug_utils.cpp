@@ -8,9 +8,7 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 DebugMessengerState::~DebugMessengerState() {
-    if (ownership == Ownership::owned && messenger != VK_NULL_HANDLE) {
-        instance.fn().vkDestroyDebugUtilsMessengerEXT(instance.vk(), messenger, nullptr);
-    }
+    if (owns_handle()) instance.fn().vkDestroyDebugUtilsMessengerEXT(instance.vk(), handle, nullptr);
 }
 }  // namespace detail
 
@@ -35,7 +33,7 @@ DebugMessenger DebugMessenger::create(const Instance& instance, const DebugMesse
     ci.messageType = info.types;
     ci.pfnUserCallback = detail::debug_trampoline;
     ci.pUserData = &state->callback;
-    check(instance.fn().vkCreateDebugUtilsMessengerEXT(instance.vk(), &ci, nullptr, &state->messenger),
+    check(instance.fn().vkCreateDebugUtilsMessengerEXT(instance.vk(), &ci, nullptr, &state->handle),
           "vkCreateDebugUtilsMessengerEXT");
     return DebugMessenger(std::move(state));
 }
@@ -48,7 +46,7 @@ DebugMessenger DebugMessenger::adopt(const Instance& instance, VkDebugUtilsMesse
     }
     detail::Ref<detail::DebugMessengerState> state(new detail::DebugMessengerState);
     state->instance = instance;
-    state->messenger = messenger;
+    state->handle = messenger;
     state->ownership = ownership;
     return DebugMessenger(std::move(state));
 }

@@ -14,19 +14,19 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 DescriptorSetLayoutState::~DescriptorSetLayoutState() {
-    destroy_owned<&DeviceFunctions::vkDestroyDescriptorSetLayout>();
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorSetLayout>(*this, device);
 }
 
 DescriptorPoolState::~DescriptorPoolState() {
     // Destroying the pool frees every set still in it, pending ones included.
-    destroy_owned<&DeviceFunctions::vkDestroyDescriptorPool>();
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorPool>(*this, device);
 }
 
 DescriptorSetState::~DescriptorSetState() {
     auto& p = *pool.state();
-    if (!p.can_free_sets || set == VK_NULL_HANDLE || ownership == Ownership::borrowed) return;
+    if (!p.can_free_sets || !owns_handle()) return;
     LockGuard lock(p.mutex);
-    if (p.generation == generation) p.pending.push(*p.device.state(), set, serial());
+    if (p.generation == generation) p.pending.push(*p.device.state(), handle, serial());
 }
 
 }  // namespace detail
@@ -222,7 +222,7 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
         check(d.fn.vkFreeDescriptorSets(d.device, p.handle, static_cast<std::uint32_t>(ready.size()), ready.data()),
               "vkFreeDescriptorSets");
     }
-    check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->set), "vkAllocateDescriptorSets");
+    check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->handle), "vkAllocateDescriptorSets");
     s->generation = p.generation;
     return DescriptorSet(std::move(s));
 }
@@ -240,7 +240,7 @@ DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorS
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
     s->pool = pool;
     s->layout = layout;
-    s->set = set;
+    s->handle = set;
     s->ownership = ownership;
     s->variable_count = variable_descriptor_count;
     LockGuard lock(pool.state()->mutex);
@@ -340,7 +340,7 @@ void update(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescri
             std::uint32_t array_element, std::size_t count, const VkDescriptorBufferInfo* buffer_info,
             const VkDescriptorImageInfo* image_info) {
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    w.dstSet = s.set;
+    w.dstSet = s.handle;
     w.dstBinding = binding;
     w.dstArrayElement = array_element;
     w.descriptorCount = static_cast<std::uint32_t>(count);
@@ -414,7 +414,7 @@ void DescriptorSet::update_with_template(const DescriptorUpdateTemplate& update_
         throw UsageError(std::string(who) + ": the template was made for another descriptor set layout");
     }
     const auto& d = state_->pool.device();
-    d.fn().vkUpdateDescriptorSetWithTemplate(d.vk(), state_->set, update_template.vk(), data);
+    d.fn().vkUpdateDescriptorSetWithTemplate(d.vk(), state_->handle, update_template.vk(), data);
 }
 
 VKRC_END_NAMESPACE

@@ -8,7 +8,7 @@ namespace detail {
 
 // A push template may be referred to by an open command buffer: the serial holds the drop.
 DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
-    destroy_owned<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>();
+    destroy_owned<&DeviceFunctions::vkDestroyDescriptorUpdateTemplate>(*this, device);
 }
 
 }  // namespace detail

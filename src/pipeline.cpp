@@ -15,16 +15,14 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-PipelineLayoutState::~PipelineLayoutState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineLayout>(); }
-RenderPassState::~RenderPassState() { destroy_owned<&DeviceFunctions::vkDestroyRenderPass>(); }
+PipelineLayoutState::~PipelineLayoutState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineLayout>(*this, device); }
+RenderPassState::~RenderPassState() { destroy_owned<&DeviceFunctions::vkDestroyRenderPass>(*this, device); }
 FramebufferState::~FramebufferState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyFramebuffer>(*render_pass.device().state(), framebuffer, serial());
+    if (render_pass) destroy_owned<&DeviceFunctions::vkDestroyFramebuffer>(*this, render_pass.device());
 }
-PipelineCacheState::~PipelineCacheState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineCache>(); }
+PipelineCacheState::~PipelineCacheState() { destroy_owned<&DeviceFunctions::vkDestroyPipelineCache>(*this, device); }
 PipelineState::~PipelineState() {
-    if (ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyPipeline>(*layout.device().state(), pipeline, serial());
+    if (layout) destroy_owned<&DeviceFunctions::vkDestroyPipeline>(*this, layout.device());
 }
 }  // namespace detail
 
@@ -52,8 +50,7 @@ RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
 
 Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                                Ownership ownership) {
-    auto s = detail::adopted_state<detail::FramebufferState, &detail::FramebufferState::render_pass,
-                                   &detail::FramebufferState::framebuffer>(
+    auto s = detail::adopted_state<detail::FramebufferState, &detail::FramebufferState::render_pass>(
         "vkrc::Framebuffer::adopt", render_pass, "RenderPass", framebuffer, "VkFramebuffer", ownership);
     s->extent = extent;
     return Framebuffer(std::move(s));
@@ -66,9 +63,8 @@ PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, 
 
 Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                          Ownership ownership) {
-    auto s =
-        detail::adopted_state<detail::PipelineState, &detail::PipelineState::layout, &detail::PipelineState::pipeline>(
-            "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
+    auto s = detail::adopted_state<detail::PipelineState, &detail::PipelineState::layout>(
+        "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
     s->bind_point = bind_point;
     return Pipeline(std::move(s));
 }
@@ -163,7 +159,7 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
     s->render_pass = info.render_pass;
     s->attachments = info.attachments;
     s->extent = {info.width, info.height};
-    check(device.fn().vkCreateFramebuffer(device.vk(), &ci, nullptr, &s->framebuffer), "vkCreateFramebuffer");
+    check(device.fn().vkCreateFramebuffer(device.vk(), &ci, nullptr, &s->handle), "vkCreateFramebuffer");
     return Framebuffer(std::move(s));
 }
 
@@ -264,7 +260,7 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Shad
     detail::Ref<detail::PipelineState> s(new detail::PipelineState);
     s->layout = layout;
     s->bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
-    check(d.fn().vkCreateComputePipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->pipeline),
+    check(d.fn().vkCreateComputePipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle),
           "vkCreateComputePipelines");
     return ComputePipeline(std::move(s));
 }
@@ -424,7 +420,7 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     detail::Ref<detail::PipelineState> s(new detail::PipelineState);
     s->layout = layout_;
     s->bind_point = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    check(d.fn().vkCreateGraphicsPipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->pipeline),
+    check(d.fn().vkCreateGraphicsPipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle),
           "vkCreateGraphicsPipelines");
     return GraphicsPipeline(std::move(s));
 }

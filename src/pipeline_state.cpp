@@ -61,7 +61,7 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Comp
     s->layout = layout;
     s->bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
     const VkPipelineCache cache = info.cache ? info.cache.vk() : VK_NULL_HANDLE;
-    check(d.fn().vkCreateComputePipelines(d.vk(), cache, 1, &ci, nullptr, &s->pipeline), "vkCreateComputePipelines");
+    check(d.fn().vkCreateComputePipelines(d.vk(), cache, 1, &ci, nullptr, &s->handle), "vkCreateComputePipelines");
     return ComputePipeline(std::move(s));
 }
 

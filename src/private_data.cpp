@@ -6,7 +6,9 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-PrivateDataSlotState::~PrivateDataSlotState() { destroy_owned<&DeviceFunctions::vkDestroyPrivateDataSlot>(); }
+PrivateDataSlotState::~PrivateDataSlotState() {
+    destroy_owned<&DeviceFunctions::vkDestroyPrivateDataSlot>(*this, device);
+}
 
 }  // namespace detail
 

@@ -17,11 +17,11 @@ namespace detail {
 // members (the allocation, then the parents) are released after, so FIFO
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
-    destroy_owned<&DeviceFunctions::vkDestroyBuffer>();
+    destroy_owned<&DeviceFunctions::vkDestroyBuffer>(*this, device);
     if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
 ImageState::~ImageState() {
-    destroy_owned<&DeviceFunctions::vkDestroyImage>();
+    destroy_owned<&DeviceFunctions::vkDestroyImage>(*this, device);
     if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
 
@@ -49,14 +49,12 @@ void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t
     device.destroy_after_gpu({run, 0, held}, serial);
 }
 ImageViewState::~ImageViewState() {
-    if (image && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyImageView>(*image.device().state(), view, serial());
+    if (image) destroy_owned<&DeviceFunctions::vkDestroyImageView>(*this, image.device());
 }
 BufferViewState::~BufferViewState() {
-    if (buffer && ownership == Ownership::owned)
-        defer_destroy<&DeviceFunctions::vkDestroyBufferView>(*buffer.device().state(), view, serial());
+    if (buffer) destroy_owned<&DeviceFunctions::vkDestroyBufferView>(*this, buffer.device());
 }
-SamplerState::~SamplerState() { destroy_owned<&DeviceFunctions::vkDestroySampler>(); }
+SamplerState::~SamplerState() { destroy_owned<&DeviceFunctions::vkDestroySampler>(*this, device); }
 
 }  // namespace detail
 
@@ -315,7 +313,7 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     }
     detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
     const auto& device = image.device();
-    check(device.fn().vkCreateImageView(device.vk(), &ci, nullptr, &state->view), "vkCreateImageView");
+    check(device.fn().vkCreateImageView(device.vk(), &ci, nullptr, &state->handle), "vkCreateImageView");
     state->image = image;
     state->format = ci.format;
     state->range = ci.subresourceRange;
@@ -334,25 +332,23 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
     ci.range = info.range;
     detail::Ref<detail::BufferViewState> state(new detail::BufferViewState);
     const auto& device = buffer.device();
-    check(device.fn().vkCreateBufferView(device.vk(), &ci, nullptr, &state->view), "vkCreateBufferView");
+    check(device.fn().vkCreateBufferView(device.vk(), &ci, nullptr, &state->handle), "vkCreateBufferView");
     state->buffer = buffer;
     return BufferView(std::move(state));
 }
 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
-    auto state =
-        detail::adopted_state<detail::ImageViewState, &detail::ImageViewState::image, &detail::ImageViewState::view>(
-            "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
+    auto state = detail::adopted_state<detail::ImageViewState, &detail::ImageViewState::image>(
+        "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
     return ImageView(std::move(state));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer,
-                                            &detail::BufferViewState::view>("vkrc::BufferView::adopt", buffer, "Buffer",
-                                                                            view, "VkBufferView", ownership));
+    return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
+        "vkrc::BufferView::adopt", buffer, "Buffer", view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {

@@ -12,7 +12,7 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-ShaderModuleState::~ShaderModuleState() { destroy_owned<&DeviceFunctions::vkDestroyShaderModule>(); }
+ShaderModuleState::~ShaderModuleState() { destroy_owned<&DeviceFunctions::vkDestroyShaderModule>(*this, device); }
 }  // namespace detail
 
 namespace {

@@ -9,9 +9,7 @@ namespace detail {
 SurfaceState::~SurfaceState() {
     // Swapchains hold the surface until their deferred destruction has run,
     // so none is left when this runs.
-    if (ownership == Ownership::owned && surface != VK_NULL_HANDLE) {
-        instance.fn().vkDestroySurfaceKHR(instance.vk(), surface, nullptr);
-    }
+    if (owns_handle()) instance.fn().vkDestroySurfaceKHR(instance.vk(), handle, nullptr);
 }
 }  // namespace detail
 
@@ -23,7 +21,7 @@ Surface Surface::adopt(const Instance& instance, VkSurfaceKHR surface, Ownership
     }
     detail::Ref<detail::SurfaceState> state(new detail::SurfaceState);
     state->instance = instance;
-    state->surface = surface;
+    state->handle = surface;
     state->ownership = ownership;
     return Surface(std::move(state));
 }

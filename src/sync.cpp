@@ -33,12 +33,12 @@ FenceState::~FenceState() {
     if (in_flight && ownership == Ownership::owned) {
         destroy_submitted_fence(*device.state(), handle, serial());
     } else {
-        destroy_owned<&DeviceFunctions::vkDestroyFence>();
+        destroy_owned<&DeviceFunctions::vkDestroyFence>(*this, device);
     }
 }
-SemaphoreState::~SemaphoreState() { destroy_owned<&DeviceFunctions::vkDestroySemaphore>(); }
-EventState::~EventState() { destroy_owned<&DeviceFunctions::vkDestroyEvent>(); }
-QueryPoolState::~QueryPoolState() { destroy_owned<&DeviceFunctions::vkDestroyQueryPool>(); }
+SemaphoreState::~SemaphoreState() { destroy_owned<&DeviceFunctions::vkDestroySemaphore>(*this, device); }
+EventState::~EventState() { destroy_owned<&DeviceFunctions::vkDestroyEvent>(*this, device); }
+QueryPoolState::~QueryPoolState() { destroy_owned<&DeviceFunctions::vkDestroyQueryPool>(*this, device); }
 }  // namespace detail
 
 Fence Fence::create(const Device& device, bool signaled) {

@@ -9,7 +9,7 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
-    destroy_owned<&DeviceFunctions::vkDestroySamplerYcbcrConversion>();
+    destroy_owned<&DeviceFunctions::vkDestroySamplerYcbcrConversion>(*this, device);
 }
 
 }  // namespace detail

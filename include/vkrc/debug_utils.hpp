@@ -28,19 +28,17 @@ struct DebugMessengerCreateInfo {
 // A debug-utils messenger; keeps its Instance alive. An instance may have any
 // number, each with its own callback and filter (besides the one that
 // InstanceCreateInfo::debug_callback installs).
-class DebugMessenger : public Handle<detail::DebugMessengerState> {
+class DebugMessenger : public VulkanObject<detail::DebugMessengerState, VkDebugUtilsMessengerEXT> {
 public:
-    DebugMessenger() noexcept = default;
     // The instance must have enabled VK_EXT_debug_utils.
     static DebugMessenger create(const Instance& instance, const DebugMessengerCreateInfo& info);
     // Wraps a messenger made elsewhere. With Ownership::owned vkrc destroys it.
     static DebugMessenger adopt(const Instance& instance, VkDebugUtilsMessengerEXT messenger, Ownership ownership);
 
-    VkDebugUtilsMessengerEXT vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 // The VkObjectType of a Vulkan handle type (VK_OBJECT_TYPE_UNKNOWN for others).
@@ -101,20 +99,16 @@ void set_name(const Device& device, const Object& object, const char* name) {
 
 namespace detail {
 
-class DebugMessengerState final : public RefCounted {
+class DebugMessengerState final : public VulkanObjectState<VkDebugUtilsMessengerEXT> {
 public:
+    static constexpr const char* type_name = "vkrc::DebugMessenger";
     ~DebugMessengerState() override;
     Instance instance;
-    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     DebugCallback callback;  // the messenger's user data: the state never moves
 };
 
 }  // namespace detail
 
-inline VkDebugUtilsMessengerEXT DebugMessenger::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::DebugMessenger::vk").messenger;
-}
 inline const Instance& DebugMessenger::instance() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::DebugMessenger::instance").instance;
 }

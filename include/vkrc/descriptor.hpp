@@ -104,16 +104,14 @@ private:
 };
 
 // A descriptor set; keeps its pool alive.
-class DescriptorSet : public Handle<detail::DescriptorSetState> {
+class DescriptorSet : public VulkanObject<detail::DescriptorSetState, VkDescriptorSet> {
 public:
-    DescriptorSet() noexcept = default;
     // A set allocated by other code from pool with layout (variable_descriptor_count
     // as it was allocated with). Owned: dropping it frees it as an allocated
     // set is freed (with FREE_DESCRIPTOR_SET, once the GPU is done); borrowed:
     // vkrc never frees it. It is invalid after the pool's reset_sets().
     static DescriptorSet adopt(const DescriptorPool& pool, const DescriptorSetLayout& layout, VkDescriptorSet set,
                                Ownership ownership, std::uint32_t variable_descriptor_count = 0);
-    VkDescriptorSet vk() const VKRC_UNCHECKED_NOEXCEPT;
     const DescriptorPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkUpdateDescriptorSets with one buffer descriptor. The set does not keep
@@ -147,7 +145,7 @@ public:
 
 private:
     friend class DescriptorPool;
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 namespace detail {
@@ -175,20 +173,18 @@ public:
     std::uint64_t generation = 0;
 };
 
-class DescriptorSetState final : public RefCounted {
+class DescriptorSetState final : public VulkanObjectState<VkDescriptorSet> {
 public:
+    static constexpr const char* type_name = "vkrc::DescriptorSet";
     ~DescriptorSetState() override;
     DescriptorPool pool;
     DescriptorSetLayout layout;  // checks writes (the raw layout may go once the set exists)
-    VkDescriptorSet set = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     std::uint64_t generation = 0;
     std::uint32_t variable_count = 0;  // of the layout's variable binding, if it has one
 };
 
 }  // namespace detail
 
-inline VkDescriptorSet DescriptorSet::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::DescriptorSet::vk").set; }
 inline const DescriptorPool& DescriptorSet::pool() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::DescriptorSet::pool").pool;
 }

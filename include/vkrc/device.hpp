@@ -494,38 +494,31 @@ void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) n
                              serial);
 }
 
-// The state of most objects made from a Device: the device (kept alive), the
-// raw handle and whether vkrc destroys it. Each family's state derives from
-// it, adds its own fields, names its wrapper in type_name (for an empty
-// handle's UsageError), and calls destroy_owned in its destructor.
+// Queues destroy (a vkDestroy* member of DeviceFunctions) of the handle of
+// state, an object of device, for after the GPU when vkrc owns it; nothing
+// for a borrowed handle or a failed creation.
+template <auto destroy, class VkHandle>
+void destroy_owned(const VulkanObjectState<VkHandle>& state, const Device& device) noexcept {
+    if (device && state.owns_handle()) defer_destroy<destroy>(*device.state(), state.handle, state.serial());
+}
+
+// The state of most objects made from a Device: the device, kept alive.
 template <class VkHandle>
-class DeviceChildState : public RefCounted {
+class DeviceChildState : public VulkanObjectState<VkHandle> {
 public:
     Device device;
-    VkHandle handle = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
-
-protected:
-    // Queues destroy (a vkDestroy* member of DeviceFunctions) of an owned
-    // handle for after the GPU; nothing for a borrowed one or a failed creation.
-    template <auto destroy>
-    void destroy_owned() noexcept {
-        if (device && ownership == Ownership::owned) defer_destroy<destroy>(*device.state(), handle, serial());
-    }
 };
 
 }  // namespace detail
 
 // Base of the wrappers of a DeviceChildState: the raw handle and the device.
 template <class State, class VkHandle>
-class DeviceChild : public Handle<State> {
+class DeviceChild : public VulkanObject<State, VkHandle> {
 public:
-    VkHandle vk() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "vk").handle; }
     const Device& device() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "device").device; }
 
 protected:
-    DeviceChild() noexcept = default;
-    explicit DeviceChild(detail::Ref<State> state) noexcept : Handle<State>(moves::move(state)) {}
+    using VulkanObject<State, VkHandle>::VulkanObject;
 };
 
 inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::vk").device; }

@@ -9,6 +9,8 @@
 #include "vkrc/config.hpp"
 #include "vkrc/detail/moves.hpp"
 
+#include <vulkan/vulkan_core.h>
+
 #include <pthread.h>
 
 #include <cstdint>
@@ -298,5 +300,30 @@ protected:
 
 // Whether a wrapper destroys an adopted raw handle when its last owner goes.
 enum class Ownership : std::uint8_t { owned, borrowed };
+
+namespace detail {
+// The state of one Vulkan object: its raw handle and whether vkrc destroys
+// it. Each family's state derives from it, adds its parent and fields,
+// and names its wrapper in type_name (for an empty handle's UsageError).
+template <class VkHandle>
+class VulkanObjectState : public RefCounted {
+public:
+    VkHandle handle = VK_NULL_HANDLE;
+    Ownership ownership = Ownership::owned;
+    // Whether vkrc destroys the handle: it was made (or adopted) and is owned.
+    bool owns_handle() const noexcept { return handle != VK_NULL_HANDLE && ownership == Ownership::owned; }
+};
+}  // namespace detail
+
+// Base of the wrappers of a VulkanObjectState: the raw handle.
+template <class State, class VkHandle>
+class VulkanObject : public Handle<State> {
+public:
+    VkHandle vk() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "vk").handle; }
+
+protected:
+    VulkanObject() noexcept = default;
+    explicit VulkanObject(detail::Ref<State> state) noexcept : Handle<State>(moves::move(state)) {}
+};
 
 VKRC_END_NAMESPACE

@@ -96,21 +96,19 @@ struct FramebufferCreateInfo {
 };
 
 // Keeps its render pass and attachments alive.
-class Framebuffer : public Handle<detail::FramebufferState> {
+class Framebuffer : public VulkanObject<detail::FramebufferState, VkFramebuffer> {
 public:
-    Framebuffer() noexcept = default;
     static Framebuffer create(const Device& device, const FramebufferCreateInfo& info);
     // Wraps one made elsewhere for render_pass. Its attachments are not kept
     // alive: their maker keeps them until the framebuffer is gone. Ownership
     // as for PipelineLayout::adopt.
     static Framebuffer adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                              Ownership ownership);
-    VkFramebuffer vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkExtent2D extent() const VKRC_UNCHECKED_NOEXCEPT;
     const RenderPass& render_pass() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 // A driver's compiled-pipeline cache, persisted between runs.
@@ -157,21 +155,19 @@ struct ComputePipelineCreateInfo {
 };
 
 // A graphics or compute pipeline; keeps its layout alive.
-class Pipeline : public Handle<detail::PipelineState> {
+class Pipeline : public VulkanObject<detail::PipelineState, VkPipeline> {
 public:
-    Pipeline() noexcept = default;
     // Wraps a pipeline made elsewhere (any kind: graphics, compute, ray
     // tracing) with layout, so that it binds through vkrc. With
     // Ownership::owned vkrc destroys it once the GPU is done; borrowed, its
     // maker does (after vkrc's last use).
     static Pipeline adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                           Ownership ownership);
-    VkPipeline vk() const VKRC_UNCHECKED_NOEXCEPT;
     VkPipelineBindPoint bind_point() const VKRC_UNCHECKED_NOEXCEPT;
     const PipelineLayout& layout() const VKRC_UNCHECKED_NOEXCEPT;
 
 protected:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 class GraphicsPipeline : public Pipeline {
@@ -386,13 +382,12 @@ public:
     List<std::uint32_t> color_counts;  // per subpass
 };
 
-class FramebufferState final : public RefCounted {
+class FramebufferState final : public VulkanObjectState<VkFramebuffer> {
 public:
+    static constexpr const char* type_name = "vkrc::Framebuffer";
     ~FramebufferState() override;
     RenderPass render_pass;
     List<ImageView> attachments;
-    VkFramebuffer framebuffer = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     VkExtent2D extent{};
 };
 
@@ -403,20 +398,16 @@ public:
     bool loaded_from_file = false;
 };
 
-class PipelineState final : public RefCounted {
+class PipelineState final : public VulkanObjectState<VkPipeline> {
 public:
+    static constexpr const char* type_name = "vkrc::Pipeline";
     ~PipelineState() override;
     PipelineLayout layout;
-    VkPipeline pipeline = VK_NULL_HANDLE;
     VkPipelineBindPoint bind_point = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    Ownership ownership = Ownership::owned;
 };
 
 }  // namespace detail
 
-inline VkFramebuffer Framebuffer::vk() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::Framebuffer::vk").framebuffer;
-}
 inline VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Framebuffer::extent").extent;
 }
@@ -426,7 +417,6 @@ inline const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEP
 inline bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::PipelineCache::loaded_from_file").loaded_from_file;
 }
-inline VkPipeline Pipeline::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Pipeline::vk").pipeline; }
 inline VkPipelineBindPoint Pipeline::bind_point() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Pipeline::bind_point").bind_point;
 }

@@ -144,9 +144,8 @@ struct ImageViewCreateInfo {
 };
 
 // Keeps its Image (and so the image's memory and Device) alive.
-class ImageView : public Handle<detail::ImageViewState> {
+class ImageView : public VulkanObject<detail::ImageViewState, VkImageView> {
 public:
-    ImageView() noexcept = default;
     static ImageView create(const Image& image, const ImageViewCreateInfo& info = {});
     // Wraps a view of image made elsewhere, with the format and range it was
     // made with (aspectMask set). With Ownership::owned vkrc destroys it once
@@ -154,13 +153,12 @@ public:
     static ImageView adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership);
 
-    VkImageView vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Image& image() const VKRC_UNCHECKED_NOEXCEPT;
     VkFormat format() const VKRC_UNCHECKED_NOEXCEPT;
     const VkImageSubresourceRange& subresource_range() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 // Mirrors VkBufferViewCreateInfo (the buffer is the parent).
@@ -178,19 +176,17 @@ struct BufferViewCreateInfo {
 };
 
 // Keeps its Buffer alive.
-class BufferView : public Handle<detail::BufferViewState> {
+class BufferView : public VulkanObject<detail::BufferViewState, VkBufferView> {
 public:
-    BufferView() noexcept = default;
     static BufferView create(const Buffer& buffer, const BufferViewCreateInfo& info);
     // Wraps a view of buffer made elsewhere. With Ownership::owned vkrc
     // destroys it once the GPU is done; borrowed, its maker does.
     static BufferView adopt(const Buffer& buffer, VkBufferView view, Ownership ownership);
 
-    VkBufferView vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Buffer& buffer() const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 // Mirrors VkSamplerCreateInfo.
@@ -267,23 +263,21 @@ public:
     Ref<RefCounted> owner;
 };
 
-class ImageViewState final : public RefCounted {
+class ImageViewState final : public VulkanObjectState<VkImageView> {
 public:
+    static constexpr const char* type_name = "vkrc::ImageView";
     ~ImageViewState() override;
     Image image;
-    VkImageView view = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     VkFormat format = VK_FORMAT_UNDEFINED;
     VkImageSubresourceRange range{};
     SamplerYcbcrConversion ycbcr_conversion;  // if made with one
 };
 
-class BufferViewState final : public RefCounted {
+class BufferViewState final : public VulkanObjectState<VkBufferView> {
 public:
+    static constexpr const char* type_name = "vkrc::BufferView";
     ~BufferViewState() override;
     Buffer buffer;
-    VkBufferView view = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
 };
 
 class SamplerState final : public DeviceChildState<VkSampler> {
@@ -329,14 +323,12 @@ inline const Allocation& Image::allocation() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Image::allocation").allocation;
 }
 
-inline VkImageView ImageView::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::vk").view; }
 inline const Image& ImageView::image() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::image").image; }
 inline VkFormat ImageView::format() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::ImageView::format").format; }
 inline const VkImageSubresourceRange& ImageView::subresource_range() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::ImageView::subresource_range").range;
 }
 
-inline VkBufferView BufferView::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::BufferView::vk").view; }
 inline const Buffer& BufferView::buffer() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::BufferView::buffer").buffer;
 }

@@ -16,14 +16,12 @@ class SurfaceState;
 // A surface; keeps its Instance alive. At most one Swapchain uses it at a
 // time (Swapchain::create takes it); swapchains retired by re-creation keep
 // it alive until the GPU and the presentation engine are done with them.
-class Surface : public Handle<detail::SurfaceState> {
+class Surface : public VulkanObject<detail::SurfaceState, VkSurfaceKHR> {
 public:
-    Surface() noexcept = default;
     // Wraps a surface made for instance. With Ownership::owned vkrc destroys
     // it (vkDestroySurfaceKHR) when the last owner goes.
     static Surface adopt(const Instance& instance, VkSurfaceKHR surface, Ownership ownership);
 
-    VkSurfaceKHR vk() const VKRC_UNCHECKED_NOEXCEPT;
     const Instance& instance() const VKRC_UNCHECKED_NOEXCEPT;
     // vkGetPhysicalDeviceSurfaceCapabilitiesKHR.
     VkSurfaceCapabilitiesKHR capabilities(const PhysicalDevice& physical_device) const;
@@ -32,17 +30,16 @@ public:
     List<VkPresentModeKHR> present_modes(const PhysicalDevice& physical_device) const;
 
 private:
-    using Handle::Handle;
+    using VulkanObject::VulkanObject;
 };
 
 namespace detail {
 
-class SurfaceState final : public RefCounted {
+class SurfaceState final : public VulkanObjectState<VkSurfaceKHR> {
 public:
+    static constexpr const char* type_name = "vkrc::Surface";
     ~SurfaceState() override;
     Instance instance;
-    VkSurfaceKHR surface = VK_NULL_HANDLE;
-    Ownership ownership = Ownership::owned;
     // Vulkan allows one non-retired swapchain per surface. taken: a live
     // Swapchain holds the surface. releasing: the last one is gone but its
     // current Vulkan swapchain is not destroyed yet (frames hold its images,
@@ -54,7 +51,6 @@ public:
 
 }  // namespace detail
 
-inline VkSurfaceKHR Surface::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Surface::vk").surface; }
 inline const Instance& Surface::instance() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Surface::instance").instance;
 }
