@@ -1,5 +1,6 @@
 #include "vkrc/debug_utils.hpp"
 
+#include "adopt.hpp"
 #include "debug_message.hpp"
 
 #include <string>
@@ -40,15 +41,10 @@ DebugMessenger DebugMessenger::create(const Instance& instance, const DebugMesse
 
 DebugMessenger DebugMessenger::adopt(const Instance& instance, VkDebugUtilsMessengerEXT messenger,
                                      Ownership ownership) {
-    require_debug_utils(instance, "vkrc::DebugMessenger::adopt");
-    if (messenger == VK_NULL_HANDLE) {
-        throw UsageError("vkrc::DebugMessenger::adopt: the VkDebugUtilsMessengerEXT is VK_NULL_HANDLE");
-    }
-    detail::Ref<detail::DebugMessengerState> state(new detail::DebugMessengerState);
-    state->instance = instance;
-    state->handle = messenger;
-    state->ownership = ownership;
-    return DebugMessenger(std::move(state));
+    constexpr const char* who = "vkrc::DebugMessenger::adopt";
+    require_debug_utils(instance, who);
+    return DebugMessenger(detail::adopted_state<detail::DebugMessengerState, &detail::DebugMessengerState::instance>(
+        who, instance, "Instance", messenger, "VkDebugUtilsMessengerEXT", ownership));
 }
 
 void set_name(const Device& device, VkObjectType type, std::uint64_t handle, const char* name) {

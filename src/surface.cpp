@@ -1,7 +1,9 @@
 #include "vkrc/surface.hpp"
-#include <vector>
 
+#include "adopt.hpp"
 #include "text.hpp"
+
+#include <vector>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -14,16 +16,12 @@ SurfaceState::~SurfaceState() {
 }  // namespace detail
 
 Surface Surface::adopt(const Instance& instance, VkSurfaceKHR surface, Ownership ownership) {
-    if (!instance) throw UsageError("vkrc::Surface::adopt: the Instance handle is empty");
-    if (surface == VK_NULL_HANDLE) throw UsageError("vkrc::Surface::adopt: the VkSurfaceKHR is VK_NULL_HANDLE");
-    if (!instance.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME)) {
-        throw UsageError("vkrc::Surface::adopt: the instance was created without VK_KHR_surface");
+    constexpr const char* who = "vkrc::Surface::adopt";
+    if (instance && !instance.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME)) {
+        throw UsageError(std::string(who) + ": the instance was created without VK_KHR_surface");
     }
-    detail::Ref<detail::SurfaceState> state(new detail::SurfaceState);
-    state->instance = instance;
-    state->handle = surface;
-    state->ownership = ownership;
-    return Surface(std::move(state));
+    return Surface(detail::adopted_state<detail::SurfaceState, &detail::SurfaceState::instance>(
+        who, instance, "Instance", surface, "VkSurfaceKHR", ownership));
 }
 
 VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_device) const {
@@ -34,21 +32,13 @@ VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_de
 }
 
 List<VkSurfaceFormatKHR> Surface::formats(const PhysicalDevice& physical_device) const {
-    const auto& fn = instance().fn();
-    return detail::enumerate<VkSurfaceFormatKHR>(
-        [&](std::uint32_t* n, VkSurfaceFormatKHR* p) {
-            return fn.vkGetPhysicalDeviceSurfaceFormatsKHR(physical_device.vk(), vk(), n, p);
-        },
-        "vkGetPhysicalDeviceSurfaceFormatsKHR");
+    return detail::enumerate<VkSurfaceFormatKHR>(instance().fn().vkGetPhysicalDeviceSurfaceFormatsKHR,
+                                                 "vkGetPhysicalDeviceSurfaceFormatsKHR", physical_device.vk(), vk());
 }
 
 List<VkPresentModeKHR> Surface::present_modes(const PhysicalDevice& physical_device) const {
-    const auto& fn = instance().fn();
-    return detail::enumerate<VkPresentModeKHR>(
-        [&](std::uint32_t* n, VkPresentModeKHR* p) {
-            return fn.vkGetPhysicalDeviceSurfacePresentModesKHR(physical_device.vk(), vk(), n, p);
-        },
-        "vkGetPhysicalDeviceSurfacePresentModesKHR");
+    return detail::enumerate<VkPresentModeKHR>(instance().fn().vkGetPhysicalDeviceSurfacePresentModesKHR,
+                                               "vkGetPhysicalDeviceSurfacePresentModesKHR", physical_device.vk(), vk());
 }
 
 VKRC_END_NAMESPACE

@@ -1,5 +1,7 @@
 #include "vkrc/sync.hpp"
 
+#include "adopt.hpp"
+
 #include <bit>
 #include <string>
 
@@ -52,13 +54,8 @@ Fence Fence::create(const Device& device, bool signaled) {
 }
 
 Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
-    require_device(device, "vkrc::Fence::adopt");
-    if (fence == VK_NULL_HANDLE) throw UsageError("vkrc::Fence::adopt: the VkFence is VK_NULL_HANDLE");
-    detail::Ref<detail::FenceState> s(new detail::FenceState);
-    s->device = device;
-    s->handle = fence;
-    s->ownership = ownership;
-    return Fence(std::move(s));
+    return Fence(
+        detail::adopted_state<detail::FenceState>("vkrc::Fence::adopt", device, "Device", fence, "VkFence", ownership));
 }
 
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
@@ -107,13 +104,9 @@ Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial
 }
 
 Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership) {
-    require_device(device, "vkrc::Semaphore::adopt");
-    if (semaphore == VK_NULL_HANDLE) throw UsageError("vkrc::Semaphore::adopt: the VkSemaphore is VK_NULL_HANDLE");
-    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
-    s->device = device;
-    s->handle = semaphore;
+    auto s = detail::adopted_state<detail::SemaphoreState>("vkrc::Semaphore::adopt", device, "Device", semaphore,
+                                                           "VkSemaphore", ownership);
     s->type = type;
-    s->ownership = ownership;
     return Semaphore(std::move(s));
 }
 
@@ -162,13 +155,8 @@ Event Event::create(const Device& device, bool device_only) {
 }
 
 Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {
-    require_device(device, "vkrc::Event::adopt");
-    if (event == VK_NULL_HANDLE) throw UsageError("vkrc::Event::adopt: the VkEvent is VK_NULL_HANDLE");
-    detail::Ref<detail::EventState> s(new detail::EventState);
-    s->device = device;
-    s->handle = event;
-    s->ownership = ownership;
-    return Event(std::move(s));
+    return Event(
+        detail::adopted_state<detail::EventState>("vkrc::Event::adopt", device, "Device", event, "VkEvent", ownership));
 }
 
 void Event::set() const {

@@ -3,8 +3,9 @@
 
 #include "vkrc/error.hpp"
 
-#include <cstdint>
 #include "vkrc/detail/span.hpp"
+
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,12 @@ std::vector<T> enumerate(F&& call, const char* what) {
     } while (r == VK_INCOMPLETE);
     items.resize(count);
     return items;
+}
+
+// The same for a Vulkan function that takes args... before the count and data.
+template <class T, class Function, class... Args>
+std::vector<T> enumerate(Function function, const char* what, Args... args) {
+    return enumerate<T>([&](std::uint32_t* count, T* data) { return function(args..., count, data); }, what);
 }
 
 }  // namespace detail

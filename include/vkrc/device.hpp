@@ -78,7 +78,6 @@ struct QueueAssignment;
 // A logical device; keeps its PhysicalDevice (and so its Instance) alive.
 class Device : public Handle<detail::DeviceState> {
 public:
-    Device() noexcept = default;
     static Device create(const PhysicalDevice& physical_device, const DeviceCreateInfo& info);
     // The defaults: a separate overload so that a caller's translation unit
     // does not build and destroy a default create-info (bench/header_cost).

@@ -67,7 +67,6 @@ struct InstanceCreateInfo {
 
 class Instance : public Handle<detail::InstanceState> {
 public:
-    Instance() noexcept = default;
     static Instance create(const InstanceCreateInfo& info);
     // The defaults: a separate overload so that a caller's translation unit
     // does not build and destroy a default create-info (bench/header_cost).
@@ -162,7 +161,6 @@ private:
 // A physical device; keeps its Instance alive. Properties are read once.
 class PhysicalDevice : public Handle<detail::PhysicalDeviceState> {
 public:
-    PhysicalDevice() noexcept = default;
     // Chooses the best device that meets the requirements, or throws
     // NoSuitableDeviceError naming each device and why it was rejected.
     static PhysicalDevice select(const Instance& instance, const DeviceRequirements& requirements);

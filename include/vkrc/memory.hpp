@@ -370,7 +370,6 @@ private:
 // work submitted before then has completed.
 class Allocation : public Handle<detail::AllocationState>, public detail::MappedWrites<Allocation> {
 public:
-    Allocation() noexcept = default;
     // Allocates for request from allocator (null: the device's default).
     static Allocation create(const Device& device, const AllocationRequest& request,
                              const SharedAllocator& allocator = {});

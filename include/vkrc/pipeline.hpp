@@ -172,8 +172,6 @@ protected:
 
 class GraphicsPipeline : public Pipeline {
 public:
-    GraphicsPipeline() noexcept = default;
-
 private:
     friend class GraphicsPipelineBuilder;
     using Pipeline::Pipeline;
@@ -181,7 +179,6 @@ private:
 
 class ComputePipeline : public Pipeline {
 public:
-    ComputePipeline() noexcept = default;
     static ComputePipeline create(const PipelineLayout& layout, const ShaderModule& module,
                                   const char* entry_point = "main", const PipelineCache& cache = {});
     static ComputePipeline create(const PipelineLayout& layout, const ComputePipelineCreateInfo& info);

@@ -101,7 +101,6 @@ struct UploaderCreateInfo {
 // is the Uploader's queue's (or that were never used on another family).
 class Uploader : public Handle<detail::UploaderState> {
 public:
-    Uploader() noexcept = default;
     static Uploader create(const UploaderCreateInfo& info);
 
     const Queue& queue() const VKRC_UNCHECKED_NOEXCEPT;
@@ -161,7 +160,6 @@ struct FrameAllocation {
 // has not finished the frame that last used it. One thread at a time.
 class FrameRing : public Handle<detail::FrameRingState> {
 public:
-    FrameRing() noexcept = default;
     static FrameRing create(const FrameRingCreateInfo& info);
 
     const Buffer& buffer() const VKRC_UNCHECKED_NOEXCEPT;

@@ -166,7 +166,6 @@ struct SwapchainCreateInfo {
 // until every frame that used it is dropped and its work has completed.
 class Swapchain final : public Handle<detail::SwapchainState>, public Presenter {
 public:
-    Swapchain() noexcept = default;
     // Creates the swapchain and takes the surface: a second live Swapchain
     // for the same surface is a UsageError. After a previous Swapchain of the
     // surface was dropped, waits for the device to be idle so that its Vulkan
@@ -228,7 +227,6 @@ struct HeadlessPresenterCreateInfo {
 // being rewritten while the GPU still renders into it.
 class HeadlessPresenter final : public Handle<detail::HeadlessPresenterState>, public Presenter {
 public:
-    HeadlessPresenter() noexcept = default;
     static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
 
     PresentStatus acquire(Frame& frame) override;
