@@ -23,6 +23,7 @@ struct PipelineLayoutCreateInfo {
     List<DescriptorSetLayout> set_layouts{};
     // Optional (empty: no push constants). Read during create().
     List<VkPushConstantRange> push_constant_ranges{};
+    // Optional (default none).
     VkPipelineLayoutCreateFlags flags = 0;
     // Optional pNext chain; read during create only.
     const void* next = nullptr;
@@ -60,6 +61,7 @@ struct RenderPassCreateInfo {
     List<SubpassDescription> subpasses{};
     // Optional (empty: none).
     List<VkSubpassDependency> dependencies{};
+    // Optional (default none).
     VkRenderPassCreateFlags flags = 0;
     // Optional pNext chain; read during create only.
     const void* next = nullptr;
@@ -82,7 +84,8 @@ private:
 struct FramebufferCreateInfo {
     // Required. The Framebuffer keeps it alive.
     RenderPass render_pass{};
-    // One per render-pass attachment; the Framebuffer keeps them alive.
+    // Required: one per render-pass attachment (empty for an attachment-less
+    // pass, or with IMAGELESS_BIT). The Framebuffer keeps them alive.
     List<ImageView> attachments{};
     // Required, non-zero.
     std::uint32_t width = 0;
@@ -90,6 +93,7 @@ struct FramebufferCreateInfo {
     std::uint32_t height = 0;
     // Optional (default 1), non-zero.
     std::uint32_t layers = 1;
+    // Optional (default none).
     VkFramebufferCreateFlags flags = 0;
     // Optional pNext chain; read during create only.
     const void* next = nullptr;
@@ -144,11 +148,11 @@ struct Specialization {
 
 // Mirrors VkComputePipelineCreateInfo and its one stage.
 struct ComputePipelineCreateInfo {
-    VkPipelineCreateFlags flags = 0;
+    VkPipelineCreateFlags flags = 0;  // optional (default none)
     ShaderModule module{};             // required; kept alive by nothing after create
     const char* entry_point = "main";  // read during create only
     Specialization specialization{};   // optional
-    VkPipelineShaderStageCreateFlags stage_flags = 0;
+    VkPipelineShaderStageCreateFlags stage_flags = 0;  // optional (default none)
     PipelineCache cache{};             // optional
     const void* stage_next = nullptr;  // optional pNext of the stage; read during create only
     const void* next = nullptr;        // optional pNext; read during create only
@@ -275,11 +279,14 @@ public:
     // rasterization their polygon mode, cull mode and front face; depth_stencil
     // depth_test's; multisample samples'.
     GraphicsPipelineBuilder& rasterization(const RasterizationState& state);
+    // The whole depth and stencil state (default: DepthStencilState's defaults).
     GraphicsPipelineBuilder& depth_stencil(const DepthStencilState& state);
+    // The whole multisample state (default: one sample, no sample shading).
     GraphicsPipelineBuilder& multisample(const MultisampleState& state);
     // One blend state per colour attachment (build() checks the count);
     // replaces blend() for every attachment. Different states need independentBlend.
     GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states);
+    // The blend constants (default zero; copied), unless BLEND_CONSTANTS is dynamic.
     GraphicsPipelineBuilder& blend_constants(const float (&constants)[4]);
     // Enables the logic op (needs the logicOp feature) instead of blending.
     GraphicsPipelineBuilder& logic_op(VkLogicOp op);
@@ -291,6 +298,7 @@ public:
     // Replaces the dynamic state list (viewport and scissor by default).
     // With VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT the counts are dynamic too.
     GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states);
+    // Restarts strips and fans at the all-ones index value (default off).
     GraphicsPipelineBuilder& primitive_restart(bool enable);
     // Specialization constants of the shader at stage (added with shader();
     // build() throws UsageError when there is none). Copied.
@@ -299,11 +307,15 @@ public:
     GraphicsPipelineBuilder& tessellation(std::uint32_t patch_control_points);
     // Multiview mask for dynamic rendering (needs the multiview feature).
     GraphicsPipelineBuilder& view_mask(std::uint32_t mask);
+    // VkGraphicsPipelineCreateInfo::flags (default none).
     GraphicsPipelineBuilder& flags(VkPipelineCreateFlags flags);
     // Chained into VkGraphicsPipelineCreateInfo (after vkrc's rendering info);
     // must live until build().
     GraphicsPipelineBuilder& next(const void* chain);
 
+    // vkCreateGraphicsPipelines with what was set, through cache if given
+    // (UsageError for what the builder can check: an empty layout, no stage,
+    // a blend count other than the colour attachments'). It may build again.
     GraphicsPipeline build(const PipelineCache& cache = {}) const;
 
 private:
