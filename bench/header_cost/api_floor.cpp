@@ -1,10 +1,9 @@
 // Header-cost probe: no vkrc, only the standard and Vulkan headers that
 // vkrc's public API is made of (std::exception as the base of its errors,
-// <type_traits> under vkrc::Span and the moves, <initializer_list> and <new>
-// under vkrc::List and vkrc::Function, <cstring> for mapped copies, and
-// pthread.h under vkrc::Mutex), and an empty main. The least a translation
-// unit using vkrc's API as it stands can cost; keep the list in step with
-// include/vkrc.
+// <initializer_list> and <new> under vkrc::List and vkrc::Function, <cstring>
+// for mapped copies, and pthread.h under vkrc::Mutex), and an empty main.
+// The least a translation unit using vkrc's API as it stands can cost; keep
+// the list in step with include/vkrc.
 #include <vulkan/vulkan_core.h>
 
 #include <pthread.h>
@@ -15,6 +14,5 @@
 #include <exception>
 #include <initializer_list>
 #include <new>
-#include <type_traits>
 
 int main() {}
