@@ -141,7 +141,9 @@ inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttach
 }  // namespace detail
 
 // A command buffer; keeps its pool alive and returns to it when dropped (once
-// the GPU has finished the work submitted before the drop).
+// the GPU has finished the work submitted before the drop). A recording
+// method's Raw<VkX> parameter takes the vkrc wrapper (a Buffer, an Image, ...)
+// or a raw handle made by other code: one method for both.
 class CommandBuffer : public Handle<detail::CommandBufferState> {
 public:
     CommandBuffer() noexcept = default;
@@ -178,12 +180,7 @@ public:
     void reset_commands(VkCommandBufferResetFlags flags = 0) const;
 
     // Render passes and dynamic rendering
-    void begin_render_pass(const RenderPass& render_pass, const Framebuffer& framebuffer, VkRect2D render_area,
-                           Span<const VkClearValue> clear_values,
-                           VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
-        begin_render_pass(render_pass.vk(), framebuffer.vk(), render_area, clear_values, contents);
-    }
-    void begin_render_pass(VkRenderPass render_pass, VkFramebuffer framebuffer, VkRect2D render_area,
+    void begin_render_pass(Raw<VkRenderPass> render_pass, Raw<VkFramebuffer> framebuffer, VkRect2D render_area,
                            Span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
@@ -216,14 +213,10 @@ public:
     void bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT {
         bind_pipeline(pipeline.bind_point(), pipeline.vk());
     }
-    void bind_vertex_buffer(std::uint32_t binding, const Buffer& buffer,
-                            VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        bind_vertex_buffer(binding, buffer.vk(), offset);
-    }
-    void bind_vertex_buffer(std::uint32_t binding, VkBuffer buffer,
+    void bind_vertex_buffer(std::uint32_t binding, Raw<VkBuffer> buffer,
                             VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffer");
-        fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, &buffer, &offset);
+        fn_->vkCmdBindVertexBuffers(cmd_, binding, 1, buffer.get(), &offset);
     }
     void bind_vertex_buffers(std::uint32_t first_binding, Span<const VkBuffer> buffers,
                              Span<const VkDeviceSize> offsets) const VKRC_UNCHECKED_NOEXCEPT {
@@ -231,11 +224,7 @@ public:
         fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                     offsets.data());
     }
-    void bind_index_buffer(const Buffer& buffer, VkDeviceSize offset = 0,
-                           VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
-        bind_index_buffer(buffer.vk(), offset, type);
-    }
-    void bind_index_buffer(VkBuffer buffer, VkDeviceSize offset = 0,
+    void bind_index_buffer(Raw<VkBuffer> buffer, VkDeviceSize offset = 0,
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_index_buffer");
         fn_->vkCmdBindIndexBuffer(cmd_, buffer, offset, type);
@@ -252,18 +241,10 @@ public:
                               Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         bind_descriptor_sets(pipeline.bind_point(), pipeline.layout().vk(), first_set, sets, dynamic_offsets);
     }
-    void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
-                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
-        push_constants(layout.vk(), stages, offset, size, data);
-    }
     // Push descriptors (VK_KHR_push_descriptor, which must be enabled on the
     // device: the function is called as loaded). Writes set `set` of layout,
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
-    void push_descriptor_set(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t set,
-                             Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
-        push_descriptor_set(bind_point, layout.vk(), set, writes);
-    }
-    void push_descriptor_set(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t set,
+    void push_descriptor_set(VkPipelineBindPoint bind_point, Raw<VkPipelineLayout> layout, std::uint32_t set,
                              Span<const VkWriteDescriptorSet> writes) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set");
         fn_->vkCmdPushDescriptorSetKHR(cmd_, bind_point, layout, set, static_cast<std::uint32_t>(writes.size()),
@@ -282,7 +263,7 @@ public:
         fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template, layout, set, data);
     }
     template <class T>
-    void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, const T& value,
+    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         push_constants(layout, stages, offset, sizeof(T), &value);
     }
@@ -316,48 +297,30 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch");
         fn_->vkCmdDispatch(cmd_, x, y, z);
     }
-    // Typed overloads read the raw handles; raw ones are the escape hatch.
-    // Each makes its vkCmd* call itself: forwarding a std::span to the raw
-    // overload costs every includer's compile (bench/header_cost).
-    void copy_buffer(const Buffer& src, const Buffer& dst,
+    void copy_buffer(Raw<VkBuffer> src, Raw<VkBuffer> dst,
                      Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_buffer(src.vk(), dst.vk(), regions);
-    }
-    void copy_buffer_to_image(const Buffer& src, const Image& dst, VkImageLayout dst_layout,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_buffer_to_image(src.vk(), dst.vk(), dst_layout, regions);
-    }
-    void copy_image_to_buffer(const Image& src, VkImageLayout src_layout, const Buffer& dst,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_image_to_buffer(src.vk(), src_layout, dst.vk(), regions);
-    }
-    void fill_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size,
-                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
-        fill_buffer(dst.vk(), offset, size, data);
-    }
-    void copy_buffer(VkBuffer src, VkBuffer dst, Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
         fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
     }
-    void copy_buffer_to_image(VkBuffer src, VkImage dst, VkImageLayout dst_layout,
+    void copy_buffer_to_image(Raw<VkBuffer> src, Raw<VkImage> dst, VkImageLayout dst_layout,
                               Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
         fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                                     regions.data());
     }
-    void copy_image_to_buffer(VkImage src, VkImageLayout src_layout, VkBuffer dst,
+    void copy_image_to_buffer(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkBuffer> dst,
                               Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
         fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()),
                                     regions.data());
     }
-    void copy_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+    void copy_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
                     Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
         fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                             regions.data());
     }
-    void fill_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size,
+    void fill_buffer(Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize size,
                      std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fill_buffer");
         fn_->vkCmdFillBuffer(cmd_, dst, offset, size, data);
@@ -371,17 +334,11 @@ public:
     void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
                           Span<const VkImageMemoryBarrier2> images,
                           VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
-    void set_event(const Event& event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
-        set_event(event.vk(), dependency);
-    }
-    void set_event(VkEvent event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+    void set_event(Raw<VkEvent> event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
         fn_->vkCmdSetEvent2(cmd_, event, &dependency);
     }
-    void reset_event(const Event& event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
-        reset_event(event.vk(), stage_mask);
-    }
-    void reset_event(VkEvent event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+    void reset_event(Raw<VkEvent> event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
         fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
     }
@@ -395,20 +352,12 @@ public:
     }
 
     // Queries
-    void reset_query_pool(const QueryPool& pool, std::uint32_t first_query,
-                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
-        reset_query_pool(pool.vk(), first_query, query_count);
-    }
-    void reset_query_pool(VkQueryPool pool, std::uint32_t first_query,
+    void reset_query_pool(Raw<VkQueryPool> pool, std::uint32_t first_query,
                           std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
         fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
     }
-    void write_timestamp(VkPipelineStageFlags2 stage, const QueryPool& pool,
-                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        write_timestamp(stage, pool.vk(), query);
-    }
-    void write_timestamp(VkPipelineStageFlags2 stage, VkQueryPool pool,
+    void write_timestamp(VkPipelineStageFlags2 stage, Raw<VkQueryPool> pool,
                          std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
         fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
@@ -416,48 +365,28 @@ public:
 
     // Transfer commands on whole images and buffers. Layouts are the images'
     // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
-    // during the call only. Typed overloads read the raw handles.
-    void blit_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
-        blit_image(src.vk(), src_layout, dst.vk(), dst_layout, regions, filter);
-    }
-    void blit_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+    // during the call only.
+    void blit_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
                     Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
         fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                             regions.data(), filter);
     }
     // src: multisampled; dst: single-sample, same format.
-    void resolve_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        resolve_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
-    }
-    void resolve_image(VkImage src, VkImageLayout src_layout, VkImage dst, VkImageLayout dst_layout,
+    void resolve_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
                        Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
         fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
                                regions.data());
     }
-    void copy_image(const Image& src, VkImageLayout src_layout, const Image& dst, VkImageLayout dst_layout,
-                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_image(src.vk(), src_layout, dst.vk(), dst_layout, regions);
-    }
     // Outside rendering; the image needs TRANSFER_DST usage.
-    void clear_color_image(const Image& image, VkImageLayout layout, const VkClearColorValue& color,
-                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        clear_color_image(image.vk(), layout, color, ranges);
-    }
-    void clear_color_image(VkImage image, VkImageLayout layout, const VkClearColorValue& color,
+    void clear_color_image(Raw<VkImage> image, VkImageLayout layout, const VkClearColorValue& color,
                            Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
         fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
                                   ranges.data());
     }
-    void clear_depth_stencil_image(const Image& image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        clear_depth_stencil_image(image.vk(), layout, value, ranges);
-    }
-    void clear_depth_stencil_image(VkImage image, VkImageLayout layout, const VkClearDepthStencilValue& value,
+    void clear_depth_stencil_image(Raw<VkImage> image, VkImageLayout layout, const VkClearDepthStencilValue& value,
                                    Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
         fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
@@ -473,10 +402,7 @@ public:
     // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
     // this call (data need not outlive it). size and offset are multiples of
     // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
-    void update_buffer(const Buffer& dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
-        update_buffer(dst.vk(), offset, size, data);
-    }
-    void update_buffer(VkBuffer dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
+    void update_buffer(Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
 #if VKRC_RUNTIME_CHECKS
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::update_buffer");
         if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
@@ -488,52 +414,32 @@ public:
 
     // Indirect work: parameters read by the GPU from buffer (INDIRECT_BUFFER
     // usage) at execution. stride 0 means tightly packed commands.
-    void draw_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                       std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        draw_indirect(buffer.vk(), offset, draw_count, stride);
-    }
-    void draw_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+    void draw_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset, std::uint32_t draw_count,
                        std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect");
         fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
                                stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
     }
-    void draw_indexed_indirect(const Buffer& buffer, VkDeviceSize offset, std::uint32_t draw_count,
-                               std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        draw_indexed_indirect(buffer.vk(), offset, draw_count, stride);
-    }
-    void draw_indexed_indirect(VkBuffer buffer, VkDeviceSize offset, std::uint32_t draw_count,
+    void draw_indexed_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset, std::uint32_t draw_count,
                                std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect");
         fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
                                       stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
     }
-    void dispatch_indirect(const Buffer& buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        dispatch_indirect(buffer.vk(), offset);
-    }
-    void dispatch_indirect(VkBuffer buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
+    void dispatch_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch_indirect");
         fn_->vkCmdDispatchIndirect(cmd_, buffer, offset);
     }
     // The draw count comes from count_buffer (a uint32 at count_offset),
     // clamped to max_draw_count. Needs the Vulkan 1.2 drawIndirectCount feature.
-    void draw_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
+    void draw_indirect_count(Raw<VkBuffer> buffer, VkDeviceSize offset, Raw<VkBuffer> count_buffer,
                              VkDeviceSize count_offset, std::uint32_t max_draw_count,
                              std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        draw_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
-    }
-    void draw_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer, VkDeviceSize count_offset,
-                             std::uint32_t max_draw_count, std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect_count");
         fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
                                     stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
     }
-    void draw_indexed_indirect_count(const Buffer& buffer, VkDeviceSize offset, const Buffer& count_buffer,
-                                     VkDeviceSize count_offset, std::uint32_t max_draw_count,
-                                     std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        draw_indexed_indirect_count(buffer.vk(), offset, count_buffer.vk(), count_offset, max_draw_count, stride);
-    }
-    void draw_indexed_indirect_count(VkBuffer buffer, VkDeviceSize offset, VkBuffer count_buffer,
+    void draw_indexed_indirect_count(Raw<VkBuffer> buffer, VkDeviceSize offset, Raw<VkBuffer> count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                      std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect_count");
@@ -542,30 +448,18 @@ public:
     }
 
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
-    void begin_query(const QueryPool& pool, std::uint32_t query,
-                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        begin_query(pool.vk(), query, flags);
-    }
-    void begin_query(VkQueryPool pool, std::uint32_t query,
+    void begin_query(Raw<VkQueryPool> pool, std::uint32_t query,
                      VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
         fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
     }
-    void end_query(const QueryPool& pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        end_query(pool.vk(), query);
-    }
-    void end_query(VkQueryPool pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
+    void end_query(Raw<VkQueryPool> pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
         fn_->vkCmdEndQuery(cmd_, pool, query);
     }
     // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
-    void copy_query_results(const QueryPool& pool, std::uint32_t first_query, std::uint32_t query_count,
-                            const Buffer& dst, VkDeviceSize offset, VkDeviceSize stride,
-                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
-        copy_query_results(pool.vk(), first_query, query_count, dst.vk(), offset, stride, flags);
-    }
-    void copy_query_results(VkQueryPool pool, std::uint32_t first_query, std::uint32_t query_count, VkBuffer dst,
-                            VkDeviceSize offset, VkDeviceSize stride,
+    void copy_query_results(Raw<VkQueryPool> pool, std::uint32_t first_query, std::uint32_t query_count,
+                            Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize stride,
                             VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
         fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
@@ -710,12 +604,7 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
         fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
     }
-    void bind_descriptor_sets(VkPipelineBindPoint bind_point, const PipelineLayout& layout, std::uint32_t first_set,
-                              Span<const VkDescriptorSet> sets,
-                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
-        bind_descriptor_sets(bind_point, layout.vk(), first_set, sets, dynamic_offsets);
-    }
-    void bind_descriptor_sets(VkPipelineBindPoint bind_point, VkPipelineLayout layout, std::uint32_t first_set,
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, Raw<VkPipelineLayout> layout, std::uint32_t first_set,
                               Span<const VkDescriptorSet> sets,
                               Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
@@ -723,8 +612,8 @@ public:
                                      sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
                                      dynamic_offsets.data());
     }
-    void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
-                        const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, std::uint32_t offset,
+                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
         fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
     }

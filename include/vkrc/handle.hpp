@@ -326,4 +326,23 @@ protected:
     explicit VulkanObject(detail::Ref<State> state) noexcept : Handle<State>(moves::move(state)) {}
 };
 
+// A raw handle parameter that also takes a vkrc wrapper (any class whose
+// vk() returns VkHandle), so one recording method serves both
+// cmd.copy_buffer(buffer, ...) and cmd.copy_buffer(raw_buffer, ...). It reads
+// the wrapper's vk() at the call and keeps nothing alive.
+template <class VkHandle>
+class Raw {
+public:
+    Raw(VkHandle handle) noexcept : handle_(handle) {}
+    template <class Wrapper>
+    requires requires(const Wrapper& wrapper, void (*take)(VkHandle)) { take(wrapper.vk()); }
+    Raw(const Wrapper& wrapper) VKRC_UNCHECKED_NOEXCEPT : handle_(wrapper.vk()) {}
+    operator VkHandle() const noexcept { return handle_; }
+    // For Vulkan calls that take an array of handles.
+    const VkHandle* get() const noexcept { return &handle_; }
+
+private:
+    VkHandle handle_;
+};
+
 VKRC_END_NAMESPACE

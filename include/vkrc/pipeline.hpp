@@ -148,14 +148,14 @@ struct Specialization {
 
 // Mirrors VkComputePipelineCreateInfo and its one stage.
 struct ComputePipelineCreateInfo {
-    VkPipelineCreateFlags flags = 0;  // optional (default none)
-    ShaderModule module{};             // required; kept alive by nothing after create
-    const char* entry_point = "main";  // read during create only
-    Specialization specialization{};   // optional
+    VkPipelineCreateFlags flags = 0;                   // optional (default none)
+    ShaderModule module{};                             // required; kept alive by nothing after create
+    const char* entry_point = "main";                  // read during create only
+    Specialization specialization{};                   // optional
     VkPipelineShaderStageCreateFlags stage_flags = 0;  // optional (default none)
-    PipelineCache cache{};             // optional
-    const void* stage_next = nullptr;  // optional pNext of the stage; read during create only
-    const void* next = nullptr;        // optional pNext; read during create only
+    PipelineCache cache{};                             // optional
+    const void* stage_next = nullptr;                  // optional pNext of the stage; read during create only
+    const void* next = nullptr;                        // optional pNext; read during create only
 };
 
 // A graphics or compute pipeline; keeps its layout alive.
