@@ -20,8 +20,9 @@ template <class Names>
 void add_unique(Names& names, const char* name) {
     if (!contains(names, name)) names.push_back(name);
 }
-// The lower-case hexadecimal digits of v, without a prefix.
-std::string hex(std::uint64_t v);
+// The lower-case hexadecimal digits of v, without a prefix, zero-padded to
+// at least digits.
+std::string hex(std::uint64_t v, std::size_t digits = 1);
 
 // Vulkan's two-call enumeration: call(&count, nullptr), then call(&count,
 // data) until it stops returning VK_INCOMPLETE; what names the function.
