@@ -594,14 +594,8 @@ AllocatorStatistics PoolAllocator::statistics(DeviceView d) const {
         Shard& shard = impl_->shards[i];
         LockGuard lock(shard.mutex);
         stats.vk_allocate_calls += shard.stats.vk_allocate_calls;
-        for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h) {
-            const HeapStatistics& from = shard.stats.heaps[h];
-            HeapStatistics& to = stats.heaps[h];
-            to.block_bytes += from.block_bytes;
-            to.allocation_bytes += from.allocation_bytes;
-            to.block_count += from.block_count;
-            to.allocation_count += from.allocation_count;
-        }
+        for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h)
+            detail::add_tallies(stats.heaps[h], shard.stats.heaps[h]);
     }
     fill_budget(d, stats);
     return stats;
