@@ -103,6 +103,8 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 
 // ---------------------------------------------------------------- the device's allocators
 
+AllocatorRegistry::~AllocatorRegistry() = default;
+
 DeviceAllocator& AllocatorRegistry::default_allocator() {
     LockGuard lock(mutex_);
     if (!default_) {

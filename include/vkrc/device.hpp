@@ -380,6 +380,7 @@ private:
 // frees can still reach it (memory.cpp).
 class AllocatorRegistry {
 public:
+    ~AllocatorRegistry();  // in memory.cpp, where DeviceAllocator is complete
     // The device's default allocator, a PoolAllocator made on first use.
     DeviceAllocator& default_allocator();
     // Keeps allocator until release_all (once per allocator).
