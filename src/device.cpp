@@ -1,7 +1,6 @@
 #include "vkrc/device.hpp"
 
 #include "text.hpp"
-#include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
 #include "vkrc/extension_functions.hpp"
 
 #include <algorithm>

@@ -103,6 +103,7 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 
 // ---------------------------------------------------------------- the device's allocators
 
+AllocatorRegistry::AllocatorRegistry() = default;
 AllocatorRegistry::~AllocatorRegistry() = default;
 
 DeviceAllocator& AllocatorRegistry::default_allocator() {

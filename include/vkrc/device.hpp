@@ -380,7 +380,10 @@ private:
 // frees can still reach it (memory.cpp).
 class AllocatorRegistry {
 public:
-    ~AllocatorRegistry();  // in memory.cpp, where DeviceAllocator is complete
+    // In memory.cpp, where DeviceAllocator is complete (the constructor
+    // destroys the list when unwinding).
+    AllocatorRegistry();
+    ~AllocatorRegistry();
     // The device's default allocator, a PoolAllocator made on first use.
     DeviceAllocator& default_allocator();
     // Keeps allocator until release_all (once per allocator).
