@@ -1,7 +1,6 @@
 #include "vkrc/device.hpp"
 
 #include "text.hpp"
-#include "vkrc/memory.hpp"  // DeviceAllocator, for the state's allocator references
 #include "vkrc/extension_functions.hpp"
 
 #include <algorithm>
@@ -335,6 +334,77 @@ void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& i
     }
 }
 
+// Throws UsageError unless the physical device has request's family and that many queues in it.
+void check_queue_request(const PhysicalDevice& physical, const QueueRequest& r) {
+    const auto& families = physical.queue_families();
+    if (r.queue_family_index >= families.size()) {
+        throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) +
+                         " does not exist (the device has " + std::to_string(families.size()) + ")");
+    }
+    if (r.queue_priorities.empty() || r.queue_priorities.size() > families[r.queue_family_index].queueCount) {
+        throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) + " has " +
+                         std::to_string(families[r.queue_family_index].queueCount) + " queues; asked for " +
+                         std::to_string(r.queue_priorities.size()));
+    }
+}
+
+// The create infos of the checked requests; they point into requests.
+std::vector<VkDeviceQueueCreateInfo> queue_create_infos(const PhysicalDevice& physical,
+                                                        const std::vector<QueueRequest>& requests) {
+    std::vector<VkDeviceQueueCreateInfo> infos;
+    for (const auto& r : requests) {
+        check_queue_request(physical, r);
+        VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        q.pNext = r.next;
+        q.queueFamilyIndex = r.queue_family_index;
+        q.queueCount = static_cast<std::uint32_t>(r.queue_priorities.size());
+        q.pQueuePriorities = r.queue_priorities.data();
+        infos.push_back(q);
+    }
+    return infos;
+}
+
+// The extensions asked for, and those vkrc enables where the device has them.
+std::vector<const char*> device_extensions(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
+    std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
+    if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
+        detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
+    }
+    // The spec requires it enabled wherever it is offered (portability drivers).
+    if (physical.supports_extension("VK_KHR_portability_subset")) {
+        detail::add_unique(extensions, "VK_KHR_portability_subset");
+    }
+    return extensions;
+}
+
+// The features asked for, plus those vkrc needs, chained for vkCreateDevice.
+// Its members point at each other, so it is made in place and never copied.
+struct FeatureChain {
+    explicit FeatureChain(const DeviceCreateInfo& info)
+        : f13(info.vulkan13_features), f12(info.vulkan12_features), f11(info.vulkan11_features) {
+        f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+        f13.pNext = const_cast<void*>(info.next);
+        f13.synchronization2 = VK_TRUE;
+        f13.dynamicRendering = VK_TRUE;
+        // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
+        f13.maintenance4 = VK_TRUE;
+        f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+        f12.pNext = &f13;
+        f12.timelineSemaphore = VK_TRUE;
+        f11.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES;
+        f11.pNext = &f12;
+        features.pNext = &f11;
+        features.features = info.enabled_features;
+    }
+    FeatureChain(const FeatureChain&) = delete;
+    FeatureChain& operator=(const FeatureChain&) = delete;
+
+    VkPhysicalDeviceVulkan13Features f13;
+    VkPhysicalDeviceVulkan12Features f12;
+    VkPhysicalDeviceVulkan11Features f11;
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+};
+
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
                  Span<const char* const> extensions, detail::Ref<detail::DeviceState>& state) {
     state = detail::Ref<detail::DeviceState>(new detail::DeviceState);
@@ -357,54 +427,11 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");
     std::vector<QueueRequest> requests(info.queue_requests.begin(), info.queue_requests.end());
     if (requests.empty()) add_role_requests(physical, info, requests);
-    std::vector<VkDeviceQueueCreateInfo> queue_infos;
-    for (const auto& r : requests) {
-        if (r.queue_family_index >= physical.queue_families().size()) {
-            throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) +
-                             " does not exist (the device has " + std::to_string(physical.queue_families().size()) +
-                             ")");
-        }
-        if (r.queue_priorities.empty() ||
-            r.queue_priorities.size() > physical.queue_families()[r.queue_family_index].queueCount) {
-            throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) + " has " +
-                             std::to_string(physical.queue_families()[r.queue_family_index].queueCount) +
-                             " queues; asked for " + std::to_string(r.queue_priorities.size()));
-        }
-        VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-        q.pNext = r.next;
-        q.queueFamilyIndex = r.queue_family_index;
-        q.queueCount = static_cast<std::uint32_t>(r.queue_priorities.size());
-        q.pQueuePriorities = r.queue_priorities.data();
-        queue_infos.push_back(q);
-    }
+    const auto queue_infos = queue_create_infos(physical, requests);
+    const auto extensions = device_extensions(physical, info);
+    const FeatureChain features(info);
 
-    std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
-    if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
-        detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
-    }
-    // The spec requires it enabled wherever it is offered (portability drivers).
-    if (physical.supports_extension("VK_KHR_portability_subset")) {
-        detail::add_unique(extensions, "VK_KHR_portability_subset");
-    }
-
-    auto f13 = info.vulkan13_features;
-    f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-    f13.pNext = const_cast<void*>(info.next);
-    f13.synchronization2 = VK_TRUE;
-    f13.dynamicRendering = VK_TRUE;
-    // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
-    f13.maintenance4 = VK_TRUE;
-    auto f12 = info.vulkan12_features;
-    f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-    f12.pNext = &f13;
-    f12.timelineSemaphore = VK_TRUE;
-    auto f11 = info.vulkan11_features;
-    f11.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES;
-    f11.pNext = &f12;
-    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f11};
-    features.features = info.enabled_features;
-
-    VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features};
+    VkDeviceCreateInfo ci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &features.features};
     ci.queueCreateInfoCount = static_cast<std::uint32_t>(queue_infos.size());
     ci.pQueueCreateInfos = queue_infos.data();
     ci.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());

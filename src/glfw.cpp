@@ -96,8 +96,7 @@ WindowSurface create_window_surface(const WindowCreateInfo& window_info, Instanc
     WindowSurface out;
     out.window = Window::create(window_info);
     for (const char* name : required_instance_extensions()) {
-        auto& names = instance_info.enabled_extension_names;
-        if (!detail::contains(names, name)) names.push_back(name);
+        detail::add_unique(instance_info.enabled_extension_names, name);
     }
     out.instance = Instance::create(instance_info);
     out.surface = create_surface(out.instance, out.window.get());

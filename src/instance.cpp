@@ -60,48 +60,74 @@ InstanceState::~InstanceState() {
 }
 }  // namespace detail
 
-Instance Instance::create() { return create(InstanceCreateInfo{}); }
+namespace {
 
-Instance Instance::create(const InstanceCreateInfo& info) {
-    auto global = GlobalFunctions::load(info.get_instance_proc_addr);
-
-    std::vector<const char*> layers(info.enabled_layer_names.begin(), info.enabled_layer_names.end());
+// The extensions asked for, and those vkrc needs: debug utils for the
+// messenger (validation or a callback) and portability enumeration where the
+// loader has it.
+std::vector<const char*> instance_extensions(const InstanceCreateInfo& info, bool portability) {
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
-    if (info.validation) {
-        detail::add_unique(layers, validation_layer);
-        detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-    }
-    // With it, the loader also lists portability drivers (MoltenVK); those
-    // need VK_KHR_portability_subset, which Device::create enables.
-    const bool portability = detail::contains(available_extensions(info.get_instance_proc_addr),
-                                              VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+    if (info.validation) detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     if (portability) detail::add_unique(extensions, VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
-    // The state exists before the instance: its callback's address is the
-    // messenger's user data from vkCreateInstance to vkDestroyInstance.
-    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
-    auto& s = *instance.state_;
-    const bool messenger = info.debug_callback || info.validation;
-    if (messenger) {
-        detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        s.debug_callback = info.debug_callback ? info.debug_callback : DebugCallback(print_debug_message);
-    }
+    if (info.debug_callback) detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    return extensions;
+}
 
+VkApplicationInfo application_info(const InstanceCreateInfo& info) {
     VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
     app.pApplicationName = info.application_name;
     app.applicationVersion = info.application_version;
     app.pEngineName = "vkrc";
     app.apiVersion = info.api_version;
+    return app;
+}
 
+// The messenger of info's severities, calling callback (which must outlive it); chained before info.next.
+VkDebugUtilsMessengerCreateInfoEXT messenger_create_info(const InstanceCreateInfo& info, DebugCallback& callback) {
+    VkDebugUtilsMessengerCreateInfoEXT m{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    m.messageSeverity = info.debug_severities;
+    m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    m.pfnUserCallback = detail::debug_trampoline;
+    m.pUserData = &callback;
+    m.pNext = info.next;
+    return m;
+}
+
+// Records raw in a new state, which from then on owns it (unless borrowed).
+void init_state(detail::InstanceState& s, VkInstance raw, std::uint32_t api_version, const GlobalFunctions& global,
+                Span<const char* const> extensions, Span<const char* const> layers) {
+    s.instance = raw;
+    s.api_version = api_version;
+    s.global_fn = global;
+    s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
+    for (const char* e : extensions) s.enabled_extensions.push_back(e);
+    for (const char* l : layers) s.enabled_layers.push_back(l);
+}
+
+}  // namespace
+
+Instance Instance::create() { return create(InstanceCreateInfo{}); }
+
+Instance Instance::create(const InstanceCreateInfo& info) {
+    auto global = GlobalFunctions::load(info.get_instance_proc_addr);
+    std::vector<const char*> layers(info.enabled_layer_names.begin(), info.enabled_layer_names.end());
+    if (info.validation) detail::add_unique(layers, validation_layer);
+    // With it, the loader also lists portability drivers (MoltenVK); those
+    // need VK_KHR_portability_subset, which Device::create enables.
+    const bool portability = detail::contains(available_extensions(info.get_instance_proc_addr),
+                                              VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+    const auto extensions = instance_extensions(info, portability);
+    // The state exists before the instance: its callback's address is the
+    // messenger's user data from vkCreateInstance to vkDestroyInstance.
+    Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
+    auto& s = *instance.state_;
+    const bool messenger = info.debug_callback || info.validation;
+    if (messenger) s.debug_callback = info.debug_callback ? info.debug_callback : DebugCallback(print_debug_message);
+    const VkApplicationInfo app = application_info(info);
     // The same messenger description is chained into vkCreateInstance so that
     // messages from instance creation and destruction reach the callback too.
-    VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    messenger_info.messageSeverity = info.debug_severities;
-    messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                                 VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                                 VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-    messenger_info.pfnUserCallback = detail::debug_trampoline;
-    messenger_info.pUserData = &s.debug_callback;
-    messenger_info.pNext = info.next;
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info = messenger_create_info(info, s.debug_callback);
 
     VkInstanceCreateInfo ci{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     ci.pNext = messenger ? &messenger_info : info.next;
@@ -114,14 +140,8 @@ Instance Instance::create(const InstanceCreateInfo& info) {
 
     VkInstance raw = VK_NULL_HANDLE;
     check(global.vkCreateInstance(&ci, nullptr, &raw), "vkCreateInstance");
-
     // From here the state owns the instance: an exception below destroys it.
-    s.instance = raw;
-    s.api_version = info.api_version;
-    s.global_fn = global;
-    s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
-    for (const char* e : extensions) s.enabled_extensions.push_back(e);
-    for (const char* l : layers) s.enabled_layers.push_back(l);
+    init_state(s, raw, info.api_version, global, extensions, layers);
     if (messenger) {
         messenger_info.pNext = nullptr;
         check(s.fn.vkCreateDebugUtilsMessengerEXT(raw, &messenger_info, nullptr, &s.messenger),
@@ -137,13 +157,8 @@ Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
     auto& s = *instance.state_;
-    s.instance = raw;
     s.ownership = ownership;
-    s.api_version = api_version;
-    s.global_fn = global;
-    s.fn = InstanceFunctions::load(global.vkGetInstanceProcAddr, raw);
-    for (const char* e : enabled_extensions) s.enabled_extensions.push_back(e);
-    for (const char* l : enabled_layers) s.enabled_layers.push_back(l);
+    init_state(s, raw, api_version, global, enabled_extensions, enabled_layers);
     return instance;
 }
 

@@ -17,10 +17,7 @@ bool DeviceView::extension_enabled(const char* name) const noexcept {
 HeapStatistics AllocatorStatistics::total() const noexcept {
     HeapStatistics t;
     for (std::uint32_t i = 0; i < heap_count; ++i) {
-        t.block_bytes += heaps[i].block_bytes;
-        t.allocation_bytes += heaps[i].allocation_bytes;
-        t.block_count += heaps[i].block_count;
-        t.allocation_count += heaps[i].allocation_count;
+        detail::add_tallies(t, heaps[i]);
         t.budget += heaps[i].budget;
         t.usage += heaps[i].usage;
     }
@@ -105,6 +102,9 @@ VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std:
 }
 
 // ---------------------------------------------------------------- the device's allocators
+
+AllocatorRegistry::AllocatorRegistry() = default;
+AllocatorRegistry::~AllocatorRegistry() = default;
 
 DeviceAllocator& AllocatorRegistry::default_allocator() {
     LockGuard lock(mutex_);

@@ -39,6 +39,14 @@ inline void add_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
 inline void remove_range(HeapStatistics& heap, VkDeviceSize bytes) noexcept {
     tally(heap.allocation_bytes, heap.allocation_count, bytes, false);
 }
+// Adds from's block and range tallies to to's; budget and usage are left
+// alone (fill_budget reads them from the device).
+inline void add_tallies(HeapStatistics& to, const HeapStatistics& from) noexcept {
+    to.block_bytes += from.block_bytes;
+    to.allocation_bytes += from.allocation_bytes;
+    to.block_count += from.block_count;
+    to.allocation_count += from.allocation_count;
+}
 
 // Vulkan's alignments are powers of two; the division is for anything else.
 constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {

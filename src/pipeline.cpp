@@ -351,14 +351,8 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     }
     attach_specializations(stages, specs);
     check_tessellation();
-    VkPipelineVertexInputStateCreateInfo vertex{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    vertex.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings_.size());
-    vertex.pVertexBindingDescriptions = bindings_.data();
-    vertex.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attributes_.size());
-    vertex.pVertexAttributeDescriptions = attributes_.data();
-    VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    assembly.topology = topology_;
-    assembly.primitiveRestartEnable = primitive_restart_ ? VK_TRUE : VK_FALSE;
+    const auto vertex = vertex_input_state();
+    const auto assembly = input_assembly_state();
     VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
     tessellation.patchControlPoints = patch_control_points_;
     const auto viewport = viewport_state();
@@ -368,38 +362,14 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     auto multisample = multisample_state();
     multisample.pSampleMask = sample_mask;
     const auto depth = depth_stencil_state();
-
-    std::uint32_t color_count = 0;
-    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
-    if (render_pass_) {
-        color_count = render_pass_.color_attachment_count(subpass_);
-    } else {
-        color_count = static_cast<std::uint32_t>(color_formats_.size());
-        rendering.colorAttachmentCount = color_count;
-        rendering.pColorAttachmentFormats = color_formats_.data();
-        rendering.depthAttachmentFormat = depth_format_;
-        rendering.stencilAttachmentFormat = stencil_format_;
-        rendering.viewMask = view_mask_;
-    }
-    require(!render_pass_ || view_mask_ == 0, who, "view_mask is for dynamic rendering; a render pass has its own");
-    if (!blends_.empty() && blends_.size() != color_count) {
-        throw UsageError(std::string(who) + ": blend_attachments has " + std::to_string(blends_.size()) +
-                         " states for " + std::to_string(color_count) + " colour attachments");
-    }
-    std::vector<VkPipelineColorBlendAttachmentState> blends(color_count, blend_);
-    if (!blends_.empty()) blends.assign(blends_.begin(), blends_.end());
-    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = color_count;
-    blend.pAttachments = blends.data();
-    blend.logicOpEnable = logic_op_enable_ ? VK_TRUE : VK_FALSE;
-    blend.logicOp = logic_op_;
-    std::copy(std::begin(blend_constants_), std::end(blend_constants_), blend.blendConstants);
-    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
-    dynamic.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states_.size());
-    dynamic.pDynamicStates = dynamic_states_.data();
+    const std::uint32_t color_count = render_pass_ ? render_pass_.color_attachment_count(subpass_)
+                                                   : static_cast<std::uint32_t>(color_formats_.size());
+    const auto rendering = rendering_info();
+    List<VkPipelineColorBlendAttachmentState> blends;
+    const auto blend = color_blend_state(color_count, blends);
+    const auto dynamic = dynamic_state_info();
 
     VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    rendering.pNext = next_;
     ci.pNext = render_pass_ ? next_ : &rendering;
     ci.flags = flags_;
     ci.pTessellationState = patch_control_points_ ? &tessellation : nullptr;

@@ -35,6 +35,8 @@ bool contains(Span<const VkDynamicState> states, VkDynamicState state) {
 
 VkBool32 vk_bool(bool b) { return b ? VK_TRUE : VK_FALSE; }
 
+constexpr const char* build_who = "vkrc::GraphicsPipelineBuilder::build";
+
 }  // namespace
 
 ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const ComputePipelineCreateInfo& info) {
@@ -141,8 +143,7 @@ void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageC
                                                      Span<VkSpecializationInfo> infos) const {
     for (const auto& sp : specializations_) {
         auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& st) { return st.stage == sp.stage; });
-        require(it != stages.end(), "vkrc::GraphicsPipelineBuilder::build",
-                "a specialization names a stage without a shader");
+        require(it != stages.end(), build_who, "a specialization names a stage without a shader");
         auto& info = infos[static_cast<std::size_t>(it - stages.begin())];
         info = specialization_info(sp.entries, sp.data);
         it->pSpecializationInfo = &info;
@@ -150,17 +151,15 @@ void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageC
 }
 
 void GraphicsPipelineBuilder::check_tessellation() const {
-    const char* who = "vkrc::GraphicsPipelineBuilder::build";
     bool tessellated = false;
     for (const auto& st : stages_) tessellated |= (st.stage & tessellation_stages) != 0;
-    require(!tessellated || patch_control_points_ > 0, who, "tessellation shaders without tessellation()");
-    require(!tessellated || topology_ == VK_PRIMITIVE_TOPOLOGY_PATCH_LIST, who,
+    require(!tessellated || patch_control_points_ > 0, build_who, "tessellation shaders without tessellation()");
+    require(!tessellated || topology_ == VK_PRIMITIVE_TOPOLOGY_PATCH_LIST, build_who,
             "tessellation shaders need topology PATCH_LIST");
 }
 
 VkPipelineViewportStateCreateInfo GraphicsPipelineBuilder::viewport_state() const {
-    const char* who = "vkrc::GraphicsPipelineBuilder::build";
-    require(viewports_.empty() || scissors_.empty() || viewports_.size() == scissors_.size(), who,
+    require(viewports_.empty() || scissors_.empty() || viewports_.size() == scissors_.size(), build_who,
             "viewports and scissors differ in count");
     const auto count = static_cast<std::uint32_t>(std::max<std::size_t>({1, viewports_.size(), scissors_.size()}));
     VkPipelineViewportStateCreateInfo v{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
@@ -168,9 +167,9 @@ VkPipelineViewportStateCreateInfo GraphicsPipelineBuilder::viewport_state() cons
     const bool dynamic_viewports = contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT_WITH_COUNT);
     const bool dynamic_scissors = contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR_WITH_COUNT);
     // Static ones must be given: Vulkan would read them from a null pointer.
-    require(viewports_.size() > 0 || dynamic_viewports || contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT), who,
-            "viewports are neither dynamic nor given with viewports()");
-    require(scissors_.size() > 0 || dynamic_scissors || contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR), who,
+    require(viewports_.size() > 0 || dynamic_viewports || contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT),
+            build_who, "viewports are neither dynamic nor given with viewports()");
+    require(scissors_.size() > 0 || dynamic_scissors || contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR), build_who,
             "scissors are neither dynamic nor given with scissors()");
     v.viewportCount = dynamic_viewports ? 0 : count;
     v.pViewports = viewports_.empty() ? nullptr : viewports_.data();
@@ -219,6 +218,64 @@ VkPipelineDepthStencilStateCreateInfo GraphicsPipelineBuilder::depth_stencil_sta
     d.back = depth_stencil_.back;
     d.minDepthBounds = depth_stencil_.min_depth_bounds;
     d.maxDepthBounds = depth_stencil_.max_depth_bounds;
+    return d;
+}
+
+VkPipelineVertexInputStateCreateInfo GraphicsPipelineBuilder::vertex_input_state() const {
+    VkPipelineVertexInputStateCreateInfo v{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    v.vertexBindingDescriptionCount = static_cast<std::uint32_t>(bindings_.size());
+    v.pVertexBindingDescriptions = bindings_.data();
+    v.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attributes_.size());
+    v.pVertexAttributeDescriptions = attributes_.data();
+    return v;
+}
+
+VkPipelineInputAssemblyStateCreateInfo GraphicsPipelineBuilder::input_assembly_state() const {
+    VkPipelineInputAssemblyStateCreateInfo a{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    a.topology = topology_;
+    a.primitiveRestartEnable = vk_bool(primitive_restart_);
+    return a;
+}
+
+VkPipelineRenderingCreateInfo GraphicsPipelineBuilder::rendering_info() const {
+    require(!render_pass_ || view_mask_ == 0, build_who,
+            "view_mask is for dynamic rendering; a render pass has its own");
+    VkPipelineRenderingCreateInfo r{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    r.pNext = next_;
+    if (render_pass_) return r;  // unused: the render pass describes the attachments
+    r.colorAttachmentCount = static_cast<std::uint32_t>(color_formats_.size());
+    r.pColorAttachmentFormats = color_formats_.data();
+    r.depthAttachmentFormat = depth_format_;
+    r.stencilAttachmentFormat = stencil_format_;
+    r.viewMask = view_mask_;
+    return r;
+}
+
+VkPipelineColorBlendStateCreateInfo GraphicsPipelineBuilder::color_blend_state(
+    std::uint32_t color_count, List<VkPipelineColorBlendAttachmentState>& attachments) const {
+    if (!blends_.empty() && blends_.size() != color_count) {
+        throw UsageError(std::string(build_who) + ": blend_attachments has " + std::to_string(blends_.size()) +
+                         " states for " + std::to_string(color_count) + " colour attachments");
+    }
+    if (!blends_.empty()) {
+        attachments = blends_;
+    } else {
+        attachments = List<VkPipelineColorBlendAttachmentState>(color_count);
+        std::fill(attachments.begin(), attachments.end(), blend_);
+    }
+    VkPipelineColorBlendStateCreateInfo b{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    b.attachmentCount = color_count;
+    b.pAttachments = attachments.data();
+    b.logicOpEnable = vk_bool(logic_op_enable_);
+    b.logicOp = logic_op_;
+    std::copy(std::begin(blend_constants_), std::end(blend_constants_), b.blendConstants);
+    return b;
+}
+
+VkPipelineDynamicStateCreateInfo GraphicsPipelineBuilder::dynamic_state_info() const {
+    VkPipelineDynamicStateCreateInfo d{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    d.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states_.size());
+    d.pDynamicStates = dynamic_states_.data();
     return d;
 }
 

@@ -173,6 +173,55 @@ void merge_next_into(Node* node, NodeStore& nodes) noexcept {
     nodes.recycle(next);
 }
 
+// Puts front, a free range of size bytes, before node, at node's offset.
+void link_free_before(Pool& pool, Node& node, Node& front, VkDeviceSize size) noexcept {
+    front.offset = node.offset;
+    front.size = size;
+    front.block = node.block;
+    front.prev_phys = node.prev_phys;
+    front.next_phys = &node;
+    if (front.prev_phys) front.prev_phys->next_phys = &front;
+    else node.block->first = &front;
+    node.prev_phys = &front;
+    pool.insert_free(&front);
+}
+
+// Puts back, a free range of size bytes at offset, after node.
+void link_free_after(Pool& pool, Node& node, Node& back, VkDeviceSize offset, VkDeviceSize size) noexcept {
+    back.offset = offset;
+    back.size = size;
+    back.block = node.block;
+    back.prev_phys = &node;
+    back.next_phys = node.next_phys;
+    if (back.next_phys) back.next_phys->prev_phys = &back;
+    node.next_phys = &back;
+    pool.insert_free(&back);
+}
+
+// Makes node, a free range, the used range [start, start + size): the
+// alignment padding before it and the rest after it stay free, as nodes of their own.
+void carve(Pool& pool, NodeStore& nodes, Node& node, VkDeviceSize start, VkDeviceSize size) {
+    const VkDeviceSize front_size = start - node.offset;
+    const VkDeviceSize back_size = node.size - front_size - size;
+    // Take the nodes the split needs first, so nothing changes if that throws.
+    Node* front = front_size ? nodes.make() : nullptr;
+    Node* back = nullptr;
+    if (back_size) {
+        try {
+            back = nodes.make();
+        } catch (...) {
+            if (front) nodes.recycle(front);
+            throw;
+        }
+    }
+    pool.remove_free(&node);
+    if (front) link_free_before(pool, node, *front, front_size);
+    if (back) link_free_after(pool, node, *back, start + size, back_size);
+    node.offset = start;
+    node.size = size;
+    node.block->allocations += 1;
+}
+
 // An independent part of a PoolAllocator: its own lock, pools (so blocks and
 // spares) and nodes. Its statistics are summed by statistics().
 struct alignas(64) Shard {  // apart in cache: threads on different shards share no line
@@ -245,6 +294,10 @@ struct PoolAllocator::Impl {
     void count_memory_object(DeviceView d);
     Block& new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least);
     void free_block(DeviceView d, Shard& shard, Pool& pool, Block& block) noexcept;
+    // allocate()'s two paths; out arrives with size and memory_type set.
+    void allocate_dedicated(DeviceView d, const AllocationRequest& request, AllocationInfo& out);
+    void allocate_range(DeviceView d, const AllocationRequest& request, AllocationInfo& out);
+    Pool& pool_for(Shard& shard, std::uint32_t type, const AllocationRequest& request);
     HeapStatistics& heap(Shard& shard, std::uint32_t type) noexcept { return shard.stats.heaps[heap_of[type]]; }
 };
 
@@ -361,6 +414,68 @@ void PoolAllocator::Impl::free_block(DeviceView d, Shard& shard, Pool& pool, Blo
     delete &block;
 }
 
+// A VkDeviceMemory of its own, counted in the statistics of a shard.
+void PoolAllocator::Impl::allocate_dedicated(DeviceView d, const AllocationRequest& request, AllocationInfo& out) {
+    // No shard's lock is held while the driver allocates.
+    count_memory_object(d);
+    try {
+        out.memory = detail::allocate_device_memory(d, out.size, out.memory_type, request.dedicated_buffer,
+                                                    request.dedicated_image, request.device_address, &out.mapped);
+    } catch (...) {
+        memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
+        throw;
+    }
+    out.memory_size = out.size;
+    out.dedicated = true;
+    Shard& shard = lock_shard();
+    ShardLock lock(shard);
+    out.allocator_data = &shard;  // whose statistics count it
+    shard.stats.vk_allocate_calls += 1;
+    detail::add_block(heap(shard, out.memory_type), out.size);
+    detail::add_range(heap(shard, out.memory_type), out.size);
+}
+
+// A range of a block in the calling thread's shard: a free range that fits, else a new block.
+void PoolAllocator::Impl::allocate_range(DeviceView d, const AllocationRequest& request, AllocationInfo& out) {
+    const std::uint32_t type = out.memory_type;
+    Shard& shard = lock_shard();
+    ShardLock lock(shard);
+    const VkDeviceSize unit = units[type];
+    const VkDeviceSize size = detail::align_up(request.requirements.size, unit);
+    const VkDeviceSize alignment = std::max<VkDeviceSize>(request.requirements.alignment, unit);
+    Pool& pool = pool_for(shard, type, request);
+
+    // Every offset is a multiple of unit, so at most alignment - unit bytes
+    // of padding go before the range.
+    const VkDeviceSize padded = size + (alignment - unit);
+    Node* node = pool.find_in_class(size, alignment);
+    if (!node) node = pool.find(padded);
+    if (!node) node = new_block(d, shard, pool, padded).first;
+    const VkDeviceSize start = detail::align_up(node->offset, alignment);
+    carve(pool, shard.nodes, *node, start, size);
+
+    const Block& block = *node->block;
+    out.memory = block.memory;
+    out.offset = start;
+    out.memory_size = block.size;
+    out.mapped = block.mapped ? block.mapped + start : nullptr;
+    out.allocator_data = node;
+    detail::add_range(heap(shard, type), size);
+}
+
+// The shard's pool for the request's memory type and kind of block, made on first use.
+Pool& PoolAllocator::Impl::pool_for(Shard& shard, std::uint32_t type, const AllocationRequest& request) {
+    const bool separate = granularity > max_rounded_granularity && !request.linear;
+    auto& slot = shard.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
+    if (!slot) {
+        slot = std::make_unique<Pool>();
+        slot->shard = &shard;
+        slot->memory_type = type;
+        slot->device_address = request.device_address;
+    }
+    return *slot;
+}
+
 PoolAllocator::PoolAllocator(const PoolAllocatorCreateInfo& info) : impl_(nullptr) {
     if (info.min_block_size == 0 || info.max_block_size < info.min_block_size) {
         throw UsageError("vkrc::PoolAllocator: min_block_size must be non-zero and at most max_block_size");
@@ -399,97 +514,8 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
 
     const bool dedicated = request.requires_dedicated || request.prefers_dedicated || request.intent.dedicated ||
                            request.requirements.size > m.info.dedicated_threshold;
-    if (dedicated) {
-        // No shard's lock is held while the driver allocates.
-        m.count_memory_object(d);
-        try {
-            info.memory = detail::allocate_device_memory(d, info.size, type, request.dedicated_buffer,
-                                                         request.dedicated_image, request.device_address, &info.mapped);
-        } catch (...) {
-            m.memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
-            throw;
-        }
-        info.memory_size = info.size;
-        info.dedicated = true;
-        Shard& shard = m.lock_shard();
-        ShardLock lock(shard);
-        info.allocator_data = &shard;  // whose statistics count it
-        shard.stats.vk_allocate_calls += 1;
-        detail::add_block(m.heap(shard, type), info.size);
-        detail::add_range(m.heap(shard, type), info.size);
-        return info;
-    }
-
-    Shard& shard = m.lock_shard();
-    ShardLock lock(shard);
-    const VkDeviceSize unit = m.units[type];
-    const VkDeviceSize size = detail::align_up(request.requirements.size, unit);
-    const VkDeviceSize alignment = std::max<VkDeviceSize>(request.requirements.alignment, unit);
-    const bool separate = m.granularity > Impl::max_rounded_granularity && !request.linear;
-    auto& slot = shard.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
-    if (!slot) {
-        slot = std::make_unique<Pool>();
-        slot->shard = &shard;
-        slot->memory_type = type;
-        slot->device_address = request.device_address;
-    }
-    Pool& pool = *slot;
-
-    // Every offset is a multiple of unit, so at most alignment - unit bytes
-    // of padding go before the range.
-    const VkDeviceSize padded = size + (alignment - unit);
-    Node* node = pool.find_in_class(size, alignment);
-    if (!node) node = pool.find(padded);
-    if (!node) node = m.new_block(d, shard, pool, padded).first;
-    // Take the nodes the split needs first, so nothing changes if that throws.
-    Node* front = nullptr;
-    Node* back = nullptr;
-    const VkDeviceSize start = detail::align_up(node->offset, alignment);
-    const VkDeviceSize front_size = start - node->offset;
-    const VkDeviceSize back_size = node->size - front_size - size;
-    if (front_size) front = shard.nodes.make();
-    if (back_size) {
-        try {
-            back = shard.nodes.make();
-        } catch (...) {
-            if (front) shard.nodes.recycle(front);
-            throw;
-        }
-    }
-    pool.remove_free(node);
-    Block& block = *node->block;
-    if (front) {
-        // The alignment padding stays free, before the range.
-        front->offset = node->offset;
-        front->size = front_size;
-        front->block = &block;
-        front->prev_phys = node->prev_phys;
-        front->next_phys = node;
-        if (front->prev_phys) front->prev_phys->next_phys = front;
-        else block.first = front;
-        node->prev_phys = front;
-        pool.insert_free(front);
-    }
-    if (back) {
-        back->offset = start + size;
-        back->size = back_size;
-        back->block = &block;
-        back->prev_phys = node;
-        back->next_phys = node->next_phys;
-        if (back->next_phys) back->next_phys->prev_phys = back;
-        node->next_phys = back;
-        pool.insert_free(back);
-    }
-    node->offset = start;
-    node->size = size;
-    block.allocations += 1;
-
-    info.memory = block.memory;
-    info.offset = start;
-    info.memory_size = block.size;
-    info.mapped = block.mapped ? block.mapped + start : nullptr;
-    info.allocator_data = node;
-    detail::add_range(m.heap(shard, type), size);
+    if (dedicated) m.allocate_dedicated(d, request, info);
+    else m.allocate_range(d, request, info);
     return info;
 }
 
@@ -568,14 +594,8 @@ AllocatorStatistics PoolAllocator::statistics(DeviceView d) const {
         Shard& shard = impl_->shards[i];
         LockGuard lock(shard.mutex);
         stats.vk_allocate_calls += shard.stats.vk_allocate_calls;
-        for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h) {
-            const HeapStatistics& from = shard.stats.heaps[h];
-            HeapStatistics& to = stats.heaps[h];
-            to.block_bytes += from.block_bytes;
-            to.allocation_bytes += from.allocation_bytes;
-            to.block_count += from.block_count;
-            to.allocation_count += from.allocation_count;
-        }
+        for (std::uint32_t h = 0; h < VK_MAX_MEMORY_HEAPS; ++h)
+            detail::add_tallies(stats.heaps[h], shard.stats.heaps[h]);
     }
     fill_budget(d, stats);
     return stats;

@@ -1,7 +1,5 @@
 #include "vkrc/resource.hpp"
 
-#include "vkrc/upload.hpp"
-
 #include "adopt.hpp"
 #include "enum_names.hpp"
 
@@ -217,6 +215,56 @@ VkImageAspectFlags format_aspects(VkFormat format) noexcept {
         case VK_FORMAT_D32_SFLOAT_S8_UINT: return VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT;
         default: return VK_IMAGE_ASPECT_COLOR_BIT;
     }
+}
+
+std::uint32_t format_texel_size(VkFormat format) noexcept {
+    const int f = static_cast<int>(format);
+    if (f == VK_FORMAT_R4G4_UNORM_PACK8) return 1;
+    if (f >= VK_FORMAT_R4G4B4A4_UNORM_PACK16 && f <= VK_FORMAT_A1R5G5B5_UNORM_PACK16) return 2;
+    if (f >= VK_FORMAT_R8_UNORM && f <= VK_FORMAT_R8_SRGB) return 1;
+    if (f >= VK_FORMAT_R8G8_UNORM && f <= VK_FORMAT_R8G8_SRGB) return 2;
+    if (f >= VK_FORMAT_R8G8B8_UNORM && f <= VK_FORMAT_B8G8R8_SRGB) return 3;
+    if (f >= VK_FORMAT_R8G8B8A8_UNORM && f <= VK_FORMAT_A2B10G10R10_SINT_PACK32) return 4;
+    if (f >= VK_FORMAT_R16_UNORM && f <= VK_FORMAT_R16_SFLOAT) return 2;
+    if (f >= VK_FORMAT_R16G16_UNORM && f <= VK_FORMAT_R16G16_SFLOAT) return 4;
+    if (f >= VK_FORMAT_R16G16B16_UNORM && f <= VK_FORMAT_R16G16B16_SFLOAT) return 6;
+    if (f >= VK_FORMAT_R16G16B16A16_UNORM && f <= VK_FORMAT_R16G16B16A16_SFLOAT) return 8;
+    if (f >= VK_FORMAT_R32_UINT && f <= VK_FORMAT_R32_SFLOAT) return 4;
+    if (f >= VK_FORMAT_R32G32_UINT && f <= VK_FORMAT_R32G32_SFLOAT) return 8;
+    if (f >= VK_FORMAT_R32G32B32_UINT && f <= VK_FORMAT_R32G32B32_SFLOAT) return 12;
+    if (f >= VK_FORMAT_R32G32B32A32_UINT && f <= VK_FORMAT_R32G32B32A32_SFLOAT) return 16;
+    if (f >= VK_FORMAT_R64_UINT && f <= VK_FORMAT_R64_SFLOAT) return 8;
+    if (f >= VK_FORMAT_R64G64_UINT && f <= VK_FORMAT_R64G64_SFLOAT) return 16;
+    if (f >= VK_FORMAT_R64G64B64_UINT && f <= VK_FORMAT_R64G64B64_SFLOAT) return 24;
+    if (f >= VK_FORMAT_R64G64B64A64_UINT && f <= VK_FORMAT_R64G64B64A64_SFLOAT) return 32;
+    if (f == VK_FORMAT_B10G11R11_UFLOAT_PACK32 || f == VK_FORMAT_E5B9G9R9_UFLOAT_PACK32) return 4;
+    return 0;
+}
+
+FormatBlock format_block(VkFormat format) noexcept {
+    const int f = static_cast<int>(format);
+    if (const std::uint32_t texel = format_texel_size(format)) return {texel, 1, 1};
+    // BC1 and BC4 take 8 bytes per 4x4 block, BC2, 3, 5, 6H and 7 take 16.
+    if (f >= VK_FORMAT_BC1_RGB_UNORM_BLOCK && f <= VK_FORMAT_BC7_SRGB_BLOCK) {
+        const bool half =
+            f <= VK_FORMAT_BC1_RGBA_SRGB_BLOCK || (f >= VK_FORMAT_BC4_UNORM_BLOCK && f <= VK_FORMAT_BC4_SNORM_BLOCK);
+        return {half ? 8u : 16u, 4, 4};
+    }
+    // ETC2 RGB8, RGB8A1 and EAC R11 take 8 bytes per 4x4 block; ETC2 RGBA8 and EAC RG11 take 16.
+    if (f >= VK_FORMAT_ETC2_R8G8B8_UNORM_BLOCK && f <= VK_FORMAT_EAC_R11G11_SNORM_BLOCK) {
+        const bool half = f <= VK_FORMAT_ETC2_R8G8B8A1_SRGB_BLOCK ||
+                          (f >= VK_FORMAT_EAC_R11_UNORM_BLOCK && f <= VK_FORMAT_EAC_R11_SNORM_BLOCK);
+        return {half ? 8u : 16u, 4, 4};
+    }
+    // ASTC LDR: 16 bytes per block, the extents in enum order (UNORM, SRGB pairs).
+    if (f >= VK_FORMAT_ASTC_4x4_UNORM_BLOCK && f <= VK_FORMAT_ASTC_12x12_SRGB_BLOCK) {
+        static constexpr std::uint8_t extents[14][2] = {{4, 4},  {5, 4},   {5, 5},   {6, 5},  {6, 6},
+                                                        {8, 5},  {8, 6},   {8, 8},   {10, 5}, {10, 6},
+                                                        {10, 8}, {10, 10}, {12, 10}, {12, 12}};
+        const auto& e = extents[(f - VK_FORMAT_ASTC_4x4_UNORM_BLOCK) / 2];
+        return {16, e[0], e[1]};
+    }
+    return {};
 }
 
 Image Image::create(const Device& device, const ImageCreateInfo& info) {

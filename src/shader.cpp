@@ -1,9 +1,9 @@
 #include "vkrc/shader.hpp"
 
 #include "adopt.hpp"
+#include "text.hpp"
 
 #include <filesystem>
-#include <cstdio>
 #include <cstring>
 #include <string>
 #include <fstream>
@@ -29,9 +29,8 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
     std::uint32_t magic = 0;
     std::memcpy(&magic, code, 4);
     if (magic != spirv_magic) {
-        char hex[16];
-        std::snprintf(hex, sizeof hex, "0x%08x", magic);
-        throw UsageError(std::string(who) + ": not SPIR-V (magic number " + hex + ", expected 0x07230203)");
+        throw UsageError(std::string(who) + ": not SPIR-V (magic number 0x" + detail::hex(magic, 8) +
+                         ", expected 0x07230203)");
     }
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = bytes;

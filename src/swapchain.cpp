@@ -329,7 +329,8 @@ PresentStatus recreate_locked(detail::SwapchainState& s) {
     chain->surface = s.surface;
     detail::Ref<detail::FrameImages> made;
     try {
-        check(device.fn().vkCreateSwapchainKHR(device.vk(), &ci, nullptr, &chain->swapchain), "vkCreateSwapchainKHR");
+        device.state()->check_result(device.fn().vkCreateSwapchainKHR(device.vk(), &ci, nullptr, &chain->swapchain),
+                                     "vkCreateSwapchainKHR");
         made = wrap_images(s, *chain, extent.value);
         grow_acquire_ring(s, made->images.size());
     } catch (...) {

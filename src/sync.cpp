@@ -169,7 +169,7 @@ void Event::unset() const {
 }
 VkResult Event::status() const {
     const auto& d = state_->device;
-    return check(d.fn().vkGetEventStatus(d.vk(), state_->handle), "vkGetEventStatus");
+    return d.state()->check_result(d.fn().vkGetEventStatus(d.vk(), state_->handle), "vkGetEventStatus");
 }
 
 namespace {

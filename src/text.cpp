@@ -14,17 +14,13 @@ bool contains(Span<const char* const> names, const char* name) noexcept {
     return std::any_of(names.begin(), names.end(), [&](const char* n) { return std::strcmp(n, name) == 0; });
 }
 
-void add_unique(std::vector<const char*>& names, const char* name) {
-    if (!contains(names, name)) names.push_back(name);
-}
-
-std::string hex(std::uint64_t v) {
-    static const char digits[] = "0123456789abcdef";
+std::string hex(std::uint64_t v, std::size_t digits) {
+    static const char symbols[] = "0123456789abcdef";
     std::string s;
     do {
-        s.insert(s.begin(), digits[v & 15]);
+        s.insert(s.begin(), symbols[v & 15]);
         v >>= 4;
-    } while (v);
+    } while (v || s.size() < digits);
     return s;
 }
 

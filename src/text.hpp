@@ -15,10 +15,15 @@ namespace detail {
 // Whether a list of extension or layer names holds name.
 bool contains(Span<const Text> names, const char* name) noexcept;
 bool contains(Span<const char* const> names, const char* name) noexcept;
-// Adds name to a list of extension or layer names unless it is there.
-void add_unique(std::vector<const char*>& names, const char* name);
-// The lower-case hexadecimal digits of v, without a prefix.
-std::string hex(std::uint64_t v);
+// Adds name to a list of extension or layer names (std::vector or List)
+// unless it is there.
+template <class Names>
+void add_unique(Names& names, const char* name) {
+    if (!contains(names, name)) names.push_back(name);
+}
+// The lower-case hexadecimal digits of v, without a prefix, zero-padded to
+// at least digits.
+std::string hex(std::uint64_t v, std::size_t digits = 1);
 
 // Vulkan's two-call enumeration: call(&count, nullptr), then call(&count,
 // data) until it stops returning VK_INCOMPLETE; what names the function.

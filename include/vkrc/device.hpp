@@ -379,6 +379,10 @@ private:
 // frees can still reach it (memory.cpp).
 class AllocatorRegistry {
 public:
+    // In memory.cpp, where DeviceAllocator is complete (the constructor
+    // destroys the list when unwinding).
+    AllocatorRegistry();
+    ~AllocatorRegistry();
     // The device's default allocator, a PoolAllocator made on first use.
     DeviceAllocator& default_allocator();
     // Keeps allocator until release_all (once per allocator).

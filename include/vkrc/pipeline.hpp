@@ -374,6 +374,14 @@ private:
     VkPipelineRasterizationStateCreateInfo rasterization_state() const;
     VkPipelineMultisampleStateCreateInfo multisample_state() const;
     VkPipelineDepthStencilStateCreateInfo depth_stencil_state() const;
+    VkPipelineVertexInputStateCreateInfo vertex_input_state() const;
+    VkPipelineInputAssemblyStateCreateInfo input_assembly_state() const;
+    // Chained before next(); with a render pass it describes nothing.
+    VkPipelineRenderingCreateInfo rendering_info() const;
+    // attachments receives the per-attachment states the result points to.
+    VkPipelineColorBlendStateCreateInfo color_blend_state(std::uint32_t color_count,
+                                                          List<VkPipelineColorBlendAttachmentState>& attachments) const;
+    VkPipelineDynamicStateCreateInfo dynamic_state_info() const;
 };
 
 namespace detail {

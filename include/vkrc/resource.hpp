@@ -228,6 +228,21 @@ private:
 // The aspects of a format: depth and/or stencil, or colour.
 VkImageAspectFlags format_aspects(VkFormat format) noexcept;
 
+// Bytes per texel of an uncompressed colour format; 0 for formats the
+// staging functions (vkrc/upload.hpp) do not handle (compressed,
+// depth/stencil, planar).
+std::uint32_t format_texel_size(VkFormat format) noexcept;
+
+// The unit a format's data is copied in: a texel (1 x 1) of an uncompressed
+// colour format, or a block of a block-compressed one (BC, ETC2/EAC, ASTC
+// LDR). bytes is 0 for formats the staging functions do not handle.
+struct FormatBlock {
+    std::uint32_t bytes = 0;
+    std::uint32_t width = 1;
+    std::uint32_t height = 1;
+};
+FormatBlock format_block(VkFormat format) noexcept;
+
 namespace detail {
 
 // Queues cleanup to run once the GPU is done with what was dropped before it.

@@ -11,20 +11,6 @@
 
 VKRC_BEGIN_NAMESPACE
 
-// Bytes per texel of an uncompressed colour format; 0 for formats the
-// staging functions do not handle (compressed, depth/stencil, planar).
-std::uint32_t format_texel_size(VkFormat format) noexcept;
-
-// The unit a format's data is copied in: a texel (1 x 1) of an uncompressed
-// colour format, or a block of a block-compressed one (BC, ETC2/EAC, ASTC
-// LDR). bytes is 0 for formats the staging functions do not handle.
-struct FormatBlock {
-    std::uint32_t bytes = 0;
-    std::uint32_t width = 1;
-    std::uint32_t height = 1;
-};
-FormatBlock format_block(VkFormat format) noexcept;
-
 // Copies data to buffer at offset through a staging buffer. The buffer needs
 // VK_BUFFER_USAGE_TRANSFER_DST_BIT. The copy waits for earlier submissions on
 // the queue to finish with the buffer; later submits on any queue see the data.
