@@ -1,6 +1,6 @@
 #include "vkrc/command.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 
 #include <string>
 
@@ -48,10 +48,9 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
     ci.pNext = info.next;
     ci.flags = info.flags;
     ci.queueFamilyIndex = info.queue_family_index;
-    detail::Ref<detail::CommandPoolState> s(new detail::CommandPoolState);
-    s->device = device;
+    auto s = detail::created_state<detail::CommandPoolState, &DeviceFunctions::vkCreateCommandPool>(
+        device, ci, "vkCreateCommandPool");
     s->queue_family_index = info.queue_family_index;
-    check(device.fn().vkCreateCommandPool(device.vk(), &ci, nullptr, &s->handle), "vkCreateCommandPool");
     return CommandPool(std::move(s));
 }
 

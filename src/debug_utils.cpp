@@ -1,6 +1,6 @@
 #include "vkrc/debug_utils.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 #include "debug_message.hpp"
 
 #include <string>

@@ -2,7 +2,7 @@
 
 #include "vkrc/descriptor_template.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
@@ -163,10 +163,9 @@ DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPool
     ci.maxSets = info.max_sets;
     ci.poolSizeCount = static_cast<std::uint32_t>(info.pool_sizes.size());
     ci.pPoolSizes = info.pool_sizes.data();
-    detail::Ref<detail::DescriptorPoolState> s(new detail::DescriptorPoolState);
-    s->device = device;
+    auto s = detail::created_state<detail::DescriptorPoolState, &DeviceFunctions::vkCreateDescriptorPool>(
+        device, ci, "vkCreateDescriptorPool");
     s->can_free_sets = (info.flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
-    check(device.fn().vkCreateDescriptorPool(device.vk(), &ci, nullptr, &s->handle), "vkCreateDescriptorPool");
     return DescriptorPool(std::move(s));
 }
 

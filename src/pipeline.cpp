@@ -1,6 +1,6 @@
 #include "vkrc/pipeline.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -85,10 +85,8 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
     ci.pSetLayouts = sets.data();
     ci.pushConstantRangeCount = static_cast<std::uint32_t>(info.push_constant_ranges.size());
     ci.pPushConstantRanges = info.push_constant_ranges.data();
-    detail::Ref<detail::PipelineLayoutState> s(new detail::PipelineLayoutState);
-    s->device = device;
-    check(device.fn().vkCreatePipelineLayout(device.vk(), &ci, nullptr, &s->handle), "vkCreatePipelineLayout");
-    return PipelineLayout(std::move(s));
+    return PipelineLayout(detail::created_state<detail::PipelineLayoutState, &DeviceFunctions::vkCreatePipelineLayout>(
+        device, ci, "vkCreatePipelineLayout"));
 }
 
 RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& info) {
@@ -170,9 +168,8 @@ PipelineCache PipelineCache::create(const Device& device, Span<const std::byte> 
     VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
     ci.initialDataSize = initial_data.size();
     ci.pInitialData = initial_data.data();
-    detail::Ref<detail::PipelineCacheState> s(new detail::PipelineCacheState);
-    s->device = device;
-    check(device.fn().vkCreatePipelineCache(device.vk(), &ci, nullptr, &s->handle), "vkCreatePipelineCache");
+    auto s = detail::created_state<detail::PipelineCacheState, &DeviceFunctions::vkCreatePipelineCache>(
+        device, ci, "vkCreatePipelineCache");
     s->loaded_from_file = !initial_data.empty();
     return PipelineCache(std::move(s));
 }

@@ -1,6 +1,6 @@
 #include "vkrc/private_data.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
@@ -20,10 +20,9 @@ PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot s
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
     if (!device) throw UsageError("vkrc::PrivateDataSlot::create: the Device handle is empty");
     VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO, info.next, info.flags};
-    detail::Ref<detail::PrivateDataSlotState> state(new detail::PrivateDataSlotState);
-    check(device.fn().vkCreatePrivateDataSlot(device.vk(), &ci, nullptr, &state->handle), "vkCreatePrivateDataSlot");
-    state->device = device;
-    return PrivateDataSlot(std::move(state));
+    return PrivateDataSlot(
+        detail::created_state<detail::PrivateDataSlotState, &DeviceFunctions::vkCreatePrivateDataSlot>(
+            device, ci, "vkCreatePrivateDataSlot"));
 }
 
 void PrivateDataSlot::set_bits(VkObjectType object_type, std::uint64_t object, std::uint64_t data) const {

@@ -1,6 +1,6 @@
 #include "vkrc/resource.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
@@ -425,9 +425,8 @@ Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     ci.maxLod = info.max_lod;
     ci.borderColor = info.border_color;
     ci.unnormalizedCoordinates = info.unnormalized_coordinates ? VK_TRUE : VK_FALSE;
-    detail::Ref<detail::SamplerState> state(new detail::SamplerState);
-    check(device.fn().vkCreateSampler(device.vk(), &ci, nullptr, &state->handle), "vkCreateSampler");
-    state->device = device;
+    auto state =
+        detail::created_state<detail::SamplerState, &DeviceFunctions::vkCreateSampler>(device, ci, "vkCreateSampler");
     state->ycbcr_conversion = info.ycbcr_conversion;
     return Sampler(std::move(state));
 }

@@ -1,6 +1,6 @@
 #include "vkrc/shader.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 #include "text.hpp"
 
 #include <filesystem>

@@ -1,6 +1,6 @@
 #include "vkrc/surface.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 #include "text.hpp"
 
 #include <vector>

@@ -1,6 +1,6 @@
 #include "vkrc/sync.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 
 #include <bit>
 #include <string>
@@ -47,10 +47,8 @@ Fence Fence::create(const Device& device, bool signaled) {
     require_device(device, "vkrc::Fence::create");
     VkFenceCreateInfo ci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     if (signaled) ci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
-    detail::Ref<detail::FenceState> s(new detail::FenceState);
-    s->device = device;
-    check(device.fn().vkCreateFence(device.vk(), &ci, nullptr, &s->handle), "vkCreateFence");
-    return Fence(std::move(s));
+    return Fence(
+        detail::created_state<detail::FenceState, &DeviceFunctions::vkCreateFence>(device, ci, "vkCreateFence"));
 }
 
 Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
@@ -148,10 +146,8 @@ Event Event::create(const Device& device, bool device_only) {
     require_device(device, "vkrc::Event::create");
     VkEventCreateInfo ci{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
     if (device_only) ci.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
-    detail::Ref<detail::EventState> s(new detail::EventState);
-    s->device = device;
-    check(device.fn().vkCreateEvent(device.vk(), &ci, nullptr, &s->handle), "vkCreateEvent");
-    return Event(std::move(s));
+    return Event(
+        detail::created_state<detail::EventState, &DeviceFunctions::vkCreateEvent>(device, ci, "vkCreateEvent"));
 }
 
 Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {

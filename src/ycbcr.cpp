@@ -1,6 +1,6 @@
 #include "vkrc/ycbcr.hpp"
 
-#include "adopt.hpp"
+#include "object_state.hpp"
 
 #include <string>
 
@@ -40,10 +40,9 @@ SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
     ci.yChromaOffset = info.y_chroma_offset;
     ci.chromaFilter = info.chroma_filter;
     ci.forceExplicitReconstruction = info.force_explicit_reconstruction ? VK_TRUE : VK_FALSE;
-    detail::Ref<detail::SamplerYcbcrConversionState> state(new detail::SamplerYcbcrConversionState);
-    check(device.fn().vkCreateSamplerYcbcrConversion(device.vk(), &ci, nullptr, &state->handle),
-          "vkCreateSamplerYcbcrConversion");
-    state->device = device;
+    auto state =
+        detail::created_state<detail::SamplerYcbcrConversionState, &DeviceFunctions::vkCreateSamplerYcbcrConversion>(
+            device, ci, "vkCreateSamplerYcbcrConversion");
     state->format = info.format;
     return SamplerYcbcrConversion(std::move(state));
 }

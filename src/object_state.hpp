@@ -1,8 +1,7 @@
-// The start that the adopt() functions share (not installed).
+// The starts that the create() and adopt() functions share (not installed).
 #pragma once
 
-#include "vkrc/error.hpp"
-#include "vkrc/handle.hpp"
+#include "vkrc/device.hpp"
 
 #include <string>
 
@@ -24,6 +23,17 @@ Ref<State> adopted_state(const char* who, const Parent& parent, const char* pare
     (*s).*parent_member = parent;
     s->handle = handle;
     s->ownership = ownership;
+    return s;
+}
+
+// The state of a new object of device, its handle made by create (a vkCreate*
+// member of DeviceFunctions; call names it in an Error). The caller has
+// checked device and fills in the rest.
+template <class State, auto create, class CreateInfo>
+Ref<State> created_state(const Device& device, const CreateInfo& ci, const char* call) {
+    Ref<State> s(new State);
+    s->device = device;
+    check((device.fn().*create)(device.vk(), &ci, nullptr, &s->handle), call);
     return s;
 }
 
