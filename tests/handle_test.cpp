@@ -1,9 +1,14 @@
 // The reference-counting core, independent of Vulkan.
 #include <vkrc/handle.hpp>
+#include <vkrc/detail/list.hpp>
+#include <vkrc/detail/span.hpp>
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <span>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace {
@@ -119,5 +124,63 @@ TEST(Handle, SixteenThreadsCopyAndDrop) {
     EXPECT_EQ(destroyed, 1);
 }
 #endif
+
+// vkrc::Span views what std::span views, and no more: an array of a derived
+// type is not an array of its base, and const elements are not writable ones.
+struct Base {
+    int x = 0;
+};
+struct Derived : Base {
+    int y = 0;
+};
+static_assert(std::is_convertible_v<std::vector<int>&, vkrc::Span<const int>>);
+static_assert(std::is_convertible_v<std::span<int>, vkrc::Span<const int>>);
+static_assert(std::is_convertible_v<vkrc::Span<int>, vkrc::Span<const int>>);
+static_assert(!std::is_convertible_v<vkrc::Span<const int>, vkrc::Span<int>>);
+static_assert(!std::is_convertible_v<const std::vector<int>&, vkrc::Span<int>>);
+static_assert(!std::is_convertible_v<std::vector<Derived>&, vkrc::Span<const Base>>);
+static_assert(!std::is_convertible_v<std::vector<unsigned>&, vkrc::Span<const int>>);
+
+int sum(vkrc::Span<const int> values) {
+    int total = 0;
+    for (int v : values) total += v;
+    return total;
+}
+
+TEST(Span, TakesEveryContiguousRange) {
+    std::vector<int> vector{1, 2, 3};
+    const std::array<int, 2> array{4, 5};
+    int c_array[] = {6, 7};
+    vkrc::List<int> list{8, 9};
+    EXPECT_EQ(sum(vector), 6);
+    EXPECT_EQ(sum(array), 9);
+    EXPECT_EQ(sum(c_array), 13);
+    EXPECT_EQ(sum(list), 17);
+    EXPECT_EQ(sum(std::span(vector).subspan(1, 2)), 5);
+    EXPECT_EQ(sum({vector.data(), 2}), 3);
+    EXPECT_EQ(sum({}), 0);
+    const vkrc::Span view(vector);
+    EXPECT_EQ(view.size_bytes(), 3 * sizeof(int));
+    EXPECT_EQ(view.back(), 3);
+    EXPECT_EQ(view.subspan(1, 1).front(), 2);
+    const std::span<const int> back = view;  // a std::span takes it back
+    EXPECT_EQ(back.size(), 3u);
+}
+
+// Raw<VkX> takes a raw handle, or any wrapper whose vk() returns one.
+struct FakeBuffer {
+    VkBuffer vk() const { return reinterpret_cast<VkBuffer>(std::uintptr_t{0x1000}); }
+};
+static_assert(std::is_convertible_v<VkBuffer, vkrc::Raw<VkBuffer>>);
+static_assert(std::is_convertible_v<const FakeBuffer&, vkrc::Raw<VkBuffer>>);
+static_assert(!std::is_convertible_v<const FakeBuffer&, vkrc::Raw<VkImage>>);
+
+TEST(Raw, ReadsTheWrappersHandle) {
+    const vkrc::Raw<VkBuffer> from_wrapper = FakeBuffer{};
+    const vkrc::Raw<VkBuffer> from_raw = VK_NULL_HANDLE;
+    EXPECT_EQ(static_cast<VkBuffer>(from_wrapper), FakeBuffer{}.vk());
+    EXPECT_EQ(*from_wrapper.get(), FakeBuffer{}.vk());
+    EXPECT_EQ(static_cast<VkBuffer>(from_raw), VK_NULL_HANDLE);
+}
 
 }  // namespace
