@@ -75,9 +75,7 @@ void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& i
 }
 
 // The bindings a layout checks writes against, and its variable-count binding.
-void keep_bindings(detail::DescriptorSetLayoutState& s, const Device& device,
-                   const List<DescriptorSetLayoutBinding>& bindings) {
-    s.device = device;
+void keep_bindings(detail::DescriptorSetLayoutState& s, const List<DescriptorSetLayoutBinding>& bindings) {
     s.bindings = bindings;
     for (const auto& b : bindings) {
         if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {
@@ -98,7 +96,6 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
             "device");
     }
     check_bindings(device, info, "vkrc::DescriptorSetLayout::create");
-    detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     std::vector<VkDescriptorSetLayoutBinding> bindings;
     std::vector<VkDescriptorBindingFlags> flags;
     // Every binding's immutable samplers, one after another; reserved whole
@@ -127,9 +124,9 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
     ci.flags = info.flags;
     ci.bindingCount = static_cast<std::uint32_t>(bindings.size());
     ci.pBindings = bindings.data();
-    keep_bindings(*s, device, info.bindings);
-    check(device.fn().vkCreateDescriptorSetLayout(device.vk(), &ci, nullptr, &s->handle),
-          "vkCreateDescriptorSetLayout");
+    auto s = detail::created_state<detail::DescriptorSetLayoutState, &DeviceFunctions::vkCreateDescriptorSetLayout>(
+        device, ci, "vkCreateDescriptorSetLayout");
+    keep_bindings(*s, info.bindings);
     return DescriptorSetLayout(std::move(s));
 }
 
@@ -139,8 +136,10 @@ DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescripto
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
     if (layout == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSetLayout is VK_NULL_HANDLE");
     check_bindings(device, info, who);
+    // The bindings before the handle: a failed copy must not destroy the adopted layout.
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
-    keep_bindings(*s, device, info.bindings);
+    keep_bindings(*s, info.bindings);
+    s->device = device;
     s->handle = layout;
     s->ownership = ownership;
     return DescriptorSetLayout(std::move(s));

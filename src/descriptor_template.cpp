@@ -1,5 +1,7 @@
 #include "vkrc/descriptor_template.hpp"
 
+#include "object_state.hpp"
+
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -35,6 +37,17 @@ void check_template_info(const Device& device, const DescriptorUpdateTemplateCre
     }
 }
 
+// What the template was made for: its type, its set layout and, for a push
+// template, the pipeline layout and set (handle copies: nothing here throws).
+void keep_template_info(detail::DescriptorUpdateTemplateState& s, const DescriptorUpdateTemplateCreateInfo& info) {
+    s.type = info.template_type;
+    s.set_layout = info.descriptor_set_layout;
+    if (info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) {
+        s.pipeline_layout = info.pipeline_layout;
+        s.set = info.set;
+    }
+}
+
 }  // namespace
 
 DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
@@ -52,16 +65,10 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
         ci.pipelineLayout = info.pipeline_layout.vk();
         ci.set = info.set;
     }
-    detail::Ref<detail::DescriptorUpdateTemplateState> s(new detail::DescriptorUpdateTemplateState);
-    s->device = device;
-    s->type = info.template_type;
-    s->set_layout = info.descriptor_set_layout;
-    if (push) {
-        s->pipeline_layout = info.pipeline_layout;
-        s->set = info.set;
-    }
-    check(device.fn().vkCreateDescriptorUpdateTemplate(device.vk(), &ci, nullptr, &s->handle),
-          "vkCreateDescriptorUpdateTemplate");
+    auto s = detail::created_state<detail::DescriptorUpdateTemplateState,
+                                   &DeviceFunctions::vkCreateDescriptorUpdateTemplate>(
+        device, ci, "vkCreateDescriptorUpdateTemplate");
+    keep_template_info(*s, info);
     return DescriptorUpdateTemplate(std::move(s));
 }
 
@@ -71,19 +78,9 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::adopt(const Device& device,
                                                          Ownership ownership) {
     constexpr const char* who = "vkrc::DescriptorUpdateTemplate::adopt";
     check_template_info(device, info, who, false);
-    if (update_template == VK_NULL_HANDLE) {
-        throw UsageError(std::string(who) + ": the VkDescriptorUpdateTemplate is VK_NULL_HANDLE");
-    }
-    detail::Ref<detail::DescriptorUpdateTemplateState> s(new detail::DescriptorUpdateTemplateState);
-    s->device = device;
-    s->handle = update_template;
-    s->ownership = ownership;
-    s->type = info.template_type;
-    s->set_layout = info.descriptor_set_layout;
-    if (info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) {
-        s->pipeline_layout = info.pipeline_layout;
-        s->set = info.set;
-    }
+    auto s = detail::adopted_state<detail::DescriptorUpdateTemplateState>(who, device, "Device", update_template,
+                                                                          "VkDescriptorUpdateTemplate", ownership);
+    keep_template_info(*s, info);
     return DescriptorUpdateTemplate(std::move(s));
 }
 

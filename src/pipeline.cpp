@@ -121,10 +121,9 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
     ci.pSubpasses = subpasses.data();
     ci.dependencyCount = static_cast<std::uint32_t>(info.dependencies.size());
     ci.pDependencies = info.dependencies.data();
-    detail::Ref<detail::RenderPassState> s(new detail::RenderPassState);
-    s->device = device;
+    auto s = detail::created_state<detail::RenderPassState, &DeviceFunctions::vkCreateRenderPass>(device, ci,
+                                                                                                  "vkCreateRenderPass");
     s->color_counts = std::move(color_counts);
-    check(device.fn().vkCreateRenderPass(device.vk(), &ci, nullptr, &s->handle), "vkCreateRenderPass");
     return RenderPass(std::move(s));
 }
 

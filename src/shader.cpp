@@ -18,8 +18,8 @@ ShaderModuleState::~ShaderModuleState() { destroy_owned<&DeviceFunctions::vkDest
 namespace {
 constexpr std::uint32_t spirv_magic = 0x07230203;
 
-void make(const Device& device, const void* code, std::size_t bytes, const char* who,
-          detail::Ref<detail::ShaderModuleState>& s) {
+detail::Ref<detail::ShaderModuleState> make(const Device& device, const void* code, std::size_t bytes,
+                                            const char* who) {
     if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
     if (bytes == 0) throw UsageError(std::string(who) + ": the SPIR-V module is empty");
     if (bytes % 4 != 0) {
@@ -35,25 +35,20 @@ void make(const Device& device, const void* code, std::size_t bytes, const char*
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = bytes;
     ci.pCode = static_cast<const std::uint32_t*>(code);
-    s = detail::Ref<detail::ShaderModuleState>(new detail::ShaderModuleState);
-    s->device = device;
-    check(device.fn().vkCreateShaderModule(device.vk(), &ci, nullptr, &s->handle), "vkCreateShaderModule");
+    return detail::created_state<detail::ShaderModuleState, &DeviceFunctions::vkCreateShaderModule>(
+        device, ci, "vkCreateShaderModule");
 }
 }  // namespace
 
 ShaderModule ShaderModule::create(const Device& device, Span<const std::uint32_t> spirv) {
-    detail::Ref<detail::ShaderModuleState> s;
-    make(device, spirv.data(), spirv.size_bytes(), "vkrc::ShaderModule::create", s);
-    return ShaderModule(std::move(s));
+    return ShaderModule(make(device, spirv.data(), spirv.size_bytes(), "vkrc::ShaderModule::create"));
 }
 
 ShaderModule ShaderModule::create(const Device& device, Span<const std::byte> spirv) {
     // Vulkan wants 4-byte-aligned words; bytes from anywhere are copied into them.
     std::vector<std::uint32_t> words((spirv.size() + 3) / 4);
     if (!spirv.empty()) std::memcpy(words.data(), spirv.data(), spirv.size());
-    detail::Ref<detail::ShaderModuleState> s;
-    make(device, words.data(), spirv.size(), "vkrc::ShaderModule::create", s);
-    return ShaderModule(std::move(s));
+    return ShaderModule(make(device, words.data(), spirv.size(), "vkrc::ShaderModule::create"));
 }
 
 ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
@@ -67,9 +62,8 @@ ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::vector<std::uint32_t> words((bytes.size() + 3) / 4);
     if (!bytes.empty()) std::memcpy(words.data(), bytes.data(), bytes.size());
-    detail::Ref<detail::ShaderModuleState> s;
-    make(device, words.data(), bytes.size(), ("vkrc::ShaderModule::load: " + std::string(spv_file)).c_str(), s);
-    return ShaderModule(std::move(s));
+    const std::string who = "vkrc::ShaderModule::load: " + std::string(spv_file);
+    return ShaderModule(make(device, words.data(), bytes.size(), who.c_str()));
 }
 
 VKRC_END_NAMESPACE

@@ -74,31 +74,27 @@ void Fence::unsignal() const {
 }
 
 namespace {
-void make_semaphore(const Device& device, SemaphoreType type, std::uint64_t initial,
-                    detail::Ref<detail::SemaphoreState>& s) {
+detail::Ref<detail::SemaphoreState> make_semaphore(const Device& device, SemaphoreType type, std::uint64_t initial) {
     VkSemaphoreTypeCreateInfo type_info{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO};
     type_info.semaphoreType = VK_SEMAPHORE_TYPE_TIMELINE;
     type_info.initialValue = initial;
     VkSemaphoreCreateInfo ci{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO};
     if (type == SemaphoreType::timeline) ci.pNext = &type_info;
-    s->device = device;
+    auto s = detail::created_state<detail::SemaphoreState, &DeviceFunctions::vkCreateSemaphore>(device, ci,
+                                                                                                "vkCreateSemaphore");
     s->type = type;
-    check(device.fn().vkCreateSemaphore(device.vk(), &ci, nullptr, &s->handle), "vkCreateSemaphore");
+    return s;
 }
 }  // namespace
 
 Semaphore Semaphore::create_binary(const Device& device) {
     require_device(device, "vkrc::Semaphore::create_binary");
-    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
-    make_semaphore(device, SemaphoreType::binary, 0, s);
-    return Semaphore(std::move(s));
+    return Semaphore(make_semaphore(device, SemaphoreType::binary, 0));
 }
 
 Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial_value) {
     require_device(device, "vkrc::Semaphore::create_timeline");
-    detail::Ref<detail::SemaphoreState> s(new detail::SemaphoreState);
-    make_semaphore(device, SemaphoreType::timeline, initial_value, s);
-    return Semaphore(std::move(s));
+    return Semaphore(make_semaphore(device, SemaphoreType::timeline, initial_value));
 }
 
 Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership) {
