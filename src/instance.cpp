@@ -67,9 +67,8 @@ namespace {
 // loader has it.
 std::vector<const char*> instance_extensions(const InstanceCreateInfo& info, bool portability) {
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
-    if (info.validation) detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (info.validation || info.debug_callback) detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     if (portability) detail::add_unique(extensions, VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
-    if (info.debug_callback) detail::add_unique(extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
     return extensions;
 }
 

@@ -67,7 +67,7 @@ List<std::byte> Download::read() const {
     if (!t) throw UsageError("vkrc::Download::read: the download is empty or its batch was not submitted");
     t.wait_on_host();
     List<std::byte> out(size_);
-    readback_.allocation().read(0, Span<std::byte>(out.data(), out.size()));
+    readback_.allocation().read(0, out);
     return out;
 }
 

@@ -233,9 +233,8 @@ public:
     void bind_descriptor_set(const Pipeline& pipeline, std::uint32_t set_index, const DescriptorSet& set,
                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_set");
-        VkDescriptorSet raw = set.vk();
-        fn_->vkCmdBindDescriptorSets(cmd_, pipeline.bind_point(), pipeline.layout().vk(), set_index, 1, &raw,
-                                     static_cast<std::uint32_t>(dynamic_offsets.size()), dynamic_offsets.data());
+        const VkDescriptorSet raw = set.vk();
+        bind_descriptor_sets(pipeline.bind_point(), pipeline.layout().vk(), set_index, Span(&raw, 1), dynamic_offsets);
     }
     void bind_descriptor_sets(const Pipeline& pipeline, std::uint32_t first_set, Span<const VkDescriptorSet> sets,
                               Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
