@@ -140,6 +140,7 @@ static_assert(!std::is_convertible_v<vkrc::Span<const int>, vkrc::Span<int>>);
 static_assert(!std::is_convertible_v<const std::vector<int>&, vkrc::Span<int>>);
 static_assert(!std::is_convertible_v<std::vector<Derived>&, vkrc::Span<const Base>>);
 static_assert(!std::is_convertible_v<std::vector<unsigned>&, vkrc::Span<const int>>);
+static_assert(!std::is_constructible_v<vkrc::List<Base>, const std::vector<Derived>&>);  // List copies by the same rule
 
 int sum(vkrc::Span<const int> values) {
     int total = 0;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "vkrc/detail/moves.hpp"
+#include "vkrc/detail/span.hpp"
 
 #include <cstddef>
 #include <initializer_list>
@@ -25,13 +26,11 @@ public:
     // destructor frees what was made.
     List(std::initializer_list<T> items) : List() { append_copies(items.begin(), items.size()); }
     List(const T* items, std::size_t count) : List() { append_copies(items, count); }
-    // Any contiguous range of T: std::vector, std::array, std::span, vkrc::Span, List.
+    // Any contiguous range of T: std::vector, std::array, std::span, vkrc::Span,
+    // List (the rule Span views by: no base-class copies of derived elements).
     template <class Range>
-    requires requires(const Range& r) {
-        static_cast<const T*>(r.data());
-        r.size();
-    }
-    List(const Range& items) : List() { append_copies(items.data(), items.size()); }
+    requires requires(const Range& r) { r.size(); } && detail::viewable_as < detail::RangeElement<const Range>,
+    const T > List(const Range& items) : List() { append_copies(items.data(), items.size()); }
     // count value-initialised elements, made in place (T need not be movable).
     explicit List(std::size_t count) : List() {
         data_ = allocate(count);
