@@ -134,30 +134,33 @@ long long integer(const std::string& option, const std::string& value, long long
 
 int positive(const std::string& option, const std::string& value) { return int(integer(option, value, 1, 1000000)); }
 
+// The items of a comma-separated option, each once, read by parse_item;
+// option names it when the list is empty.
+template <class Item, class Parse>
+std::vector<Item> parse_list(const std::string& option, const std::string& list, Parse parse_item) {
+    std::vector<Item> items;
+    std::stringstream parts(list);
+    for (std::string part; std::getline(parts, part, ',');) {
+        Item item = parse_item(part);
+        if (std::find(items.begin(), items.end(), item) == items.end()) items.push_back(item);
+    }
+    if (items.empty()) usage(option + " is empty");
+    return items;
+}
+
 // --variants a,b,...: known names, each once.
 std::vector<std::string> parse_variants(const std::string& list) {
-    std::vector<std::string> variants;
-    std::stringstream names(list);
-    for (std::string name; std::getline(names, name, ',');) {
+    return parse_list<std::string>("--variants", list, [](const std::string& name) {
         bool known = false;
         for (const auto& entry : variant_registry()) known |= entry.name == name;
         if (!known) usage("unknown variant '" + name + "'");
-        if (std::find(variants.begin(), variants.end(), name) == variants.end()) variants.push_back(name);
-    }
-    if (variants.empty()) usage("--variants is empty");
-    return variants;
+        return name;
+    });
 }
 
 // --threads N[,N...]: each count once.
 std::vector<int> parse_threads(const std::string& option, const std::string& list) {
-    std::vector<int> threads;
-    std::stringstream counts(list);
-    for (std::string count; std::getline(counts, count, ',');) {
-        const int n = int(integer(option, count, 1, 64));
-        if (std::find(threads.begin(), threads.end(), n) == threads.end()) threads.push_back(n);
-    }
-    if (threads.empty()) usage("--threads is empty");
-    return threads;
+    return parse_list<int>(option, list, [&](const std::string& count) { return int(integer(option, count, 1, 64)); });
 }
 
 void parse_size(const std::string& option, const std::string& value, Config& config) {
