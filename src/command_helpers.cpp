@@ -173,17 +173,19 @@ void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const Mipmap
 // Queue labels
 
 namespace {
-VkDebugUtilsLabelEXT make_label(const char* name, const LabelColor& color) {
-    return {VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+// Calls a begin- or insert-label function (null without VK_EXT_debug_utils)
+// under the queue's lock: Vulkan requires queue calls to be synchronised.
+void label_queue(PFN_vkQueueInsertDebugUtilsLabelEXT f, detail::QueueState& queue, const char* name,
+                 const LabelColor& color) {
+    if (!f) return;
+    const VkDebugUtilsLabelEXT label = detail::debug_label(name, color);
+    LockGuard lock(queue.mutex);
+    f(queue.queue, &label);
 }
 }  // namespace
 
 void Queue::begin_label(const char* name, const LabelColor& color) const {
-    auto f = device_.fn().vkQueueBeginDebugUtilsLabelEXT;
-    if (!f) return;
-    auto label = make_label(name, color);
-    LockGuard lock(queue_->mutex);
-    f(queue_->queue, &label);
+    label_queue(device_.fn().vkQueueBeginDebugUtilsLabelEXT, *queue_, name, color);
 }
 
 void Queue::end_label() const {
@@ -194,11 +196,7 @@ void Queue::end_label() const {
 }
 
 void Queue::insert_label(const char* name, const LabelColor& color) const {
-    auto f = device_.fn().vkQueueInsertDebugUtilsLabelEXT;
-    if (!f) return;
-    auto label = make_label(name, color);
-    LockGuard lock(queue_->mutex);
-    f(queue_->queue, &label);
+    label_queue(device_.fn().vkQueueInsertDebugUtilsLabelEXT, *queue_, name, color);
 }
 
 VKRC_END_NAMESPACE

@@ -471,8 +471,7 @@ public:
     void begin_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_label");
         if (auto f = fn_->vkCmdBeginDebugUtilsLabelEXT) {
-            const VkDebugUtilsLabelEXT label{
-                VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+            const VkDebugUtilsLabelEXT label = detail::debug_label(name, color);
             f(cmd_, &label);
         }
     }
@@ -483,8 +482,7 @@ public:
     void insert_label(const char* name, const LabelColor& color = {}) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::insert_label");
         if (auto f = fn_->vkCmdInsertDebugUtilsLabelEXT) {
-            const VkDebugUtilsLabelEXT label{
-                VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+            const VkDebugUtilsLabelEXT label = detail::debug_label(name, color);
             f(cmd_, &label);
         }
     }

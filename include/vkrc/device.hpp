@@ -128,6 +128,14 @@ struct LabelColor {
     float r = 0.0f, g = 0.0f, b = 0.0f, a = 0.0f;
 };
 
+namespace detail {
+// The label that queue and command-buffer labels pass (name is not copied:
+// Vulkan reads it during the call).
+inline VkDebugUtilsLabelEXT debug_label(const char* name, const LabelColor& color) noexcept {
+    return {VK_STRUCTURE_TYPE_DEBUG_UTILS_LABEL_EXT, nullptr, name, {color.r, color.g, color.b, color.a}};
+}
+}  // namespace detail
+
 // A queue; keeps its Device alive. Submission and presentation take the
 // queue's lock under the multi-thread policy (Vulkan requires external
 // synchronisation of queues); nothing else does.
