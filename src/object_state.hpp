@@ -4,9 +4,22 @@
 #include "vkrc/device.hpp"
 
 #include <string>
+#include <string_view>
 
 VKRC_BEGIN_NAMESPACE
 namespace detail {
+
+// Refuses a bad argument of who with UsageError "who: problem".
+inline void require(bool ok, const char* who, std::string_view problem) {
+    if (!ok) throw UsageError(std::string(who) + ": " + std::string(problem));
+}
+
+// Refuses an empty vkrc handle with UsageError "who: the_name handle is
+// empty", the_name saying which (e.g. "the Device", "a ShaderModule").
+template <class Handle>
+void require_handle(const Handle& handle, const char* who, const char* the_name) {
+    if (!handle) throw UsageError(std::string(who) + ": " + the_name + " handle is empty");
+}
 
 // The state of an adopted handle: refuses an empty parent ("who: the
 // parent_name handle is empty") and a null handle ("who: the handle_name is

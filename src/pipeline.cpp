@@ -26,11 +26,7 @@ PipelineState::~PipelineState() {
 }
 }  // namespace detail
 
-namespace {
-void require(bool ok, const char* who, const char* problem) {
-    if (!ok) throw UsageError(std::string(who) + ": " + problem);
-}
-}  // namespace
+using detail::require;
 
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
 
@@ -70,10 +66,10 @@ Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPi
 }
 
 PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
-    require(static_cast<bool>(device), "vkrc::PipelineLayout::create", "the Device handle is empty");
+    detail::require_handle(device, "vkrc::PipelineLayout::create", "the Device");
     std::vector<VkDescriptorSetLayout> sets;
     for (const auto& l : info.set_layouts) {
-        require(static_cast<bool>(l), "vkrc::PipelineLayout::create", "a DescriptorSetLayout handle is empty");
+        detail::require_handle(l, "vkrc::PipelineLayout::create", "a DescriptorSetLayout");
         require(l.device() == device, "vkrc::PipelineLayout::create",
                 "a DescriptorSetLayout belongs to another device");
         sets.push_back(l.vk());
@@ -91,7 +87,7 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
 
 RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& info) {
     const char* who = "vkrc::RenderPass::create";
-    require(static_cast<bool>(device), who, "the Device handle is empty");
+    detail::require_handle(device, who, "the Device");
     require(!info.subpasses.empty(), who, "subpasses is empty");
     std::vector<VkSubpassDescription> subpasses;
     std::vector<std::uint32_t> color_counts;
@@ -135,12 +131,12 @@ std::uint32_t RenderPass::color_attachment_count(std::uint32_t subpass) const {
 
 Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInfo& info) {
     const char* who = "vkrc::Framebuffer::create";
-    require(static_cast<bool>(device), who, "the Device handle is empty");
+    detail::require_handle(device, who, "the Device");
     require(static_cast<bool>(info.render_pass), who, "render_pass is empty");
     require(info.width > 0 && info.height > 0 && info.layers > 0, who, "width, height and layers must be non-zero");
     std::vector<VkImageView> views;
     for (const auto& v : info.attachments) {
-        require(static_cast<bool>(v), who, "an attachment ImageView handle is empty");
+        detail::require_handle(v, who, "an attachment ImageView");
         views.push_back(v.vk());
     }
     VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
@@ -163,7 +159,7 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
 // Pipeline caches
 
 PipelineCache PipelineCache::create(const Device& device, Span<const std::byte> initial_data) {
-    require(static_cast<bool>(device), "vkrc::PipelineCache::create", "the Device handle is empty");
+    detail::require_handle(device, "vkrc::PipelineCache::create", "the Device");
     VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
     ci.initialDataSize = initial_data.size();
     ci.pInitialData = initial_data.data();
@@ -193,7 +189,7 @@ const char* cache_data_problem(const PhysicalDevice& physical, const std::vector
 }  // namespace
 
 PipelineCache PipelineCache::load(const Device& device, const char* file) {
-    require(static_cast<bool>(device), "vkrc::PipelineCache::load", "the Device handle is empty");
+    detail::require_handle(device, "vkrc::PipelineCache::load", "the Device");
     std::vector<std::byte> data;
     const char* problem = nullptr;
     std::ifstream in(file, std::ios::binary);
@@ -241,24 +237,11 @@ void PipelineCache::save(const char* file) const {
 
 ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const ShaderModule& module,
                                         const char* entry_point, const PipelineCache& cache) {
-    const char* who = "vkrc::ComputePipeline::create";
-    require(static_cast<bool>(layout), who, "the PipelineLayout handle is empty");
-    require(static_cast<bool>(module), who, "the ShaderModule handle is empty");
-    require(module.device() == layout.device(), who,
-            "the ShaderModule belongs to another device than the pipeline layout");
-    VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    ci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    ci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    ci.stage.module = module.vk();
-    ci.stage.pName = entry_point;
-    ci.layout = layout.vk();
-    const auto& d = layout.device();
-    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
-    s->layout = layout;
-    s->bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
-    check(d.fn().vkCreateComputePipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle),
-          "vkCreateComputePipelines");
-    return ComputePipeline(std::move(s));
+    ComputePipelineCreateInfo info;
+    info.module = module;
+    info.entry_point = entry_point;
+    info.cache = cache;
+    return create(layout, info);
 }
 
 // The default dynamic states are set here rather than by a default member
@@ -268,7 +251,7 @@ GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout)
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                                          const char* entry_point) {
-    require(static_cast<bool>(module), "vkrc::GraphicsPipelineBuilder::shader", "the ShaderModule handle is empty");
+    detail::require_handle(module, "vkrc::GraphicsPipelineBuilder::shader", "the ShaderModule");
     require(module.device() == layout_.device(), "vkrc::GraphicsPipelineBuilder::shader",
             "the ShaderModule belongs to another device than the pipeline layout");
     stages_.push_back({stage, module, entry_point});
@@ -329,66 +312,6 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(Span<const VkFormat>
     depth_format_ = depth_format;
     stencil_format_ = stencil_format;
     return *this;
-}
-
-GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) const {
-    const char* who = "vkrc::GraphicsPipelineBuilder::build";
-    require(static_cast<bool>(layout_), who, "the PipelineLayout handle is empty");
-    require(!stages_.empty(), who, "no shader stages");
-    std::vector<VkPipelineShaderStageCreateInfo> stages;
-    std::vector<VkSpecializationInfo> specs(stages_.size());
-    for (const auto& st : stages_) {
-        require(static_cast<bool>(st.module), who, "a ShaderModule handle is empty");
-        VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-        si.stage = st.stage;
-        si.module = st.module.vk();
-        si.pName = st.entry_point;
-        stages.push_back(si);
-    }
-    attach_specializations(stages, specs);
-    check_tessellation();
-    const auto vertex = vertex_input_state();
-    const auto assembly = input_assembly_state();
-    VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
-    tessellation.patchControlPoints = patch_control_points_;
-    const auto viewport = viewport_state();
-    const auto raster = rasterization_state();
-    const std::uint32_t sample_mask[2] = {static_cast<std::uint32_t>(multisample_.sample_mask),
-                                          static_cast<std::uint32_t>(multisample_.sample_mask >> 32)};
-    auto multisample = multisample_state();
-    multisample.pSampleMask = sample_mask;
-    const auto depth = depth_stencil_state();
-    const std::uint32_t color_count = render_pass_ ? render_pass_.color_attachment_count(subpass_)
-                                                   : static_cast<std::uint32_t>(color_formats_.size());
-    const auto rendering = rendering_info();
-    List<VkPipelineColorBlendAttachmentState> blends;
-    const auto blend = color_blend_state(color_count, blends);
-    const auto dynamic = dynamic_state_info();
-
-    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
-    ci.pNext = render_pass_ ? next_ : &rendering;
-    ci.flags = flags_;
-    ci.pTessellationState = patch_control_points_ ? &tessellation : nullptr;
-    ci.stageCount = static_cast<std::uint32_t>(stages.size());
-    ci.pStages = stages.data();
-    ci.pVertexInputState = &vertex;
-    ci.pInputAssemblyState = &assembly;
-    ci.pViewportState = &viewport;
-    ci.pRasterizationState = &raster;
-    ci.pMultisampleState = &multisample;
-    ci.pDepthStencilState = &depth;
-    ci.pColorBlendState = &blend;
-    ci.pDynamicState = &dynamic;
-    ci.layout = layout_.vk();
-    ci.renderPass = render_pass_ ? render_pass_.vk() : VK_NULL_HANDLE;
-    ci.subpass = subpass_;
-    const auto& d = layout_.device();
-    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
-    s->layout = layout_;
-    s->bind_point = VK_PIPELINE_BIND_POINT_GRAPHICS;
-    check(d.fn().vkCreateGraphicsPipelines(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle),
-          "vkCreateGraphicsPipelines");
-    return GraphicsPipeline(std::move(s));
 }
 
 VKRC_END_NAMESPACE

@@ -1,6 +1,8 @@
-// Issue 14's pipeline state: specialization constants, the full graphics
-// state of GraphicsPipelineBuilder, and ComputePipeline's create info.
+// Making pipelines: specialization constants, the full graphics state of
+// GraphicsPipelineBuilder and its build(), and ComputePipeline::create.
 #include "vkrc/pipeline.hpp"
+
+#include "object_state.hpp"
 
 #include <algorithm>
 #include <string>
@@ -8,11 +10,9 @@
 
 VKRC_BEGIN_NAMESPACE
 
-namespace {
+using detail::require;
 
-void require(bool ok, const char* who, const std::string& problem) {
-    if (!ok) throw UsageError(std::string(who) + ": " + problem);
-}
+namespace {
 
 void check_specialization(const Specialization& spec, const char* who) {
     for (const auto& e : spec.map_entries) {
@@ -37,12 +37,26 @@ VkBool32 vk_bool(bool b) { return b ? VK_TRUE : VK_FALSE; }
 
 constexpr const char* build_who = "vkrc::GraphicsPipelineBuilder::build";
 
+// The state of a new pipeline of layout, its handle made by create
+// (vkCreateGraphicsPipelines or vkCreateComputePipelines; call names it) from ci.
+template <auto create, class CreateInfo>
+detail::Ref<detail::PipelineState> created_pipeline(const PipelineLayout& layout, VkPipelineBindPoint bind_point,
+                                                    const PipelineCache& cache, const CreateInfo& ci,
+                                                    const char* call) {
+    const auto& d = layout.device();
+    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
+    s->layout = layout;
+    s->bind_point = bind_point;
+    check((d.fn().*create)(d.vk(), cache ? cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle), call);
+    return s;
+}
+
 }  // namespace
 
 ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const ComputePipelineCreateInfo& info) {
     const char* who = "vkrc::ComputePipeline::create";
-    require(static_cast<bool>(layout), who, "the PipelineLayout handle is empty");
-    require(static_cast<bool>(info.module), who, "the ShaderModule handle is empty");
+    detail::require_handle(layout, who, "the PipelineLayout");
+    detail::require_handle(info.module, who, "the ShaderModule");
     require(info.module.device() == layout.device(), who,
             "the ShaderModule belongs to another device than the pipeline layout");
     check_specialization(info.specialization, who);
@@ -58,13 +72,8 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Comp
     ci.stage.pName = info.entry_point;
     ci.stage.pSpecializationInfo = info.specialization.map_entries.empty() ? nullptr : &spec;
     ci.layout = layout.vk();
-    const auto& d = layout.device();
-    detail::Ref<detail::PipelineState> s(new detail::PipelineState);
-    s->layout = layout;
-    s->bind_point = VK_PIPELINE_BIND_POINT_COMPUTE;
-    const VkPipelineCache cache = info.cache ? info.cache.vk() : VK_NULL_HANDLE;
-    check(d.fn().vkCreateComputePipelines(d.vk(), cache, 1, &ci, nullptr, &s->handle), "vkCreateComputePipelines");
-    return ComputePipeline(std::move(s));
+    return ComputePipeline(created_pipeline<&DeviceFunctions::vkCreateComputePipelines>(
+        layout, VK_PIPELINE_BIND_POINT_COMPUTE, info.cache, ci, "vkCreateComputePipelines"));
 }
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::rasterization(const RasterizationState& state) {
@@ -137,6 +146,19 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::flags(VkPipelineCreateFlags fl
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::next(const void* chain) {
     next_ = chain;
     return *this;
+}
+
+List<VkPipelineShaderStageCreateInfo> GraphicsPipelineBuilder::shader_stages() const {
+    List<VkPipelineShaderStageCreateInfo> stages;
+    for (const auto& st : stages_) {
+        detail::require_handle(st.module, build_who, "a ShaderModule");
+        VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+        si.stage = st.stage;
+        si.module = st.module.vk();
+        si.pName = st.entry_point;
+        stages.push_back(si);
+    }
+    return stages;
 }
 
 void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageCreateInfo> stages,
@@ -277,6 +299,52 @@ VkPipelineDynamicStateCreateInfo GraphicsPipelineBuilder::dynamic_state_info() c
     d.dynamicStateCount = static_cast<std::uint32_t>(dynamic_states_.size());
     d.pDynamicStates = dynamic_states_.data();
     return d;
+}
+
+GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) const {
+    detail::require_handle(layout_, build_who, "the PipelineLayout");
+    require(!stages_.empty(), build_who, "no shader stages");
+    auto stages = shader_stages();
+    std::vector<VkSpecializationInfo> specs(stages_.size());
+    attach_specializations(stages, specs);
+    check_tessellation();
+    const auto vertex = vertex_input_state();
+    const auto assembly = input_assembly_state();
+    VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
+    tessellation.patchControlPoints = patch_control_points_;
+    const auto viewport = viewport_state();
+    const auto raster = rasterization_state();
+    const std::uint32_t sample_mask[2] = {static_cast<std::uint32_t>(multisample_.sample_mask),
+                                          static_cast<std::uint32_t>(multisample_.sample_mask >> 32)};
+    auto multisample = multisample_state();
+    multisample.pSampleMask = sample_mask;
+    const auto depth = depth_stencil_state();
+    const std::uint32_t color_count = render_pass_ ? render_pass_.color_attachment_count(subpass_)
+                                                   : static_cast<std::uint32_t>(color_formats_.size());
+    const auto rendering = rendering_info();
+    List<VkPipelineColorBlendAttachmentState> blends;
+    const auto blend = color_blend_state(color_count, blends);
+    const auto dynamic = dynamic_state_info();
+
+    VkGraphicsPipelineCreateInfo ci{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    ci.pNext = render_pass_ ? next_ : &rendering;
+    ci.flags = flags_;
+    ci.pTessellationState = patch_control_points_ ? &tessellation : nullptr;
+    ci.stageCount = static_cast<std::uint32_t>(stages.size());
+    ci.pStages = stages.data();
+    ci.pVertexInputState = &vertex;
+    ci.pInputAssemblyState = &assembly;
+    ci.pViewportState = &viewport;
+    ci.pRasterizationState = &raster;
+    ci.pMultisampleState = &multisample;
+    ci.pDepthStencilState = &depth;
+    ci.pColorBlendState = &blend;
+    ci.pDynamicState = &dynamic;
+    ci.layout = layout_.vk();
+    ci.renderPass = render_pass_ ? render_pass_.vk() : VK_NULL_HANDLE;
+    ci.subpass = subpass_;
+    return GraphicsPipeline(created_pipeline<&DeviceFunctions::vkCreateGraphicsPipelines>(
+        layout_, VK_PIPELINE_BIND_POINT_GRAPHICS, cache, ci, "vkCreateGraphicsPipelines"));
 }
 
 VKRC_END_NAMESPACE

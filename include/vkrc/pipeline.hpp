@@ -368,6 +368,7 @@ private:
     VkPipelineCreateFlags flags_ = 0;
     const void* next_ = nullptr;
     // build()'s pieces (src/pipeline_state.cpp); the results point into *this.
+    List<VkPipelineShaderStageCreateInfo> shader_stages() const;
     void attach_specializations(Span<VkPipelineShaderStageCreateInfo> stages, Span<VkSpecializationInfo> infos) const;
     void check_tessellation() const;
     VkPipelineViewportStateCreateInfo viewport_state() const;
