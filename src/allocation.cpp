@@ -2,6 +2,7 @@
 #include "vkrc/memory.hpp"
 
 #include "memory_internal.hpp"
+#include "object_state.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -77,7 +78,7 @@ void AllocationState::on_last_release() noexcept {
 
 Allocation Allocation::create(const Device& device, const AllocationRequest& request,
                               const SharedAllocator& allocator) {
-    if (!device) throw UsageError("vkrc::Allocation::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Allocation::create", "the Device");
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
     if (a) {

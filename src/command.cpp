@@ -43,7 +43,7 @@ CommandBufferState::~CommandBufferState() {
 }  // namespace detail
 
 CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::CommandPool::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::CommandPool::create", "the Device");
     VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     ci.pNext = info.next;
     ci.flags = info.flags;
@@ -98,7 +98,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
 CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
                                    Ownership ownership) {
     constexpr const char* who = "vkrc::CommandBuffer::adopt";
-    if (!pool) throw UsageError(std::string(who) + ": the CommandPool handle is empty");
+    detail::require_handle(pool, who, "the CommandPool");
     if (command_buffer == VK_NULL_HANDLE)
         throw UsageError(std::string(who) + ": the VkCommandBuffer is VK_NULL_HANDLE");
     if (level != VK_COMMAND_BUFFER_LEVEL_PRIMARY && level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {

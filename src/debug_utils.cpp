@@ -15,7 +15,7 @@ DebugMessengerState::~DebugMessengerState() {
 
 namespace {
 void require_debug_utils(const Instance& instance, const char* call) {
-    if (!instance) throw UsageError(std::string(call) + ": the Instance handle is empty");
+    detail::require_handle(instance, call, "the Instance");
     if (!instance.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) {
         throw UsageError(std::string(call) + ": the instance was created without VK_EXT_debug_utils");
     }

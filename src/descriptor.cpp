@@ -88,7 +88,7 @@ void keep_bindings(detail::DescriptorSetLayoutState& s, const List<DescriptorSet
 }  // namespace
 
 DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::DescriptorSetLayout::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::DescriptorSetLayout::create", "the Device");
     if ((info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR) &&
         !device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)) {
         throw UsageError(
@@ -133,7 +133,7 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
 DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescriptorSetLayout layout,
                                                const DescriptorSetLayoutCreateInfo& info, Ownership ownership) {
     constexpr const char* who = "vkrc::DescriptorSetLayout::adopt";
-    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    detail::require_handle(device, who, "the Device");
     if (layout == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSetLayout is VK_NULL_HANDLE");
     check_bindings(device, info, who);
     // The bindings before the handle: a failed copy must not destroy the adopted layout.
@@ -154,7 +154,7 @@ DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool
 }
 
 DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPoolCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::DescriptorPool::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::DescriptorPool::create", "the Device");
     if (info.max_sets == 0) throw UsageError("vkrc::DescriptorPool::create: max_sets is 0");
     if (info.pool_sizes.empty()) throw UsageError("vkrc::DescriptorPool::create: pool_sizes is empty");
     VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, info.next};
@@ -191,7 +191,7 @@ void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::u
 
 DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
                                        std::uint32_t variable_descriptor_count) const {
-    if (!layout) throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout handle is empty");
+    detail::require_handle(layout, "vkrc::DescriptorPool::allocate", "the DescriptorSetLayout");
     if (!(layout.device() == device())) {
         throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout belongs to another device");
     }
@@ -228,8 +228,8 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
 DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorSetLayout& layout, VkDescriptorSet set,
                                    Ownership ownership, std::uint32_t variable_descriptor_count) {
     constexpr const char* who = "vkrc::DescriptorSet::adopt";
-    if (!pool) throw UsageError(std::string(who) + ": the DescriptorPool handle is empty");
-    if (!layout) throw UsageError(std::string(who) + ": the DescriptorSetLayout handle is empty");
+    detail::require_handle(pool, who, "the DescriptorPool");
+    detail::require_handle(layout, who, "the DescriptorSetLayout");
     if (set == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSet is VK_NULL_HANDLE");
     if (!(layout.device() == pool.device())) {
         throw UsageError(std::string(who) + ": the DescriptorSetLayout belongs to another device");
@@ -305,7 +305,7 @@ void check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkD
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer,
                                  VkDeviceSize offset, VkDeviceSize range, std::uint32_t array_element) const {
     constexpr const char* who = "vkrc::DescriptorSet::write_buffer";
-    if (!buffer) throw UsageError(std::string(who) + ": the Buffer handle is empty");
+    detail::require_handle(buffer, who, "the Buffer");
     if (!(buffer.device() == pool().device()))
         throw UsageError(std::string(who) + ": the buffer belongs to another device");
     const VkBufferUsageFlags needs =
@@ -402,7 +402,7 @@ void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type, S
 void DescriptorSet::update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const {
     VKRC_REQUIRE_STATE("vkrc::DescriptorSet::update_with_template");
     constexpr const char* who = "vkrc::DescriptorSet::update_with_template";
-    if (!update_template) throw UsageError(std::string(who) + ": the DescriptorUpdateTemplate handle is empty");
+    detail::require_handle(update_template, who, "the DescriptorUpdateTemplate");
     if (update_template.template_type() != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET) {
         throw UsageError(std::string(who) + ": the template is for push descriptors");
     }

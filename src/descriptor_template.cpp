@@ -20,7 +20,7 @@ namespace {
 // adopt() passes need_entries false: the template exists, its entries are not read.
 void check_template_info(const Device& device, const DescriptorUpdateTemplateCreateInfo& info, const char* who,
                          bool need_entries) {
-    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    detail::require_handle(device, who, "the Device");
     if (need_entries && info.entries.empty()) throw UsageError(std::string(who) + ": entries is empty");
     if (!info.descriptor_set_layout) throw UsageError(std::string(who) + ": descriptor_set_layout is empty");
     if (!(info.descriptor_set_layout.device() == device)) {

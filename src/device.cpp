@@ -1,6 +1,7 @@
 #include "vkrc/device.hpp"
 
 #include "text.hpp"
+#include "object_state.hpp"
 #include "vkrc/extension_functions.hpp"
 
 #include <algorithm>
@@ -12,7 +13,7 @@
 VKRC_BEGIN_NAMESPACE
 
 int find_dedicated_queue_family(const PhysicalDevice& physical, QueueRole role) {
-    if (!physical) throw UsageError("vkrc::find_dedicated_queue_family: the PhysicalDevice handle is empty");
+    detail::require_handle(physical, "vkrc::find_dedicated_queue_family", "the PhysicalDevice");
     constexpr VkQueueFlags graphics = VK_QUEUE_GRAPHICS_BIT, compute = VK_QUEUE_COMPUTE_BIT;
     const auto& families = physical.queue_families();
     for (std::uint32_t i = 0; i < families.size(); ++i) {
@@ -424,7 +425,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
 Device Device::create(const PhysicalDevice& physical) { return create(physical, DeviceCreateInfo{}); }
 
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
-    if (!physical) throw UsageError("vkrc::Device::create: the PhysicalDevice handle is empty");
+    detail::require_handle(physical, "vkrc::Device::create", "the PhysicalDevice");
     std::vector<QueueRequest> requests(info.queue_requests.begin(), info.queue_requests.end());
     if (requests.empty()) add_role_requests(physical, info, requests);
     const auto queue_infos = queue_create_infos(physical, requests);
@@ -451,7 +452,7 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
 
 Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
                      Span<const char* const> enabled_extensions) {
-    if (!physical) throw UsageError("vkrc::Device::adopt: the PhysicalDevice handle is empty");
+    detail::require_handle(physical, "vkrc::Device::adopt", "the PhysicalDevice");
     if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Device::adopt: the VkDevice is VK_NULL_HANDLE");
     detail::Ref<detail::DeviceState> state;
     try {

@@ -1,6 +1,7 @@
 #include "vkrc/glfw.hpp"
 
 #include "text.hpp"
+#include "object_state.hpp"
 
 #include <GLFW/glfw3.h>
 
@@ -40,7 +41,7 @@ List<const char*> required_instance_extensions() {
 }
 
 Surface create_surface(const Instance& instance, GLFWwindow* window) {
-    if (!instance) throw UsageError("vkrc::glfw::create_surface: the Instance handle is empty");
+    detail::require_handle(instance, "vkrc::glfw::create_surface", "the Instance");
     if (!window) throw UsageError("vkrc::glfw::create_surface: the window is null");
     VkSurfaceKHR surface = VK_NULL_HANDLE;
     check(glfwCreateWindowSurface(instance.vk(), window, nullptr, &surface), "glfwCreateWindowSurface");

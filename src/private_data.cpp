@@ -18,7 +18,7 @@ PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot s
 }
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::PrivateDataSlot::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::PrivateDataSlot::create", "the Device");
     VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO, info.next, info.flags};
     return PrivateDataSlot(
         detail::created_state<detail::PrivateDataSlotState, &DeviceFunctions::vkCreatePrivateDataSlot>(

@@ -154,7 +154,7 @@ detail::Ref<detail::ImageState> image_state(const Device& device, const ImageCre
 }  // namespace
 
 Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::Buffer::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Buffer::create", "the Device");
     if (info.size == 0) throw UsageError("vkrc::Buffer::create: size is 0");
     if (info.usage == 0) throw UsageError("vkrc::Buffer::create: usage is 0");
     constexpr VkBufferCreateFlags sparse = VK_BUFFER_CREATE_SPARSE_BINDING_BIT | VK_BUFFER_CREATE_SPARSE_RESIDENCY_BIT |
@@ -195,7 +195,7 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
 
 Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
                      Ownership ownership, Function<void()> cleanup) {
-    if (!device) throw UsageError("vkrc::Buffer::adopt: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Buffer::adopt", "the Device");
     if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
     auto state = buffer_state(device, size, usage, ownership);
     state->handle = buffer;
@@ -268,7 +268,7 @@ FormatBlock format_block(VkFormat format) noexcept {
 }
 
 Image Image::create(const Device& device, const ImageCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::Image::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Image::create", "the Device");
     if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::Image::create: format is VK_FORMAT_UNDEFINED");
     if (info.extent.width == 0 || info.extent.height == 0 || info.extent.depth == 0) {
         throw UsageError("vkrc::Image::create: extent has a zero dimension");
@@ -306,7 +306,7 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
 
 Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership,
                    Function<void()> cleanup) {
-    if (!device) throw UsageError("vkrc::Image::adopt: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Image::adopt", "the Device");
     if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
     auto state = image_state(device, info, ownership);
     state->handle = image;
@@ -315,7 +315,7 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
 }
 
 ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info) {
-    if (!image) throw UsageError("vkrc::ImageView::create: the Image handle is empty");
+    detail::require_handle(image, "vkrc::ImageView::create", "the Image");
     VkSamplerYcbcrConversionInfo conversion =
         conversion_info(image.device(), info.ycbcr_conversion, info.next, "vkrc::ImageView::create");
     VkImageViewCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};
@@ -370,7 +370,7 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
 }
 
 BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& info) {
-    if (!buffer) throw UsageError("vkrc::BufferView::create: the Buffer handle is empty");
+    detail::require_handle(buffer, "vkrc::BufferView::create", "the Buffer");
     if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::BufferView::create: format is VK_FORMAT_UNDEFINED");
     VkBufferViewCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO, info.next};
     ci.flags = info.flags;
@@ -405,7 +405,7 @@ Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership owners
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::Sampler::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::Sampler::create", "the Device");
     VkSamplerYcbcrConversionInfo conversion =
         conversion_info(device, info.ycbcr_conversion, info.next, "vkrc::Sampler::create");
     VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};

@@ -20,7 +20,7 @@ constexpr std::uint32_t spirv_magic = 0x07230203;
 
 detail::Ref<detail::ShaderModuleState> make(const Device& device, const void* code, std::size_t bytes,
                                             const char* who) {
-    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
+    detail::require_handle(device, who, "the Device");
     if (bytes == 0) throw UsageError(std::string(who) + ": the SPIR-V module is empty");
     if (bytes % 4 != 0) {
         throw UsageError(std::string(who) + ": the SPIR-V size (" + std::to_string(bytes) +

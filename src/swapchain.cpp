@@ -1,6 +1,7 @@
 #include "vkrc/swapchain.hpp"
 
 #include "vkrc/upload.hpp"
+#include "object_state.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -356,7 +357,7 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface) {
 
 Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info) {
     if (!queue) throw UsageError("vkrc::Swapchain::create: the Queue is empty");
-    if (!surface) throw UsageError("vkrc::Swapchain::create: the Surface handle is empty");
+    detail::require_handle(surface, "vkrc::Swapchain::create", "the Surface");
     const Device& device = queue.device();
     if (!device.extension_enabled(VK_KHR_SWAPCHAIN_EXTENSION_NAME)) {
         throw UsageError("vkrc::Swapchain::create: the device was created without VK_KHR_swapchain");

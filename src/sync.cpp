@@ -8,10 +8,6 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace {
-void require_device(const Device& device, const char* who) {
-    if (!device) throw UsageError(std::string(who) + ": the Device handle is empty");
-}
-
 // After a wait or a status query: a signalled fence is no longer in flight.
 VkResult finish_fence_query(detail::FenceState& s, VkResult r, const char* name) {
     if (r == VK_SUCCESS) s.note_signalled();
@@ -44,7 +40,7 @@ QueryPoolState::~QueryPoolState() { destroy_owned<&DeviceFunctions::vkDestroyQue
 }  // namespace detail
 
 Fence Fence::create(const Device& device, bool signaled) {
-    require_device(device, "vkrc::Fence::create");
+    detail::require_handle(device, "vkrc::Fence::create", "the Device");
     VkFenceCreateInfo ci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     if (signaled) ci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
     return Fence(
@@ -88,12 +84,12 @@ detail::Ref<detail::SemaphoreState> make_semaphore(const Device& device, Semapho
 }  // namespace
 
 Semaphore Semaphore::create_binary(const Device& device) {
-    require_device(device, "vkrc::Semaphore::create_binary");
+    detail::require_handle(device, "vkrc::Semaphore::create_binary", "the Device");
     return Semaphore(make_semaphore(device, SemaphoreType::binary, 0));
 }
 
 Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial_value) {
-    require_device(device, "vkrc::Semaphore::create_timeline");
+    detail::require_handle(device, "vkrc::Semaphore::create_timeline", "the Device");
     return Semaphore(make_semaphore(device, SemaphoreType::timeline, initial_value));
 }
 
@@ -139,7 +135,7 @@ VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
 }
 
 Event Event::create(const Device& device, bool device_only) {
-    require_device(device, "vkrc::Event::create");
+    detail::require_handle(device, "vkrc::Event::create", "the Device");
     VkEventCreateInfo ci{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
     if (device_only) ci.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
     return Event(
@@ -168,7 +164,7 @@ namespace {
 // The state of a pool described by info, its VkQueryPool not yet set.
 detail::Ref<detail::QueryPoolState> query_pool_state(const Device& device, const QueryPoolCreateInfo& info,
                                                      const char* who) {
-    require_device(device, who);
+    detail::require_handle(device, who, "the Device");
     if (info.query_count == 0) throw UsageError(std::string(who) + ": query_count is 0");
     const bool statistics = info.query_type == VK_QUERY_TYPE_PIPELINE_STATISTICS;
     if (statistics && info.pipeline_statistics == 0) {

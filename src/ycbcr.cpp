@@ -27,7 +27,7 @@ SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSam
 
 SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
                                                       const SamplerYcbcrConversionCreateInfo& info) {
-    if (!device) throw UsageError("vkrc::SamplerYcbcrConversion::create: the Device handle is empty");
+    detail::require_handle(device, "vkrc::SamplerYcbcrConversion::create", "the Device");
     if (info.format == VK_FORMAT_UNDEFINED) {
         throw UsageError("vkrc::SamplerYcbcrConversion::create: format is VK_FORMAT_UNDEFINED");
     }
