@@ -486,7 +486,6 @@ Queue Device::default_queue() const {
 
 QueueAssignment Device::queue_for(QueueRole role) const {
     VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
-    VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
     if (state_->queues.empty()) throw UsageError("vkrc::Device::queue_for: the device has no queues");
     const std::size_t index = state_->role_queues[static_cast<int>(role)];
     const std::size_t graphics = state_->role_queues[static_cast<int>(QueueRole::graphics)];
@@ -499,6 +498,7 @@ QueueAssignment Device::queue_for(QueueRole role) const {
 }
 
 void Device::wait_idle() const {
+    VKRC_REQUIRE_STATE("vkrc::Device::wait_idle");
     // Everything submitted before the wait is complete after it.
     std::vector<std::uint64_t> submitted;
     for (auto& q : state_->queues) submitted.push_back(q.timeline.last_submitted());

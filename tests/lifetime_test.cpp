@@ -586,6 +586,8 @@ TEST(EmptyHandle, AccessorsAndRecordingThrowUsageError) {
     expect_empty([&] { (void)buffer.size(); }, "vkrc::Buffer::size");
     expect_empty([&] { allocation.write_value(0, 1u); }, "vkrc::Allocation::write");
     expect_empty([&] { (void)vkrc::Device().vk(); }, "vkrc::Device::vk");
+    expect_empty([] { vkrc::Device().wait_idle(); }, "vkrc::Device::wait_idle");
+    expect_empty([] { (void)vkrc::Device().queue_for(vkrc::QueueRole::transfer); }, "vkrc::Device::queue_for");
 }
 #endif
 
