@@ -56,35 +56,31 @@ VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src
     return b;
 }
 
-VkImageMemoryBarrier2 image_ownership_release(VkImage image, const VkImageSubresourceRange& range,
-                                              VkImageLayout old_layout, VkImageLayout new_layout,
-                                              std::uint32_t src_family, std::uint32_t dst_family,
-                                              VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) noexcept {
-    auto b = image_barrier(image, range, old_layout, new_layout, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE,
-                           VK_ACCESS_2_NONE);
+VkImageMemoryBarrier2 ImageOwnershipTransfer::release(VkPipelineStageFlags2 src_stage,
+                                                      VkAccessFlags2 src_access) const noexcept {
+    const auto b = image_barrier(image, range, old_layout, new_layout, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE,
+                                 VK_ACCESS_2_NONE);
     return between_families(b, src_family, dst_family);
 }
 
-VkImageMemoryBarrier2 image_ownership_acquire(VkImage image, const VkImageSubresourceRange& range,
-                                              VkImageLayout old_layout, VkImageLayout new_layout,
-                                              std::uint32_t src_family, std::uint32_t dst_family,
-                                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    auto b = image_barrier(image, range, old_layout, new_layout, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, dst_stage,
-                           dst_access);
+VkImageMemoryBarrier2 ImageOwnershipTransfer::acquire(VkPipelineStageFlags2 dst_stage,
+                                                      VkAccessFlags2 dst_access) const noexcept {
+    const auto b = image_barrier(image, range, old_layout, new_layout, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                                 dst_stage, dst_access);
     return between_families(b, src_family, dst_family);
 }
 
-VkBufferMemoryBarrier2 buffer_ownership_release(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
-                                                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                                VkDeviceSize offset, VkDeviceSize size) noexcept {
-    auto b = buffer_barrier(buffer, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, offset, size);
+VkBufferMemoryBarrier2 BufferOwnershipTransfer::release(VkPipelineStageFlags2 src_stage,
+                                                        VkAccessFlags2 src_access) const noexcept {
+    const auto b =
+        buffer_barrier(buffer, src_stage, src_access, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, offset, size);
     return between_families(b, src_family, dst_family);
 }
 
-VkBufferMemoryBarrier2 buffer_ownership_acquire(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
-                                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                                VkDeviceSize offset, VkDeviceSize size) noexcept {
-    auto b = buffer_barrier(buffer, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, dst_stage, dst_access, offset, size);
+VkBufferMemoryBarrier2 BufferOwnershipTransfer::acquire(VkPipelineStageFlags2 dst_stage,
+                                                        VkAccessFlags2 dst_access) const noexcept {
+    const auto b =
+        buffer_barrier(buffer, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, dst_stage, dst_access, offset, size);
     return between_families(b, src_family, dst_family);
 }
 

@@ -288,11 +288,9 @@ void Uploader::upload_buffer(const Buffer& buffer, VkDeviceSize offset, Span<con
     s.open.copy_buffer(s.staging.vk(), buffer.vk(), {&region, 1});
     const std::uint32_t family = s.queue.family_index();
     if (s.consumer_family == family) return;
-    s.buffer_releases.push_back(buffer_ownership_release(buffer.vk(), family, s.consumer_family,
-                                                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                         offset, data.size()));
-    s.pending.buffer_acquires.push_back(buffer_ownership_acquire(
-        buffer.vk(), family, s.consumer_family, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw, offset, data.size()));
+    const BufferOwnershipTransfer transfer{buffer.vk(), family, s.consumer_family, offset, data.size()};
+    s.buffer_releases.push_back(transfer.release(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
+    s.pending.buffer_acquires.push_back(transfer.acquire(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
 }
 
 namespace {
@@ -341,12 +339,10 @@ void Uploader::upload_image(const Image& image, Span<const std::byte> data, cons
                                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
         return;
     }
-    s.image_ends.push_back(image_ownership_release(image.vk(), all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                                   info.new_layout, family, s.consumer_family,
-                                                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
-    s.pending.image_acquires.push_back(image_ownership_acquire(image.vk(), all, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                                               info.new_layout, family, s.consumer_family,
-                                                               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
+    const ImageOwnershipTransfer transfer{image.vk(),      all,    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                          info.new_layout, family, s.consumer_family};
+    s.image_ends.push_back(transfer.release(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT));
+    s.pending.image_acquires.push_back(transfer.acquire(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, memory_rw));
 }
 
 namespace {

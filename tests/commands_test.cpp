@@ -354,18 +354,28 @@ TEST_F(VulkanTest, BarrierHelpersForMipRangesAndOwnership) {
     EXPECT_EQ(mips.levelCount, 2u);
     EXPECT_EQ(mips.layerCount, VK_REMAINING_ARRAY_LAYERS);
     const std::uint32_t family = queue.family_index();
-    auto release = vkrc::image_ownership_release(image.vk(), mips, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
-                                                 family, family, copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    const vkrc::ImageOwnershipTransfer image_transfer{.image = image.vk(),
+                                                      .range = mips,
+                                                      .old_layout = VK_IMAGE_LAYOUT_GENERAL,
+                                                      .new_layout = VK_IMAGE_LAYOUT_GENERAL,
+                                                      .src_family = family,
+                                                      .dst_family = family};
+    auto release = image_transfer.release(copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     EXPECT_EQ(release.dstStageMask, VK_PIPELINE_STAGE_2_NONE);
     EXPECT_EQ(release.srcQueueFamilyIndex, family);
-    auto acquire = vkrc::image_ownership_acquire(image.vk(), mips, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_GENERAL,
-                                                 family, family, copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    auto acquire = image_transfer.acquire(copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     EXPECT_EQ(acquire.srcStageMask, VK_PIPELINE_STAGE_2_NONE);
-    auto buffer_release =
-        vkrc::buffer_ownership_release(buffer.vk(), family, family, copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    auto buffer_acquire =
-        vkrc::buffer_ownership_acquire(buffer.vk(), family, family, copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    // Both halves carry the same image, range, layouts and families.
+    EXPECT_EQ(acquire.image, release.image);
+    EXPECT_EQ(acquire.subresourceRange.baseMipLevel, 1u);
+    EXPECT_EQ(acquire.oldLayout, release.oldLayout);
+    EXPECT_EQ(acquire.dstQueueFamilyIndex, release.dstQueueFamilyIndex);
+    const vkrc::BufferOwnershipTransfer buffer_transfer{
+        .buffer = buffer.vk(), .src_family = family, .dst_family = family};
+    auto buffer_release = buffer_transfer.release(copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    auto buffer_acquire = buffer_transfer.acquire(copy_stage, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     EXPECT_EQ(buffer_acquire.dstQueueFamilyIndex, family);
+    EXPECT_EQ(buffer_acquire.size, VK_WHOLE_SIZE);
     // With one family (lavapipe has one) the pair is a plain barrier; recorded
     // for the validation layer to check the structures.
     OneShot s(queue);

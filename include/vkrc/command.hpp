@@ -757,24 +757,43 @@ VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src
                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                       VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
 
-// Queue-family ownership transfer of an EXCLUSIVE resource: record the
-// release on a queue of src_family, then, after a semaphore, the acquire with
-// the same families and layouts on a queue of dst_family. The release's
-// destination and the acquire's source scopes are empty, as Vulkan ignores them.
-VkImageMemoryBarrier2 image_ownership_release(VkImage image, const VkImageSubresourceRange& range,
-                                              VkImageLayout old_layout, VkImageLayout new_layout,
-                                              std::uint32_t src_family, std::uint32_t dst_family,
-                                              VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) noexcept;
-VkImageMemoryBarrier2 image_ownership_acquire(VkImage image, const VkImageSubresourceRange& range,
-                                              VkImageLayout old_layout, VkImageLayout new_layout,
-                                              std::uint32_t src_family, std::uint32_t dst_family,
-                                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept;
-VkBufferMemoryBarrier2 buffer_ownership_release(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
-                                                VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                                VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
-VkBufferMemoryBarrier2 buffer_ownership_acquire(VkBuffer buffer, std::uint32_t src_family, std::uint32_t dst_family,
-                                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                                VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
+// A queue-family ownership transfer of an EXCLUSIVE image: record release()
+// on a queue of src_family, then, after a semaphore, acquire() on a queue of
+// dst_family. Vulkan wants both barriers to name the same families, layouts
+// and range; one description makes both, so they cannot disagree.
+struct ImageOwnershipTransfer {
+    // Required.
+    VkImage image = VK_NULL_HANDLE;
+    // Optional (default every level and layer of the colour aspect).
+    VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
+    // The layout transition that travels with the transfer (equal: none).
+    VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VkImageLayout new_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    // Required: the family giving the image up and the one taking it.
+    std::uint32_t src_family = VK_QUEUE_FAMILY_IGNORED;
+    std::uint32_t dst_family = VK_QUEUE_FAMILY_IGNORED;
+
+    // The barrier after the writes that src_family's queue made (its
+    // destination scope is empty: Vulkan ignores it).
+    VkImageMemoryBarrier2 release(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) const noexcept;
+    // The barrier before dst_family's queue uses the image (empty source scope).
+    VkImageMemoryBarrier2 acquire(VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) const noexcept;
+};
+
+// The same for an EXCLUSIVE buffer's size bytes from offset (VK_WHOLE_SIZE: to the end).
+struct BufferOwnershipTransfer {
+    // Required.
+    VkBuffer buffer = VK_NULL_HANDLE;
+    // Required: the family giving the buffer up and the one taking it.
+    std::uint32_t src_family = VK_QUEUE_FAMILY_IGNORED;
+    std::uint32_t dst_family = VK_QUEUE_FAMILY_IGNORED;
+    // Optional (default the whole buffer).
+    VkDeviceSize offset = 0;
+    VkDeviceSize size = VK_WHOLE_SIZE;
+
+    VkBufferMemoryBarrier2 release(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) const noexcept;
+    VkBufferMemoryBarrier2 acquire(VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) const noexcept;
+};
 
 // What generate_mipmaps starts from and leaves behind.
 struct MipmapInfo {
