@@ -3,6 +3,8 @@
 // and command buffer lifetime code).
 #include "vkrc/command.hpp"
 
+#include "object_state.hpp"
+
 #include <algorithm>
 #include <string>
 
@@ -90,34 +92,32 @@ namespace {
 
 const char* const mipmaps_who = "vkrc::generate_mipmaps";
 
-void require_mipmaps(bool ok, const std::string& problem) {
-    if (!ok) throw UsageError(std::string(mipmaps_who) + ": " + problem);
-}
-
 // The checks Vulkan would otherwise report as undefined behaviour or a device loss.
 void check_mipmap_image(const CommandBuffer& cmd, const Image& image, const MipmapInfo& info) {
-    require_mipmaps(static_cast<bool>(cmd), "the CommandBuffer handle is empty");
-    require_mipmaps(static_cast<bool>(image), "the Image handle is empty");
+    detail::require_handle(cmd, mipmaps_who, "the CommandBuffer");
+    detail::require_handle(image, mipmaps_who, "the Image");
     constexpr VkImageUsageFlags transfer = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    require_mipmaps((image.usage() & transfer) == transfer, "the image lacks TRANSFER_SRC and TRANSFER_DST usage");
-    require_mipmaps(image.samples() == VK_SAMPLE_COUNT_1_BIT, "the image is multisampled");
-    require_mipmaps(info.base_layout != VK_IMAGE_LAYOUT_UNDEFINED, "base_layout is UNDEFINED: level 0 has no contents");
-    require_mipmaps(info.base_layer < image.array_layers() &&
+    detail::require((image.usage() & transfer) == transfer, mipmaps_who,
+                    "the image lacks TRANSFER_SRC and TRANSFER_DST usage");
+    detail::require(image.samples() == VK_SAMPLE_COUNT_1_BIT, mipmaps_who, "the image is multisampled");
+    detail::require(info.base_layout != VK_IMAGE_LAYOUT_UNDEFINED, mipmaps_who,
+                    "base_layout is UNDEFINED: level 0 has no contents");
+    detail::require(info.base_layer < image.array_layers() &&
                         (info.layer_count == VK_REMAINING_ARRAY_LAYERS ||
                          (info.layer_count > 0 && info.layer_count <= image.array_layers() - info.base_layer)),
-                    "layers out of the image's range");
+                    mipmaps_who, "layers out of the image's range");
     const auto& physical = image.device().physical_device();
     const auto& families = physical.queue_families();
     const auto family = cmd.pool().queue_family_index();
-    require_mipmaps(family < families.size() && (families[family].queueFlags & VK_QUEUE_GRAPHICS_BIT),
+    detail::require(family < families.size() && (families[family].queueFlags & VK_QUEUE_GRAPHICS_BIT), mipmaps_who,
                     "blits need a queue family with graphics");
     VkFormatProperties props{};
     physical.instance().fn().vkGetPhysicalDeviceFormatProperties(physical.vk(), image.format(), &props);
     const auto features = props.optimalTilingFeatures;
-    require_mipmaps((features & VK_FORMAT_FEATURE_BLIT_SRC_BIT) && (features & VK_FORMAT_FEATURE_BLIT_DST_BIT),
-                    "the format cannot be blitted");
-    require_mipmaps(info.filter != VK_FILTER_LINEAR || (features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT),
-                    "the format cannot be filtered linearly; use VK_FILTER_NEAREST");
+    detail::require((features & VK_FORMAT_FEATURE_BLIT_SRC_BIT) && (features & VK_FORMAT_FEATURE_BLIT_DST_BIT),
+                    mipmaps_who, "the format cannot be blitted");
+    detail::require(info.filter != VK_FILTER_LINEAR || (features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT),
+                    mipmaps_who, "the format cannot be filtered linearly; use VK_FILTER_NEAREST");
 }
 
 VkOffset3D end_of(VkExtent3D e) {
