@@ -166,19 +166,43 @@ public:
     virtual void update(double t) = 0;
     // Waits until the device is idle; untimed, between blocks of frames.
     virtual void drain() = 0;
-    // Runs update(t) and one full frame through the stages above, waits for
-    // it and reads its colour image back: width * height RGBA8 pixels, top
-    // row first.
-    virtual std::vector<std::uint8_t> render_reference_frame(double t) = 0;
+    // Runs update(t) and one full frame through the stages above, offscreen
+    // in both modes, waits for it and reads its colour image back: width *
+    // height RGBA8 pixels, top row first.
+    std::vector<std::uint8_t> render_reference_frame(double t) {
+        drain();
+        update(t);
+        render_offscreen(true);
+        acquire();
+        uniform();
+        command();
+        submit();
+        present();
+        wait();  // the other slot's last frame: every slot is free afterwards
+        render_offscreen(false);
+        return read_back_offscreen();
+    }
     // After drain(): the last timed frame's colour image, rendered at time t
     // (the convention's "last frame"), as RGBA8 pixels, top row first.
-    virtual std::vector<std::uint8_t> read_back_last_frame(double t) = 0;
+    std::vector<std::uint8_t> read_back_last_frame(double t) {
+        return window() ? read_back_presented_frame(t) : read_back_offscreen();
+    }
     virtual std::string device_name() const = 0;
     // How frames are presented, e.g. "swapchain B8G8R8A8_UNORM, FIFO, 3
     // images, 800x600": the harness requires it to be the same for all.
     virtual std::string presentation() const = 0;
     // Windowed: the variant's window; null headless.
     virtual const BenchWindow* window() const = 0;
+
+protected:
+    // true: the stages render to the offscreen image even when windowed;
+    // false: back to the configured target.
+    virtual void render_offscreen(bool on) = 0;
+    // The colour image of the last frame rendered offscreen, after it is done.
+    virtual std::vector<std::uint8_t> read_back_offscreen() = 0;
+    // Windowed: one more frame at time t through the window's stages, its
+    // swapchain image copied back between its rendering and its presentation.
+    virtual std::vector<std::uint8_t> read_back_presented_frame(double t) = 0;
 };
 
 // Windowed mode's choices (the convention above), one rule for all variants.

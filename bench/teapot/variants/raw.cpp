@@ -1018,25 +1018,7 @@ public:
 
     void drain() override { check(gpu_.fn.vkDeviceWaitIdle(gpu_.device), "vkDeviceWaitIdle"); }
 
-    std::vector<std::uint8_t> render_reference_frame(double t) override {
-        drain();
-        update(t);
-        // Offscreen in both modes, through the headless path of the stages.
-        present_to_window_ = false;
-        acquire();
-        uniform();
-        command();
-        submit();
-        present();
-        wait();  // the other slot's last frame: every slot is free afterwards
-        present_to_window_ = config_.window;
-        return read_back_ring_image();
-    }
-
-    std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return read_back_presented_frame(t);
-        return read_back_ring_image();
-    }
+    void render_offscreen(bool on) override { present_to_window_ = !on && config_.window; }
 
     std::string device_name() const override { return gpu_.name; }
 
@@ -1176,7 +1158,7 @@ private:
 
     // Drains, then copies the ring image last presented to the readback
     // buffer with a one-off command buffer from the last frame's slot.
-    std::vector<std::uint8_t> read_back_ring_image() {
+    std::vector<std::uint8_t> read_back_offscreen() override {
         drain();
         Frame& f = frames_.slots[slot_];
         if (f.submitted) {
@@ -1201,7 +1183,7 @@ private:
     // submission renders (waiting on the acquire semaphore), then a one-off
     // copy (copy_presented_image) signals the render-done semaphore that
     // present waits on.
-    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+    std::vector<std::uint8_t> read_back_presented_frame(double t) override {
         drain();
         update(t);
         acquire();

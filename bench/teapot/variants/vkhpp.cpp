@@ -201,30 +201,12 @@ public:
 
     void drain() override { device_->waitIdle(); }
 
-    std::vector<std::uint8_t> render_reference_frame(double t) override {
-        drain();
-        update(t);
-        // Offscreen in both modes, through the headless path of the stages.
-        present_to_window_ = false;
-        acquire();
-        uniform();
-        command();
-        submit();
-        present();
-        wait();  // the other slot's last frame: every slot is free afterwards
-        present_to_window_ = config_.window;
-        return read_back_ring_image();
-    }
-
-    std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return read_back_presented_frame(t);
-        return read_back_ring_image();
-    }
+    void render_offscreen(bool on) override { present_to_window_ = !on && config_.window; }
 
     // Windowed: one more frame at time t through the window's stages, its
     // swapchain image copied to the readback buffer between its rendering and
     // its presentation (as raw.cpp's read_back_presented_frame).
-    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+    std::vector<std::uint8_t> read_back_presented_frame(double t) override {
         drain();
         update(t);
         acquire();
@@ -276,7 +258,7 @@ public:
 
     // Drains, then copies the ring image last presented to the readback
     // buffer with a one-off command buffer from the last frame's slot.
-    std::vector<std::uint8_t> read_back_ring_image() {
+    std::vector<std::uint8_t> read_back_offscreen() override {
         drain();
         Frame& f = frames_[slot_];
         if (f.submitted) {

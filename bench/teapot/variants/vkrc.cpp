@@ -220,32 +220,13 @@ public:
 
     void drain() override { device_.wait_idle(); }
 
-    std::vector<std::uint8_t> render_reference_frame(double t) override {
-        drain();
-        update(t);
-        // Offscreen in both modes: the same stages with the headless presenter.
-        const bool timed = to_swapchain_;
-        to_swapchain_ = false;
-        acquire();
-        uniform();
-        command();
-        submit();
-        present();
-        wait();  // the other slot's last frame: every slot is free afterwards
-        to_swapchain_ = timed;
-        return read_back_offscreen();
-    }
-
-    std::vector<std::uint8_t> read_back_last_frame(double t) override {
-        if (config_.window) return read_back_presented_frame(t);
-        return read_back_offscreen();
-    }
+    void render_offscreen(bool on) override { to_swapchain_ = !on && config_.window; }
 
     // Windowed: one more frame at time t through the window's stages, its
     // swapchain image copied to a readback buffer between its rendering and
     // its presentation (as raw.cpp's read_back_presented_frame): the frame's
     // submission takes the frame's waits, the copy's its signals.
-    std::vector<std::uint8_t> read_back_presented_frame(double t) {
+    std::vector<std::uint8_t> read_back_presented_frame(double t) override {
         drain();
         update(t);
         acquire();
@@ -296,7 +277,7 @@ public:
     }
 
     // Drains, then reads back the headless presenter's last presented image.
-    std::vector<std::uint8_t> read_back_offscreen() {
+    std::vector<std::uint8_t> read_back_offscreen() override {
         drain();
         Frame& f = frames_[slot_];
         if (f.submitted) {
