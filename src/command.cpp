@@ -56,7 +56,7 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
 
 CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
                                Ownership ownership) {
-    auto s = detail::adopted_state<detail::CommandPoolState>("vkrc::CommandPool::adopt", device, "Device", pool,
+    auto s = detail::adopted_state<detail::CommandPoolState>("vkrc::CommandPool::adopt", device, "the Device", pool,
                                                              "VkCommandPool", ownership);
     s->queue_family_index = queue_family_index;
     return CommandPool(std::move(s));

@@ -44,7 +44,7 @@ DebugMessenger DebugMessenger::adopt(const Instance& instance, VkDebugUtilsMesse
     constexpr const char* who = "vkrc::DebugMessenger::adopt";
     require_debug_utils(instance, who);
     return DebugMessenger(detail::adopted_state<detail::DebugMessengerState, &detail::DebugMessengerState::instance>(
-        who, instance, "Instance", messenger, "VkDebugUtilsMessengerEXT", ownership));
+        who, instance, "the Instance", messenger, "VkDebugUtilsMessengerEXT", ownership));
 }
 
 void set_name(const Device& device, VkObjectType type, std::uint64_t handle, const char* name) {

@@ -147,8 +147,8 @@ DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescripto
 
 DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
                                      Ownership ownership) {
-    auto s = detail::adopted_state<detail::DescriptorPoolState>("vkrc::DescriptorPool::adopt", device, "Device", pool,
-                                                                "VkDescriptorPool", ownership);
+    auto s = detail::adopted_state<detail::DescriptorPoolState>("vkrc::DescriptorPool::adopt", device, "the Device",
+                                                                pool, "VkDescriptorPool", ownership);
     s->can_free_sets = (flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
     return DescriptorPool(std::move(s));
 }

@@ -78,7 +78,7 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::adopt(const Device& device,
                                                          Ownership ownership) {
     constexpr const char* who = "vkrc::DescriptorUpdateTemplate::adopt";
     check_template_info(device, info, who, false);
-    auto s = detail::adopted_state<detail::DescriptorUpdateTemplateState>(who, device, "Device", update_template,
+    auto s = detail::adopted_state<detail::DescriptorUpdateTemplateState>(who, device, "the Device", update_template,
                                                                           "VkDescriptorUpdateTemplate", ownership);
     keep_template_info(*s, info);
     return DescriptorUpdateTemplate(std::move(s));

@@ -21,16 +21,16 @@ void require_handle(const Handle& handle, const char* who, const char* the_name)
     if (!handle) throw UsageError(std::string(who) + ": " + the_name + " handle is empty");
 }
 
-// The state of an adopted handle: refuses an empty parent ("who: the
-// parent_name handle is empty") and a null handle ("who: the handle_name is
-// VK_NULL_HANDLE") with UsageError, then holds both (the parent in
+// The state of an adopted handle: refuses an empty parent (require_handle
+// with the_parent, e.g. "the Device") and a null handle ("who: the
+// handle_name is VK_NULL_HANDLE") with UsageError, then holds both (the parent in
 // parent_member, by default a DeviceChildState's device) and the ownership.
 // The caller fills in the rest; nothing it does after this may throw, or the
 // state would destroy an owned handle that adopt() did not take.
 template <class State, auto parent_member = &State::device, class Parent, class VkHandle>
-Ref<State> adopted_state(const char* who, const Parent& parent, const char* parent_name, VkHandle handle,
+Ref<State> adopted_state(const char* who, const Parent& parent, const char* the_parent, VkHandle handle,
                          const char* handle_name, Ownership ownership) {
-    if (!parent) throw UsageError(std::string(who) + ": the " + parent_name + " handle is empty");
+    require_handle(parent, who, the_parent);
     if (handle == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the " + handle_name + " is VK_NULL_HANDLE");
     Ref<State> s(new State);
     (*s).*parent_member = parent;

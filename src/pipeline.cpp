@@ -32,14 +32,14 @@ PipelineLayout PipelineLayout::create(const Device& device) { return create(devi
 
 PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {
     return PipelineLayout(detail::adopted_state<detail::PipelineLayoutState>(
-        "vkrc::PipelineLayout::adopt", device, "Device", layout, "VkPipelineLayout", ownership));
+        "vkrc::PipelineLayout::adopt", device, "the Device", layout, "VkPipelineLayout", ownership));
 }
 
 RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
                              Span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
     List<std::uint32_t> counts(color_attachment_counts);  // before the state: a failed copy must not destroy
-    auto s = detail::adopted_state<detail::RenderPassState>("vkrc::RenderPass::adopt", device, "Device", render_pass,
-                                                            "VkRenderPass", ownership);
+    auto s = detail::adopted_state<detail::RenderPassState>("vkrc::RenderPass::adopt", device, "the Device",
+                                                            render_pass, "VkRenderPass", ownership);
     s->color_counts = std::move(counts);
     return RenderPass(std::move(s));
 }
@@ -47,20 +47,20 @@ RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
 Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                                Ownership ownership) {
     auto s = detail::adopted_state<detail::FramebufferState, &detail::FramebufferState::render_pass>(
-        "vkrc::Framebuffer::adopt", render_pass, "RenderPass", framebuffer, "VkFramebuffer", ownership);
+        "vkrc::Framebuffer::adopt", render_pass, "the RenderPass", framebuffer, "VkFramebuffer", ownership);
     s->extent = extent;
     return Framebuffer(std::move(s));
 }
 
 PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, Ownership ownership) {
     return PipelineCache(detail::adopted_state<detail::PipelineCacheState>(
-        "vkrc::PipelineCache::adopt", device, "Device", cache, "VkPipelineCache", ownership));
+        "vkrc::PipelineCache::adopt", device, "the Device", cache, "VkPipelineCache", ownership));
 }
 
 Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                          Ownership ownership) {
     auto s = detail::adopted_state<detail::PipelineState, &detail::PipelineState::layout>(
-        "vkrc::Pipeline::adopt", layout, "PipelineLayout", pipeline, "VkPipeline", ownership);
+        "vkrc::Pipeline::adopt", layout, "the PipelineLayout", pipeline, "VkPipeline", ownership);
     s->bind_point = bind_point;
     return Pipeline(std::move(s));
 }

@@ -14,7 +14,7 @@ PrivateDataSlotState::~PrivateDataSlotState() {
 
 PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership) {
     return PrivateDataSlot(detail::adopted_state<detail::PrivateDataSlotState>(
-        "vkrc::PrivateDataSlot::adopt", device, "Device", slot, "VkPrivateDataSlot", ownership));
+        "vkrc::PrivateDataSlot::adopt", device, "the Device", slot, "VkPrivateDataSlot", ownership));
 }
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {

@@ -388,7 +388,7 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
     auto state = detail::adopted_state<detail::ImageViewState, &detail::ImageViewState::image>(
-        "vkrc::ImageView::adopt", image, "Image", view, "VkImageView", ownership);
+        "vkrc::ImageView::adopt", image, "the Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
     return ImageView(std::move(state));
@@ -396,11 +396,11 @@ ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
     return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
-        "vkrc::BufferView::adopt", buffer, "Buffer", view, "VkBufferView", ownership));
+        "vkrc::BufferView::adopt", buffer, "the Buffer", view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    return Sampler(detail::adopted_state<detail::SamplerState>("vkrc::Sampler::adopt", device, "Device", sampler,
+    return Sampler(detail::adopted_state<detail::SamplerState>("vkrc::Sampler::adopt", device, "the Device", sampler,
                                                                "VkSampler", ownership));
 }
 

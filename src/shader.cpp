@@ -52,8 +52,8 @@ ShaderModule ShaderModule::create(const Device& device, Span<const std::byte> sp
 }
 
 ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
-    return ShaderModule(detail::adopted_state<detail::ShaderModuleState>("vkrc::ShaderModule::adopt", device, "Device",
-                                                                         module, "VkShaderModule", ownership));
+    return ShaderModule(detail::adopted_state<detail::ShaderModuleState>(
+        "vkrc::ShaderModule::adopt", device, "the Device", module, "VkShaderModule", ownership));
 }
 
 ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {

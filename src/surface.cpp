@@ -21,7 +21,7 @@ Surface Surface::adopt(const Instance& instance, VkSurfaceKHR surface, Ownership
         throw UsageError(std::string(who) + ": the instance was created without VK_KHR_surface");
     }
     return Surface(detail::adopted_state<detail::SurfaceState, &detail::SurfaceState::instance>(
-        who, instance, "Instance", surface, "VkSurfaceKHR", ownership));
+        who, instance, "the Instance", surface, "VkSurfaceKHR", ownership));
 }
 
 VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_device) const {

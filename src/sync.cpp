@@ -48,8 +48,8 @@ Fence Fence::create(const Device& device, bool signaled) {
 }
 
 Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
-    return Fence(
-        detail::adopted_state<detail::FenceState>("vkrc::Fence::adopt", device, "Device", fence, "VkFence", ownership));
+    return Fence(detail::adopted_state<detail::FenceState>("vkrc::Fence::adopt", device, "the Device", fence, "VkFence",
+                                                           ownership));
 }
 
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
@@ -94,7 +94,7 @@ Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial
 }
 
 Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership) {
-    auto s = detail::adopted_state<detail::SemaphoreState>("vkrc::Semaphore::adopt", device, "Device", semaphore,
+    auto s = detail::adopted_state<detail::SemaphoreState>("vkrc::Semaphore::adopt", device, "the Device", semaphore,
                                                            "VkSemaphore", ownership);
     s->type = type;
     return Semaphore(std::move(s));
@@ -143,8 +143,8 @@ Event Event::create(const Device& device, bool device_only) {
 }
 
 Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {
-    return Event(
-        detail::adopted_state<detail::EventState>("vkrc::Event::adopt", device, "Device", event, "VkEvent", ownership));
+    return Event(detail::adopted_state<detail::EventState>("vkrc::Event::adopt", device, "the Device", event, "VkEvent",
+                                                           ownership));
 }
 
 void Event::set() const {

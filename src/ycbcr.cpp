@@ -19,7 +19,7 @@ SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSam
     constexpr const char* who = "vkrc::SamplerYcbcrConversion::adopt";
     // Before the state exists: once it holds an owned conversion, a throw would destroy it.
     if (format == VK_FORMAT_UNDEFINED) throw UsageError(std::string(who) + ": format is VK_FORMAT_UNDEFINED");
-    auto state = detail::adopted_state<detail::SamplerYcbcrConversionState>(who, device, "Device", conversion,
+    auto state = detail::adopted_state<detail::SamplerYcbcrConversionState>(who, device, "the Device", conversion,
                                                                             "VkSamplerYcbcrConversion", ownership);
     state->format = format;
     return SamplerYcbcrConversion(std::move(state));
