@@ -28,9 +28,10 @@ public:
     List(const T* items, std::size_t count) : List() { append_copies(items, count); }
     // Any contiguous range of T: std::vector, std::array, std::span, vkrc::Span,
     // List (the rule Span views by: no base-class copies of derived elements).
-    template <class Range>
-    requires requires(const Range& r) { r.size(); } && detail::viewable_as < detail::RangeElement<const Range>,
-    const T > List(const Range& items) : List() { append_copies(items.data(), items.size()); }
+    template <detail::range_of<const T> Range>
+    List(const Range& items) : List() {
+        append_copies(items.data(), items.size());
+    }
     // count value-initialised elements, made in place (T need not be movable).
     explicit List(std::size_t count) : List() {
         data_ = allocate(count);

@@ -33,6 +33,14 @@ template <class From, class T>
 concept viewable_as = requires(From (*from)[], void (*to)(T (*)[])) {
     to(from);
 };
+// A range with size() (its data() is RangeElement's part).
+template <class Range>
+concept sized = requires(Range& r) {
+    r.size();
+};
+// A contiguous range (data() and size()) whose elements can be viewed as T.
+template <class Range, class T>
+concept range_of = sized<Range> && viewable_as<RangeElement<Range>, T>;
 }  // namespace detail
 
 template <class T>
@@ -45,8 +53,7 @@ public:
     template <std::size_t N>
     constexpr Span(T (&items)[N]) noexcept : data_(items), size_(N) {}
     // Any contiguous range whose elements are T (or non-const T for a Span of const T).
-    template <class Range>
-    requires requires(Range& r) { r.size(); } && detail::viewable_as<detail::RangeElement<Range>, T>
+    template <detail::range_of<T> Range>
     constexpr Span(Range&& items) noexcept : data_(items.data()), size_(items.size()) {}
 
     constexpr T* data() const noexcept { return data_; }
