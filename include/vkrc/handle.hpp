@@ -254,11 +254,11 @@ namespace detail {
 // clang-format off
 #if VKRC_RUNTIME_CHECKS
 #  define VKRC_UNCHECKED_NOEXCEPT
-#  define VKRC_REQUIRE_STATE(call) \
-      if (!this->state_) [[unlikely]] ::vkrc::detail::throw_empty_handle(call)
+#  define VKRC_REQUIRE_STATE(...) \
+      if (!this->state_) [[unlikely]] ::vkrc::detail::throw_empty_handle(__VA_ARGS__)
 #else
 #  define VKRC_UNCHECKED_NOEXCEPT noexcept
-#  define VKRC_REQUIRE_STATE(call) static_cast<void>(0)
+#  define VKRC_REQUIRE_STATE(...) static_cast<void>(0)
 #endif
 // clang-format on
 
@@ -289,10 +289,7 @@ protected:
     }
     // The same, naming the call type::member (the accessors of a shared base).
     State& live([[maybe_unused]] const char* type, [[maybe_unused]] const char* member) const VKRC_UNCHECKED_NOEXCEPT {
-#if VKRC_RUNTIME_CHECKS
-        if (!state_) [[unlikely]]
-            detail::throw_empty_handle(type, member);
-#endif
+        VKRC_REQUIRE_STATE(type, member);
         return *state_;
     }
     detail::Ref<State> state_;
