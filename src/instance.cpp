@@ -173,9 +173,8 @@ bool Instance::layer_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
 
 List<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
-    auto props = detail::enumerate<VkLayerProperties>(
-        [&](std::uint32_t* n, VkLayerProperties* p) { return global.vkEnumerateInstanceLayerProperties(n, p); },
-        "vkEnumerateInstanceLayerProperties");
+    auto props = detail::enumerate<VkLayerProperties>(global.vkEnumerateInstanceLayerProperties,
+                                                      "vkEnumerateInstanceLayerProperties");
     std::vector<Text> names;
     for (const auto& p : props) names.emplace_back(p.layerName);
     return names;
@@ -183,11 +182,8 @@ List<Text> Instance::available_layers(PFN_vkGetInstanceProcAddr get_instance_pro
 
 List<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance_proc_addr) {
     auto global = GlobalFunctions::load(get_instance_proc_addr);
-    auto props = detail::enumerate<VkExtensionProperties>(
-        [&](std::uint32_t* n, VkExtensionProperties* p) {
-            return global.vkEnumerateInstanceExtensionProperties(nullptr, n, p);
-        },
-        "vkEnumerateInstanceExtensionProperties");
+    auto props = detail::enumerate<VkExtensionProperties>(global.vkEnumerateInstanceExtensionProperties,
+                                                          "vkEnumerateInstanceExtensionProperties", nullptr);
     std::vector<Text> names;
     for (const auto& p : props) names.emplace_back(p.extensionName);
     return names;
@@ -195,9 +191,7 @@ List<Text> Instance::available_extensions(PFN_vkGetInstanceProcAddr get_instance
 
 List<PhysicalDevice> Instance::physical_devices() const {
     const auto& f = fn();
-    auto raws = detail::enumerate<VkPhysicalDevice>(
-        [&](std::uint32_t* n, VkPhysicalDevice* p) { return f.vkEnumeratePhysicalDevices(vk(), n, p); },
-        "vkEnumeratePhysicalDevices");
+    auto raws = detail::enumerate<VkPhysicalDevice>(f.vkEnumeratePhysicalDevices, "vkEnumeratePhysicalDevices", vk());
     std::vector<PhysicalDevice> devices;
     for (VkPhysicalDevice raw : raws) {
         PhysicalDevice device(detail::Ref<detail::PhysicalDeviceState>(new detail::PhysicalDeviceState));
@@ -211,11 +205,8 @@ List<PhysicalDevice> Instance::physical_devices() const {
         s.queue_families.resize(families);
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, s.queue_families.data());
         read_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.features);
-        auto exts = detail::enumerate<VkExtensionProperties>(
-            [&](std::uint32_t* n, VkExtensionProperties* p) {
-                return f.vkEnumerateDeviceExtensionProperties(raw, nullptr, n, p);
-            },
-            "vkEnumerateDeviceExtensionProperties");
+        auto exts = detail::enumerate<VkExtensionProperties>(f.vkEnumerateDeviceExtensionProperties,
+                                                             "vkEnumerateDeviceExtensionProperties", raw, nullptr);
         for (const auto& e : exts) s.extensions.push_back(e.extensionName);
         s.default_queue_family = device.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
         devices.push_back(std::move(device));

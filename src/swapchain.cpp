@@ -1,7 +1,9 @@
 #include "vkrc/swapchain.hpp"
 
 #include "vkrc/upload.hpp"
+
 #include "object_state.hpp"
+#include "text.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -275,10 +277,8 @@ VkSwapchainCreateInfoKHR swapchain_create_info(const detail::SwapchainState& s, 
 detail::Ref<detail::FrameImages> wrap_images(const detail::SwapchainState& s, detail::SwapchainChainState& chain,
                                              VkExtent2D extent) {
     const Device& device = s.queue.device();
-    std::uint32_t n = 0;
-    check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain.swapchain, &n, nullptr), "vkGetSwapchainImagesKHR");
-    std::vector<VkImage> raw(n);
-    check(device.fn().vkGetSwapchainImagesKHR(device.vk(), chain.swapchain, &n, raw.data()), "vkGetSwapchainImagesKHR");
+    const auto raw = detail::enumerate<VkImage>(device.fn().vkGetSwapchainImagesKHR, "vkGetSwapchainImagesKHR",
+                                                device.vk(), chain.swapchain);
     ImageCreateInfo info;
     info.format = s.surface_format.format;
     info.extent = {extent.width, extent.height, 1};
