@@ -3,22 +3,18 @@
 
 #include "vkrc/device.hpp"
 
-#include <string>
+#include "caller.hpp"
+
 #include <string_view>
 
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// Refuses a bad argument of who with UsageError "who: problem".
-inline void require(bool ok, const char* who, std::string_view problem) {
-    if (!ok) throw UsageError(std::string(who) + ": " + std::string(problem));
-}
-
-// Refuses an empty vkrc handle with UsageError "who: the_name handle is
-// empty", the_name saying which (e.g. "the Device", "a ShaderModule").
+// The older two forms of Caller's checks, until every site names its Caller.
+inline void require(bool ok, const char* who, std::string_view problem) { Caller(who).require(ok, problem); }
 template <class Handle>
 void require_handle(const Handle& handle, const char* who, const char* the_name) {
-    if (!handle) throw UsageError(std::string(who) + ": " + the_name + " handle is empty");
+    Caller(who).require_handle(handle, the_name);
 }
 
 // The state of an adopted handle: refuses an empty parent (require_handle
@@ -30,8 +26,9 @@ void require_handle(const Handle& handle, const char* who, const char* the_name)
 template <class State, auto parent_member = &State::device, class Parent, class VkHandle>
 Ref<State> adopted_state(const char* who, const Parent& parent, const char* the_parent, VkHandle handle,
                          const char* handle_name, Ownership ownership) {
-    require_handle(parent, who, the_parent);
-    if (handle == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the " + handle_name + " is VK_NULL_HANDLE");
+    const Caller caller(who);
+    caller.require_handle(parent, the_parent);
+    caller.require_not_null(handle, handle_name);
     Ref<State> s(new State);
     (*s).*parent_member = parent;
     s->handle = handle;

@@ -1,0 +1,75 @@
+// How vkrc refuses a bad argument (not installed): one message format,
+// "who: what", where who is the public function, named once per function.
+#pragma once
+
+#include "vkrc/error.hpp"
+
+#include "enum_names.hpp"
+
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+VKRC_BEGIN_NAMESPACE
+namespace detail {
+
+// One piece of a refusal's message: text as is, integers in decimal, the
+// Vulkan enums enum_names.hpp knows by name.
+inline void append_piece(std::string& out, std::string_view text) { out += text; }
+template <class T>
+concept decimal_number = std::is_integral_v<T> && !std::is_same_v<T, bool>;
+template <class T>
+concept named_enum = std::is_enum_v<T> && requires(T e) {
+    enum_text(e);
+};
+template <decimal_number Integer>
+void append_piece(std::string& out, Integer n) {
+    out += std::to_string(n);
+}
+template <named_enum Enum>
+void append_piece(std::string& out, Enum e) {
+    out += enum_text(e);
+}
+
+// The public function that checks its arguments. Usage, once per function:
+//     const detail::Caller caller{"vkrc::DescriptorPool::create"};
+//     caller.require(info.max_sets != 0, "max_sets is 0");
+//     caller.require(n <= max, "count ", n, " exceeds ", max);
+// The pieces are formatted only when the check fails, so a passing check
+// costs its condition alone.
+class Caller {
+public:
+    explicit constexpr Caller(const char* name) noexcept : name_(name) {}
+    const char* name() const noexcept { return name_; }
+
+    // Throws UsageError "name: what..." unless ok.
+    template <class... What>
+    void require(bool ok, const What&... what) const {
+        if (!ok) [[unlikely]]
+            refuse(what...);
+    }
+    template <class... What>
+    [[noreturn]] void refuse(const What&... what) const {
+        std::string message(name_);
+        message += ": ";
+        (append_piece(message, what), ...);
+        throw UsageError(message);
+    }
+    // "name: the_name handle is empty", the_name saying which (e.g. "the
+    // Device", "a ShaderModule").
+    template <class Handle>
+    void require_handle(const Handle& handle, const char* the_name) const {
+        require(static_cast<bool>(handle), the_name, " handle is empty");
+    }
+    // "name: the handle_name is VK_NULL_HANDLE" (e.g. "VkDevice").
+    template <class VkHandle>
+    void require_not_null(VkHandle handle, const char* handle_name) const {
+        require(handle != VK_NULL_HANDLE, "the ", handle_name, " is VK_NULL_HANDLE");
+    }
+
+private:
+    const char* name_;
+};
+
+}  // namespace detail
+VKRC_END_NAMESPACE
