@@ -82,9 +82,9 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
     if (a) {
-        s.allocators.keep(allocator);
+        s.keep_allocator(allocator);
     } else {
-        a = &s.allocators.default_allocator();
+        a = &s.default_allocator();
     }
     AllocationInfo info = a->allocate(DeviceView(s), request);
     if (info.allocator != a) {
@@ -135,10 +135,10 @@ void Allocation::invalidate(VkDeviceSize offset, VkDeviceSize size) const {
     state_->invalidate(offset, size);
 }
 
-DeviceAllocator& default_allocator(const Device& device) { return device.state()->allocators.default_allocator(); }
+DeviceAllocator& default_allocator(const Device& device) { return device.state()->default_allocator(); }
 
 AllocatorStatistics memory_statistics(const Device& device) {
-    return device.state()->allocators.default_allocator().statistics(DeviceView(*device.state()));
+    return device.state()->default_allocator().statistics(DeviceView(*device.state()));
 }
 
 VKRC_END_NAMESPACE

@@ -30,14 +30,13 @@ void CommandPoolState::free_ready() {
 
 CommandBufferState::~CommandBufferState() {
     if (cmd == VK_NULL_HANDLE) return;
-    auto& p = *pool.state();
-    auto& device = *p.device.state();
     // Closed first: it holds nothing once gone, but a primary it was
     // executed in may still hold it.
-    device.commands.remove(device, window);
+    device().unregister_window(window);
     if (ownership == Ownership::borrowed) return;
+    auto& p = *pool.state();
     LockGuard lock(p.mutex);
-    p.pending.push(device, cmd, serial());
+    p.pending.push(device(), cmd, serial());
 }
 
 }  // namespace detail
@@ -86,7 +85,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     p.free_completed();
     check(p.device.fn().vkAllocateCommandBuffers(p.device.vk(), &ai, &s->cmd), "vkAllocateCommandBuffers");
     try {
-        p.device.state()->commands.add(s->window);
+        p.device.state()->register_window(s->window);
     } catch (...) {
         p.device.fn().vkFreeCommandBuffers(p.device.vk(), p.handle, 1, &s->cmd);
         s->cmd = VK_NULL_HANDLE;
@@ -108,7 +107,7 @@ CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer comm
     auto s = new_command_buffer_state(pool, level);
     s->ownership = ownership;
     // Registered like an allocated one, so that drops during its recording are held.
-    pool.state()->device.state()->commands.add(s->window);
+    s->device().register_window(s->window);
     s->cmd = command_buffer;
     return CommandBuffer(std::move(s));
 }
@@ -121,7 +120,7 @@ void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
         p.free_completed();
         check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
     }
-    p.device.state()->commands.close_pool(*p.device.state(), &p);
+    p.device.state()->close_pool_windows(&p);
 }
 
 std::size_t CommandPool::pending_free_count() const {
@@ -139,7 +138,7 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
     // Only a primary's submit closes it: a ONE_TIME secondary stays open until reset, re-begin or free.
     const bool one_time =
         s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && (info.flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0;
-    p.device.state()->commands.begin(s.window, one_time);
+    s.device().open_window(s.window, one_time);
 }
 }  // namespace
 
@@ -190,7 +189,7 @@ void CommandBuffer::end() const {
     auto& p = *state_->pool.state();
     LockGuard lock(p.mutex);
     check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
-    p.device.state()->commands.end(state_->window);
+    state_->device().end_window(state_->window);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
@@ -200,15 +199,14 @@ void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
         LockGuard lock(p.mutex);
         check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
     }
-    p.device.state()->commands.close(*p.device.state(), state_->window);
+    state_->device().close_window(state_->window);
 }
 
 namespace detail {
 void close_submitted(Span<const CommandBuffer> command_buffers) noexcept {
     for (const CommandBuffer& c : command_buffers) {
         auto& s = *c.state();
-        if (s.window.one_time)
-            s.pool.state()->device.state()->commands.close(*s.pool.state()->device.state(), s.window);
+        if (s.window.one_time) s.device().close_window(s.window);
     }
 }
 }  // namespace detail

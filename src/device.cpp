@@ -49,11 +49,16 @@ DeviceState::~DeviceState() {
     if (ownership == Ownership::owned) fn.vkDestroyDevice(device, nullptr);
 }
 
-bool DeviceState::refresh(QueueState& q) noexcept {
+VkResult DeviceState::refresh(QueueState& q) noexcept {
     std::uint64_t value = 0;
-    if (note_result(fn.vkGetSemaphoreCounterValue(device, q.semaphore, &value)) != VK_SUCCESS) return false;
-    q.timeline.note_completed(value);
-    return true;
+    const VkResult r = note_result(fn.vkGetSemaphoreCounterValue(device, q.semaphore, &value));
+    if (r == VK_SUCCESS) q.timeline.note_completed(value);
+    return r;
+}
+
+std::uint64_t DeviceState::read_completed(QueueState& q) {
+    check(refresh(q), "vkGetSemaphoreCounterValue");
+    return q.timeline.completed();
 }
 
 bool DeviceState::idle_now() noexcept {
@@ -62,7 +67,8 @@ bool DeviceState::idle_now() noexcept {
         const std::uint64_t last = q.timeline.last_submitted();
         if (q.timeline.completed() >= last) continue;
         // Without a signal covering the last submit, nothing says it has completed.
-        if (q.timeline.last_signalled() < last || !refresh(q) || q.timeline.completed() < last) idle = false;
+        if (q.timeline.last_signalled() < last || refresh(q) != VK_SUCCESS || q.timeline.completed() < last)
+            idle = false;
     }
     return idle || lost.load(std::memory_order_relaxed);
 }
@@ -89,7 +95,7 @@ VkResult DeviceState::wait_for_submission(QueueState& q, std::uint64_t number, c
     return r;
 }
 
-void DeviceState::await_submission(QueueState& q, std::uint64_t number) {
+void DeviceState::await(QueueState& q, std::uint64_t number) {
     const char* failed_call = nullptr;
     VkResult r = wait_for_submission(q, number, &failed_call);
     if (r != VK_SUCCESS) check(r, failed_call);
@@ -128,7 +134,7 @@ bool DeviceState::reached(Span<const std::uint64_t> snapshot) noexcept {
     for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
         auto& q = queues[i];
         if (q.timeline.completed() >= snapshot[i]) continue;
-        if (!refresh(q)) return lost.load(std::memory_order_relaxed);
+        if (refresh(q) != VK_SUCCESS) return lost.load(std::memory_order_relaxed);
         if (q.timeline.completed() < snapshot[i]) return false;
     }
     return true;
@@ -514,7 +520,7 @@ void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
     state_->collect();
 }
 std::size_t Device::deferred_count() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::Device::deferred_count").deferred.size() + state_->commands.held_count();
+    return live("vkrc::Device::deferred_count").deferred_count();
 }
 bool Device::lost() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Device::lost").lost.load(std::memory_order_relaxed);

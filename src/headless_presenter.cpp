@@ -106,7 +106,7 @@ List<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
                          " does not exist (the ring has " + std::to_string(ring->images.size()) + ")");
     }
     const Image& image = ring->images[image_index];
-    s.queue.device().state()->await_submission(*s.queue.state(), s.queue.state()->timeline.last_submitted());
+    detail::await(s.queue, detail::last_submitted(s.queue));
     return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
 }
 

@@ -29,26 +29,16 @@ void Ticket::record_acquire(const CommandBuffer& cmd) const {
 }
 
 namespace {
-// Reads queue's timeline into its completed cache and returns it.
-std::uint64_t refresh_completed(const Queue& queue) {
-    auto& d = *queue.device().state();
-    auto& q = *queue.state();
-    std::uint64_t value = 0;
-    d.check_result(d.fn.vkGetSemaphoreCounterValue(d.device, q.semaphore, &value), "vkGetSemaphoreCounterValue");
-    q.timeline.note_completed(value);
-    return q.timeline.completed();
-}
-
+// Waits for value on queue, then runs the deferred destructions it allowed.
 void await(const Queue& queue, std::uint64_t value) {
-    auto& d = *queue.device().state();
-    d.await_submission(*queue.state(), value);
-    d.collect();
+    detail::await(queue, value);
+    queue.device().collect_garbage();
 }
 }  // namespace
 
 bool Ticket::done() const {
-    if (!queue || queue.state()->timeline.completed() >= value) return true;
-    return refresh_completed(queue) >= value || queue.device().lost();
+    if (!queue || detail::completed(queue) >= value) return true;
+    return detail::read_completed(queue) >= value || queue.device().lost();
 }
 
 void Ticket::wait_on_host() const {
@@ -126,8 +116,8 @@ void begin_batch(detail::UploaderState& s) {
     // cached value, else by the semaphore's (so that a stream that never
     // fills the ring, and so never reads the semaphore there, still reuses
     // them); else a new one.
-    if (!s.recorded.empty() && (s.recorded.front().value <= s.queue.state()->timeline.completed() ||
-                                s.recorded.front().value <= refresh_completed(s.queue))) {
+    if (!s.recorded.empty() && (s.recorded.front().value <= detail::completed(s.queue) ||
+                                s.recorded.front().value <= detail::read_completed(s.queue))) {
         s.open = std::move(s.recorded.front().cmd);
         s.recorded.pop_front();
     } else {
@@ -189,7 +179,7 @@ Ticket submit_batch(detail::UploaderState& s, Span<const SemaphoreSubmit> waits)
     } catch (...) {
         // Nothing of the batch runs (or the device is lost): its ring space
         // is free once the work before it is.
-        s.ring.tag_open(s.queue.state()->timeline.last_submitted());
+        s.ring.tag_open(detail::last_submitted(s.queue));
         s.pending = {};
         throw;
     }
@@ -212,10 +202,10 @@ VkDeviceSize reserve(detail::UploaderState& s, VkDeviceSize size, VkDeviceSize a
         throw UsageError(std::string(who) + ": " + std::to_string(size) + " bytes do not fit in the " +
                          std::to_string(s.staging.size()) + "-byte staging ring");
     }
-    s.ring.retire(s.queue.state()->timeline.completed());
+    s.ring.retire(detail::completed(s.queue));
     VkDeviceSize offset = 0;
     while (!s.ring.try_allocate(size, alignment, offset)) {
-        s.ring.retire(refresh_completed(s.queue));
+        s.ring.retire(detail::read_completed(s.queue));
         if (s.ring.try_allocate(size, alignment, offset)) break;
         if (s.ring.oldest() == 0) {
             // The batch's acquires go with the next ticket, which covers it.
@@ -224,7 +214,7 @@ VkDeviceSize reserve(detail::UploaderState& s, VkDeviceSize size, VkDeviceSize a
             s.pending.image_acquires = std::move(carried.image_acquires);
         }
         await(s.queue, s.ring.oldest());
-        s.ring.retire(s.queue.device().lost() ? UINT64_MAX - 1 : s.queue.state()->timeline.completed());
+        s.ring.retire(s.queue.device().lost() ? UINT64_MAX - 1 : detail::completed(s.queue));
     }
     return offset;
 }
@@ -461,7 +451,7 @@ void FrameRing::begin_frame() const {
     if (s.open) throw UsageError("vkrc::FrameRing::begin_frame: the frame before was not ended (end_frame)");
     s.index = (s.index + 1) % static_cast<std::uint32_t>(s.frame_values.size());
     const std::uint64_t value = s.frame_values[s.index];
-    if (value != 0 && s.queue.state()->timeline.completed() < value) await(s.queue, value);
+    if (value != 0 && detail::completed(s.queue) < value) await(s.queue, value);
     s.head = 0;
     s.open = true;
 }
@@ -470,7 +460,7 @@ void FrameRing::end_frame() const {
     VKRC_REQUIRE_STATE("vkrc::FrameRing::end_frame");
     auto& s = *state_;
     if (!s.open) throw UsageError("vkrc::FrameRing::end_frame: no frame was begun (begin_frame)");
-    s.frame_values[s.index] = s.queue.state()->timeline.covering_value();
+    s.frame_values[s.index] = detail::covering_value(s.queue);
     s.open = false;
 }
 

@@ -1,7 +1,5 @@
 #include "vkrc/swapchain.hpp"
 
-#include "vkrc/upload.hpp"
-
 #include "object_state.hpp"
 #include "text.hpp"
 
@@ -94,7 +92,7 @@ SwapchainChainState::~SwapchainChainState() {
         // destroy_after_gpu below waits for that value (docs/design.md,
         // Presentation).
         try {
-            queue.state()->timeline.request_signal();
+            request_signal(queue);
             queue.submit({});
         } catch (...) {
             LockGuard lock(queue.mutex());
@@ -394,7 +392,7 @@ PresentStatus Swapchain::acquire(Frame& frame) {
     const std::uint32_t slot = s.next_acquire;
     // The semaphore must have no pending wait: its last frame was presented
     // after the submission that waited on it, at this queue value.
-    s.queue.device().state()->await_submission(*s.queue.state(), s.acquire_done_values[slot]);
+    detail::await(s.queue, s.acquire_done_values[slot]);
     std::uint32_t index = 0;
     VkResult r = device.fn().vkAcquireNextImageKHR(device.vk(), s.chain->swapchain, UINT64_MAX,
                                                    s.acquire_semaphores[slot].vk(), VK_NULL_HANDLE, &index);
@@ -445,7 +443,7 @@ PresentStatus Swapchain::present(const Frame& frame) {
     chain.presented = true;
     // The slot's reuse waits for this submission number: in a frame loop the
     // frame's fence has usually shown it complete by then.
-    s.acquire_done_values[frame.acquire_slot_] = s.queue.state()->timeline.last_submitted();
+    s.acquire_done_values[frame.acquire_slot_] = detail::last_submitted(s.queue);
     if (r == VK_ERROR_OUT_OF_DATE_KHR) {
         s.needs_recreate = true;
         return PresentStatus::out_of_date;

@@ -852,6 +852,8 @@ public:
     VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     Ownership ownership = Ownership::owned;  // borrowed (adopted): never freed by vkrc
     RecordingWindow window;                  // registered with the device's OpenCommandBuffers
+    // The device whose OpenCommandBuffers keeps window.
+    DeviceState& device() const noexcept { return *pool.state()->device.state(); }
 };
 
 }  // namespace detail

@@ -24,7 +24,7 @@ public:
     void push(DeviceState& device, VkHandle handle, std::uint64_t serial) noexcept {
         try {
             // An open command buffer may still refer to it (OpenCommandBuffers).
-            if (device.commands.holds(serial)) {
+            if (device.held_back(serial)) {
                 held_.push_back(Held{handle, serial});
                 return;
             }
@@ -72,7 +72,7 @@ private:
     // The held handles no open command buffer refers to any more wait for
     // the work submitted so far, like a fresh drop; the others stay, in order.
     void release_held(DeviceState& device) {
-        const std::uint64_t limit = device.commands.limit();
+        const std::uint64_t limit = device.hold_limit();
         std::size_t kept = 0;
         for (std::size_t i = 0; i < held_.size(); ++i) {
             try {

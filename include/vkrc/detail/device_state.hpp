@@ -1,0 +1,406 @@
+// The machinery behind Device and Queue (not part of the API): queue
+// timelines, deferred destruction, open command buffers' recording windows,
+// the allocators, and the named operations the other layers call on them
+// (DeviceState's, and those below it that start from a Queue). Included by
+// vkrc/device.hpp, whose inline accessors need the complete states.
+#pragma once
+
+#include "vkrc/device.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+
+// The numbering of one queue's submissions and what is known of their
+// completion: vkrc's only GPU-side tracking. Submits are numbered from 1; a
+// submit signals the queue's timeline semaphore with its own number only
+// when someone asked since the last signal (a dropped object, a pool freeing
+// a child, a wait), so frame loops that drop nothing never pay for a signal.
+// The note_submitted / note_signalled / next_number / take_signal_request
+// calls are made under the queue's mutex; the others from any thread.
+class QueueTimeline {
+public:
+    // The number the next submit gets.
+    std::uint64_t next_number() const noexcept { return submitted_.load(__ATOMIC_RELAXED) + 1; }
+    // The number of the last submit (0: none yet).
+    std::uint64_t last_submitted() const noexcept { return submitted_.load(__ATOMIC_ACQUIRE); }
+    // The number of the last submit that signalled the timeline semaphore.
+    std::uint64_t last_signalled() const noexcept { return signalled_.load(__ATOMIC_ACQUIRE); }
+    // The highest number known to have completed: read from the semaphore,
+    // or that of a vkrc-submitted fence seen signalled (a fence signal covers
+    // all earlier work on its queue).
+    std::uint64_t completed() const noexcept { return completed_.load(__ATOMIC_RELAXED); }
+
+    // Asks the next submit to signal the semaphore.
+    void request_signal() noexcept { signal_wanted_.store(true, __ATOMIC_RELAXED); }
+    // Whether a signal was asked for since the last one.
+    bool signal_requested() const noexcept { return signal_wanted_.load(__ATOMIC_RELAXED); }
+    // Clears the request and says whether there was one; taken before
+    // submitting, so a request made meanwhile is either covered by this
+    // submit's signal or asks the next submit again.
+    bool take_signal_request() noexcept { return signal_wanted_.exchange(false, __ATOMIC_RELAXED); }
+
+    // Submit number went in without a signal.
+    void note_submitted(std::uint64_t number) noexcept { submitted_.store(number, __ATOMIC_RELEASE); }
+    // Submit number went in and signals the semaphore with its number.
+    void note_signalled(std::uint64_t number) noexcept {
+        submitted_.store(number, __ATOMIC_RELEASE);
+        signalled_.store(number, __ATOMIC_RELEASE);
+    }
+    // Raises completed() to value (several threads may refresh it).
+    void note_completed(std::uint64_t value) noexcept {
+        std::uint64_t seen = completed_.load(__ATOMIC_RELAXED);
+        while (seen < value && !completed_.compare_exchange_weak(seen, value, __ATOMIC_RELAXED)) {}
+    }
+
+    // The number whose completion means all work submitted so far has
+    // completed. When no signal covers it yet, asks the next submit for one
+    // (until then only a vkrc fence of that submit or a later one, or a wait
+    // for idle, can show it complete).
+    std::uint64_t covering_value() noexcept {
+        const std::uint64_t last = last_submitted();
+        if (last_signalled() < last) request_signal();
+        return last;
+    }
+
+private:
+    Atomic<std::uint64_t> submitted_{0};
+    Atomic<std::uint64_t> signalled_{0};
+    Atomic<bool> signal_wanted_{false};
+    Atomic<std::uint64_t> completed_{0};
+};
+
+class QueueState {
+public:
+    VkQueue queue = VK_NULL_HANDLE;
+    std::uint32_t family_index = 0;
+    std::uint32_t index = 0;
+    VkSemaphore semaphore = VK_NULL_HANDLE;  // the timeline's, counting in submission numbers
+    QueueTimeline timeline;
+    mutable Mutex mutex;
+};
+
+// Work to run once the GPU is done with an object: destroying its Vulkan
+// handle, or returning its memory to an allocator. A plain function pointer
+// and two words, so that queued actions hold no references and a Device with
+// pending actions is still torn down when its last handle goes.
+struct DeferredAction {
+    void (*run)(DeviceState& device, std::uint64_t handle, void* context) noexcept = nullptr;
+    std::uint64_t handle = 0;
+    void* context = nullptr;
+};
+
+// The device's queue of deferred actions. Actions queued while the same work
+// was pending share one batch; batches run in the order they were queued, so
+// an object queued after another (an image after its view) is destroyed after it.
+class DeferredDestructor {
+public:
+    // Runs the action now when no vkrc-submitted work is pending, otherwise once all work submitted before this call has completed.
+    void destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept;
+    // Runs the queued actions whose work has completed; never blocks on the
+    // GPU. Inline: with nothing queued (a steady frame loop) it is one load.
+    void collect(DeviceState& device) noexcept {
+        if (count_.load(__ATOMIC_RELAXED) != 0) [[unlikely]]
+            collect_queued(device);
+    }
+    // Runs every queued action at once; for teardown, after the GPU is idle or lost.
+    void run_all(DeviceState& device) noexcept;
+    // The number of queued actions.
+    std::size_t size() const noexcept;
+
+private:
+    void collect_queued(DeviceState& device) noexcept;
+    // Moves the actions whose work has completed to out; may throw bad_alloc.
+    void take_ready(DeviceState& device, List<DeferredAction>& out);
+
+    struct Batch {
+        List<std::uint64_t> wait_values;  // per queue
+        List<DeferredAction> actions;
+    };
+    mutable Mutex mutex_;
+    List<Batch> batches_;
+    // Read without the lock by collect() to skip it when nothing is queued.
+    Atomic<std::size_t> count_{0};
+};
+
+// One command buffer's recording window, as the device's OpenCommandBuffers
+// sees it. end is 0 while closed, UINT64_MAX while recording, and after
+// end() the creation counter's value then: the command buffer may refer to
+// objects with a lower serial only.
+struct RecordingWindow {
+    Atomic<std::uint64_t> end{0};
+    const void* pool = nullptr;  // the CommandPoolState, for pool resets
+    bool one_time = false;       // a ONE_TIME_SUBMIT primary: closes when submitted
+    std::size_t index = 0;       // in the registry
+};
+
+// Drops held back while a command buffer that may refer to them is open
+// (recording, or executable and not yet submitted for the last time): a drop
+// of an object is held while some open window's end exceeds its serial, and
+// goes into the deferred queue (so still waits for the GPU) once none does.
+// begin/end/close touch the window and one counter; the lock is taken when
+// something is held, or to register a command buffer at allocate and free.
+class OpenCommandBuffers {
+public:
+    struct Held {
+        DeferredAction action;
+        std::uint64_t serial = 0;
+    };
+    void add(RecordingWindow& window);
+    void remove(DeviceState& device, RecordingWindow& window) noexcept;
+    void begin(RecordingWindow& window, bool one_time) noexcept {
+        window.one_time = one_time;
+        if (window.end.exchange(UINT64_MAX) == 0) open_.fetch_add(1);
+    }
+    void end(RecordingWindow& window) noexcept { window.end.store(current_serial()); }
+    void close(DeviceState& device, RecordingWindow& window) noexcept {
+        const std::uint64_t end = window.end.exchange(0);
+        if (end != 0) open_.fetch_sub(1);
+        // Only closing a window at the last computed limit can uncover a held
+        // drop: a long hold by a reusable command buffer costs other closes nothing.
+        if (held_count_.load() != 0 && end >= covered_.load(__ATOMIC_RELAXED)) release(device);
+    }
+    // Closes every window of a pool (vkResetCommandPool). A frame loop
+    // resets a pool whose ONE_TIME_SUBMIT primaries its submit closed:
+    // nothing to scan, no lock (the pool is externally synchronised, so none
+    // of its windows opens meanwhile).
+    void close_pool(DeviceState& device, const void* pool) noexcept {
+        if (open_.load() != 0 || held_count_.load() != 0) close_pool_slow(device, pool);
+    }
+    // Whether a drop of an object with this serial must wait for a close.
+    bool holds(std::uint64_t serial) noexcept;
+    // Holds action when holds(serial); false (and nothing done) otherwise.
+    bool hold(DeferredAction action, std::uint64_t serial) noexcept;
+    // Objects with a serial at or above this are held by no open window.
+    std::uint64_t limit() noexcept;
+    // Moves the entries no longer held to the deferred queue, in order.
+    void release(DeviceState& device) noexcept;
+    // collect()'s safety net: release when a hold happened since the last release.
+    void release_if_stale(DeviceState& device) noexcept {
+        if (held_count_.load(__ATOMIC_RELAXED) != 0 && stale_.load(__ATOMIC_RELAXED)) release(device);
+    }
+    // Teardown: runs what is still held.
+    void run_all(DeviceState& device) noexcept;
+    std::size_t held_count() const noexcept { return held_count_.load(__ATOMIC_RELAXED); }
+
+private:
+    std::uint64_t limit_locked() const noexcept;
+    void close_pool_slow(DeviceState& device, const void* pool) noexcept;
+    mutable Mutex mutex_;
+    List<RecordingWindow*> windows_;  // every allocated command buffer of the device
+    List<Held> held_;
+    Atomic<std::size_t> open_{0};
+    Atomic<std::size_t> held_count_{0};
+    Atomic<bool> stale_{false};
+    Atomic<std::uint64_t> covered_{0};  // limit_locked() at the last hold or release
+};
+
+// Every allocator used with the device, kept until teardown so that deferred
+// frees can still reach it (memory.cpp).
+class AllocatorRegistry {
+public:
+    // In memory.cpp, where DeviceAllocator is complete (the constructor
+    // destroys the list when unwinding).
+    AllocatorRegistry();
+    ~AllocatorRegistry();
+    // The device's default allocator, a PoolAllocator made on first use.
+    DeviceAllocator& default_allocator();
+    // Keeps allocator until release_all (once per allocator).
+    void keep(const Ref<DeviceAllocator>& allocator);
+    // Calls each allocator's release() and drops them; teardown, after every deferred free ran.
+    void release_all(DeviceState& device) noexcept;
+
+private:
+    Mutex mutex_;
+    List<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
+    DeviceAllocator* default_ = nullptr;
+};
+
+// The device's machinery, through named operations: the other layers call
+// these, never the parts (commands, deferred, allocators) directly.
+class DeviceState final : public RefCounted {
+public:
+    ~DeviceState() override;
+
+    // ---- Deferred destruction
+    // Defers a destruction: see DeferredDestructor::destroy_after_gpu; serial
+    // is the dropped object's, which open command buffers may hold back
+    // (OpenCommandBuffers).
+    void destroy_after_gpu(DeferredAction action, std::uint64_t serial) noexcept {
+        if (commands.hold(action, serial)) return;
+        deferred.destroy_after_gpu(*this, action);
+    }
+    // Releases stale holds, then runs the completed deferred actions.
+    void collect() noexcept {
+        commands.release_if_stale(*this);
+        deferred.collect(*this);
+    }
+    // Objects waiting for the GPU or for an open command buffer.
+    std::size_t deferred_count() const noexcept { return deferred.size() + commands.held_count(); }
+
+    // ---- Command buffers' recording windows (OpenCommandBuffers)
+    // A command buffer is allocated or adopted (may throw bad_alloc), or freed.
+    void register_window(RecordingWindow& window) { commands.add(window); }
+    void unregister_window(RecordingWindow& window) noexcept { commands.remove(*this, window); }
+    // vkBeginCommandBuffer and vkEndCommandBuffer succeeded.
+    void open_window(RecordingWindow& window, bool one_time) noexcept { commands.begin(window, one_time); }
+    void end_window(RecordingWindow& window) noexcept { commands.end(window); }
+    // The command buffer was reset, or its one-time submit went in.
+    void close_window(RecordingWindow& window) noexcept { commands.close(*this, window); }
+    // Every window of pool closes (vkResetCommandPool).
+    void close_pool_windows(const void* pool) noexcept { commands.close_pool(*this, pool); }
+    // For pools that free their children themselves (PoolFreeList): whether
+    // an open window may refer to an object of this serial, and the serial
+    // at or above which none does.
+    bool held_back(std::uint64_t serial) noexcept { return commands.holds(serial); }
+    std::uint64_t hold_limit() noexcept { return commands.limit(); }
+
+    // ---- Allocators
+    // The device's default allocator, a PoolAllocator made on first use.
+    DeviceAllocator& default_allocator() { return allocators.default_allocator(); }
+    // Keeps allocator until teardown, so that deferred frees still reach it.
+    void keep_allocator(const Ref<DeviceAllocator>& allocator) { allocators.keep(allocator); }
+
+    // ---- Results and device loss
+    // Marks the device lost: the GPU will touch nothing any more, so every
+    // queued action may run.
+    void mark_lost() noexcept { lost.store(true, __ATOMIC_RELAXED); }
+    // Marks the device lost when r says so; returns r.
+    VkResult note_result(VkResult r) noexcept {
+        if (r == VK_ERROR_DEVICE_LOST) mark_lost();
+        return r;
+    }
+    // Marks the device lost when r says so, then check(r, call).
+    VkResult check_result(VkResult r, const char* call) { return check(note_result(r), call); }
+    // After a call that may have run or waited for GPU work: marks the device
+    // lost when r says so, runs the completed deferred actions, then check(r, call).
+    VkResult finish_call(VkResult r, const char* call) {
+        note_result(r);
+        collect();
+        return check(r, call);
+    }
+
+    // ---- Queues' timelines
+    // Under the queue's lock: when submits since the last timeline signal
+    // carried none, submits an empty batch that signals. value receives a
+    // timeline value, signalled or on its way, that covers all work submitted
+    // so far.
+    VkResult signal_submitted_work(QueueState& queue, std::uint64_t& value) noexcept;
+    // Waits until the queue's submission number has completed (at once when
+    // a fence or the timeline has already shown it), signalling the timeline
+    // first when no submit has; failed_call, if given, receives the name of
+    // the call that failed.
+    VkResult wait_for_submission(QueueState& queue, std::uint64_t number, const char** failed_call = nullptr) noexcept;
+    // wait_for_submission, throwing Error (DeviceLostError) on failure.
+    void await(QueueState& queue, std::uint64_t number);
+    // Reads the queue's timeline semaphore and returns the highest number
+    // known complete; throws Error (DeviceLostError) when the read fails.
+    std::uint64_t read_completed(QueueState& queue);
+
+    // For objects a pool owns (command buffers, descriptor sets), which must
+    // be freed under their pool's lock rather than by a DeferredAction: the
+    // covering values of every queue (out is resized to the queue count), and
+    // whether the GPU has completed the work they stand for.
+    void submitted_snapshot(List<std::uint64_t>& out);
+    bool reached(Span<const std::uint64_t> snapshot) noexcept;
+    // Reads the queues' timelines; true when everything submitted has completed.
+    bool idle_now() noexcept;
+
+    VkDevice device = VK_NULL_HANDLE;
+    DeviceFunctions fn;
+    // Loaded by the first Device::ext_fn() (src/extension_functions.cpp).
+    Atomic<DeviceExtensionFunctions*> ext_fn{nullptr};
+    PhysicalDevice physical_device;
+    Ownership ownership = Ownership::owned;
+    List<Text> enabled_extensions;
+    List<QueueState> queues;                 // made once, never grows: Queue handles point into it
+    std::size_t role_queues[3] = {0, 0, 0};  // by QueueRole: an index into queues
+    Atomic<bool> lost{false};
+
+private:
+    friend class OpenCommandBuffers;  // moves released drops into deferred
+    // Reads one queue's timeline into its completed cache.
+    VkResult refresh(QueueState& queue) noexcept;
+
+    OpenCommandBuffers commands;
+    DeferredDestructor deferred;
+    AllocatorRegistry allocators;
+};
+
+// The timeline operations from a Queue handle, for the layers above the
+// device (stream, swapchain, presenters).
+// The highest submission number of queue known complete (no call).
+inline std::uint64_t completed(const Queue& queue) noexcept { return queue.state()->timeline.completed(); }
+// The number of queue's last submission (0: none).
+inline std::uint64_t last_submitted(const Queue& queue) noexcept { return queue.state()->timeline.last_submitted(); }
+// A number whose completion means all work submitted so far on queue has
+// completed; asks the next submit to signal it when no signal does.
+inline std::uint64_t covering_value(const Queue& queue) noexcept { return queue.state()->timeline.covering_value(); }
+// Asks queue's next submit to signal its timeline.
+inline void request_signal(const Queue& queue) noexcept { queue.state()->timeline.request_signal(); }
+// DeviceState::read_completed and DeviceState::await of queue.
+inline std::uint64_t read_completed(const Queue& queue) { return queue.device().state()->read_completed(*queue.state()); }
+inline void await(const Queue& queue, std::uint64_t number) { queue.device().state()->await(*queue.state(), number); }
+
+// Queue::submit that always signals the queue's timeline with the
+// submission's number, which it returns: a value to wait on at once, for
+// tickets (stream.cpp). Throws DeviceLostError on device loss.
+std::uint64_t submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits);
+
+// Converts any Vulkan handle to the word stored in a DeferredAction.
+template <class VkHandle>
+std::uint64_t handle_bits(VkHandle handle) noexcept {
+    return (std::uint64_t)(handle);
+}
+template <class VkHandle>
+VkHandle handle_from_bits(std::uint64_t bits) noexcept {
+    return (VkHandle)(bits);
+}
+
+// Queues vkDestroyX(device, handle, nullptr) to run after the GPU is done.
+// Usage: defer_destroy<&DeviceFunctions::vkDestroyBuffer>(device, buffer, serial());
+// serial: the dropped state's serial().
+template <auto DestroyMember, class VkHandle>
+void defer_destroy(DeviceState& device, VkHandle handle, std::uint64_t serial) noexcept {
+    if (handle == VK_NULL_HANDLE) return;
+    device.destroy_after_gpu({[](DeviceState& d, std::uint64_t bits, void*) noexcept {
+                                  (d.fn.*DestroyMember)(d.device, handle_from_bits<VkHandle>(bits), nullptr);
+                              },
+                              handle_bits(handle), nullptr},
+                             serial);
+}
+
+// Queues destroy (a vkDestroy* member of DeviceFunctions) of the handle of
+// state, an object of device, for after the GPU when vkrc owns it; nothing
+// for a borrowed handle or a failed creation.
+template <auto destroy, class VkHandle>
+void destroy_owned(const VulkanObjectState<VkHandle>& state, const Device& device) noexcept {
+    if (device && state.owns_handle()) defer_destroy<destroy>(*device.state(), state.handle, state.serial());
+}
+
+// The state of most objects made from a Device: the device, kept alive.
+template <class VkHandle>
+class DeviceChildState : public VulkanObjectState<VkHandle> {
+public:
+    Device device;
+};
+
+}  // namespace detail
+
+// Device's and Queue's accessors, inline for the hot path: here, where the states are complete.
+inline VkDevice Device::vk() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::vk").device; }
+inline const DeviceFunctions& Device::fn() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Device::fn").fn; }
+inline const PhysicalDevice& Device::physical_device() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::Device::physical_device").physical_device;
+}
+inline const Instance& Device::instance() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::Device::instance").physical_device.instance();
+}
+
+inline VkQueue Queue::vk() const noexcept { return queue_->queue; }
+inline std::uint32_t Queue::family_index() const noexcept { return queue_->family_index; }
+inline std::uint32_t Queue::index() const noexcept { return queue_->index; }
+inline VkSemaphore Queue::timeline_semaphore() const noexcept { return queue_->semaphore; }
+inline Mutex& Queue::mutex() const noexcept { return queue_->mutex; }
+
+VKRC_END_NAMESPACE
