@@ -1,7 +1,7 @@
-// Barrier helpers, generate_mipmaps, queue labels and the out-of-line error
-// paths of recording methods (kept here so that command.cpp stays the pool
-// and command buffer lifetime code).
-#include "vkrc/command.hpp"
+// Barrier helpers (vkrc/barrier.hpp), generate_mipmaps (vkrc/mipmap.hpp),
+// queue labels and the out-of-line error paths of recording methods (kept
+// here so that command.cpp stays the pool and command buffer lifetime code).
+#include "vkrc/mipmap.hpp"
 
 #include "object_state.hpp"
 

@@ -1,4 +1,6 @@
-// Command pools, command buffers and recording (submission: vkrc/submit.hpp).
+// Command buffers and recording (pools: vkrc/command_pool.hpp; barriers:
+// vkrc/barrier.hpp; what rendering begins with: vkrc/rendering.hpp;
+// submission: vkrc/submit.hpp).
 //
 // Recording methods are inline: each is one call through the device function
 // table with the raw handles read out of the wrappers. No allocation, no
@@ -6,8 +8,11 @@
 //     cmd.fn().vkCmdSetLineWidth(cmd.vk(), 2.0f);
 #pragma once
 
+#include "vkrc/barrier.hpp"
+#include "vkrc/command_pool.hpp"
 #include "vkrc/descriptor_template.hpp"
 #include "vkrc/pipeline.hpp"
+#include "vkrc/rendering.hpp"
 #include "vkrc/sync.hpp"
 
 #include "vkrc/detail/span.hpp"
@@ -15,128 +20,7 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
-class CommandPoolState;
 class CommandBufferState;
-}  // namespace detail
-
-// Mirrors VkCommandPoolCreateInfo.
-struct CommandPoolCreateInfo {
-    // Optional (default: command buffers reset one by one).
-    VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-    // The family the pool's command buffers are submitted to (default 0; usually queue.family_index()).
-    std::uint32_t queue_family_index = 0;
-    // Optional pNext chain; read during create only.
-    const void* next = nullptr;
-};
-
-class CommandBuffer;
-
-// A command pool, externally synchronised as Vulkan requires: record into the
-// command buffers of one pool from one thread at a time (use a pool per
-// thread). Under the multi-thread policy the pool's lock is taken by
-// allocate, reset, begin and end (never per recorded command), so that the
-// frees vkrc does on its own when a command buffer is dropped (on any thread)
-// never race with them.
-class CommandPool : public DeviceChild<detail::CommandPoolState, VkCommandPool> {
-public:
-    static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
-    // Wraps a pool made elsewhere from device for queue_family_index. With
-    // Ownership::owned vkrc destroys it once the GPU is done. Borrowed, its
-    // maker destroys it, after the GPU is done with every command buffer vkrc
-    // allocated from it; those dropped last stay allocated until then.
-    static CommandPool adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
-                             Ownership ownership);
-
-    std::uint32_t queue_family_index() const VKRC_UNCHECKED_NOEXCEPT;
-
-    CommandBuffer allocate(VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY) const;
-    // vkResetCommandPool: every command buffer of the pool returns to the
-    // initial state. The caller ensures none is pending on the GPU.
-    void reset_commands(VkCommandPoolResetFlags flags = 0) const;
-    // Command buffers dropped while the GPU may use them, not yet freed.
-    std::size_t pending_free_count() const;
-
-private:
-    using DeviceChild::DeviceChild;
-};
-
-// What a secondary command buffer inherits (VkCommandBufferInheritanceInfo,
-// with VkCommandBufferInheritanceRenderingInfo for dynamic rendering). Leave
-// render_pass empty and color_formats empty for secondaries used outside
-// rendering; set either for RENDER_PASS_CONTINUE secondaries.
-// Every member is optional and read during begin_secondary() (the command buffer keeps no reference).
-struct CommandBufferInheritance {
-    // A render pass; subpass and framebuffer (empty: not known) go with it.
-    RenderPass render_pass{};
-    std::uint32_t subpass = 0;
-    Framebuffer framebuffer{};
-    // Dynamic rendering, without render_pass: need not outlive begin_secondary().
-    Span<const VkFormat> color_formats{};
-    VkFormat depth_format = VK_FORMAT_UNDEFINED;
-    VkFormat stencil_format = VK_FORMAT_UNDEFINED;
-    VkSampleCountFlagBits rasterization_samples = VK_SAMPLE_COUNT_1_BIT;
-};
-
-// One attachment of dynamic rendering (VkRenderingAttachmentInfo).
-// image_view: view.vk() of an ImageView that lives until the work is submitted.
-struct RenderingAttachment {
-    // Required.
-    VkImageView image_view = VK_NULL_HANDLE;
-    // Optional (default colour attachment optimal; set it for depth).
-    VkImageLayout image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-    // Optional (default clear, then store).
-    VkAttachmentLoadOp load_op = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    VkAttachmentStoreOp store_op = VK_ATTACHMENT_STORE_OP_STORE;
-    // Used with load_op CLEAR (default zero).
-    VkClearValue clear_value{};
-    // Optional multisample resolve: NONE (the default) resolves nothing;
-    // otherwise resolve_image_view (a single-sample view that lives until the
-    // work is submitted) receives the resolved image, in resolve_image_layout.
-    VkResolveModeFlagBits resolve_mode = VK_RESOLVE_MODE_NONE;
-    VkImageView resolve_image_view = VK_NULL_HANDLE;
-    VkImageLayout resolve_image_layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-};
-
-// VkRenderingInfo. At most max_color_attachments colour attachments.
-// Read during begin_rendering(): the span and pointers need not outlive the call.
-struct RenderingInfo {
-    static constexpr std::uint32_t max_color_attachments = 8;
-    // Required (the default is empty).
-    VkRect2D render_area{};
-    // Optional (empty: none).
-    Span<const RenderingAttachment> color_attachments{};
-    // Optional (null: none).
-    const RenderingAttachment* depth_attachment = nullptr;
-    const RenderingAttachment* stencil_attachment = nullptr;
-    // Optional (default none).
-    VkRenderingFlags flags = 0;
-    // Optional (default 1).
-    std::uint32_t layer_count = 1;
-    // Optional multiview mask (0: no multiview; needs the multiview feature).
-    std::uint32_t view_mask = 0;
-    // Optional pNext chain of VkRenderingInfo; must live through the call.
-    const void* next = nullptr;
-};
-
-namespace detail {
-[[noreturn]] void throw_too_many_color_attachments(std::size_t count);
-
-// begin_rendering's conversion: a function rather than a lambda, and an
-// index loop rather than span iterators, because each closure type and
-// iterator instantiation costs every includer's compile (bench/header_cost).
-inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttachment& a) noexcept {
-    VkRenderingAttachmentInfo r{};
-    r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-    r.imageView = a.image_view;
-    r.imageLayout = a.image_layout;
-    r.loadOp = a.load_op;
-    r.storeOp = a.store_op;
-    r.clearValue = a.clear_value;
-    r.resolveMode = a.resolve_mode;
-    r.resolveImageView = a.resolve_image_view;
-    r.resolveImageLayout = a.resolve_image_layout;
-    return r;
-}
 [[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
 }  // namespace detail
 
@@ -203,15 +87,55 @@ public:
     }
     // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
     // RenderingInfo::max_color_attachments colour attachments.
-    void begin_rendering(const RenderingInfo& info) const;
+    void begin_rendering(const RenderingInfo& info) const {
+#if VKRC_RUNTIME_CHECKS
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_rendering");
+        if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
+            detail::throw_too_many_color_attachments(info.color_attachments.size());
+        }
+#endif
+        VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
+        const RenderingAttachment* color_attachments = info.color_attachments.data();
+        const std::size_t color_count = info.color_attachments.size();
+        std::uint32_t count = 0;
+        for (; count < color_count && count < RenderingInfo::max_color_attachments; ++count) {
+            colors[count] = detail::rendering_attachment_info(color_attachments[count]);
+        }
+        VkRenderingAttachmentInfo depth, stencil;
+        VkRenderingInfo r{};
+        r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
+        r.pNext = info.next;
+        r.flags = info.flags;
+        r.viewMask = info.view_mask;
+        r.renderArea = info.render_area;
+        r.layerCount = info.layer_count;
+        r.colorAttachmentCount = count;
+        r.pColorAttachments = colors;
+        if (info.depth_attachment) {
+            depth = detail::rendering_attachment_info(*info.depth_attachment);
+            r.pDepthAttachment = &depth;
+        }
+        if (info.stencil_attachment) {
+            stencil = detail::rendering_attachment_info(*info.stencil_attachment);
+            r.pStencilAttachment = &stencil;
+        }
+        fn_->vkCmdBeginRendering(cmd_, &r);
+    }
     void end_rendering() const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_rendering");
         fn_->vkCmdEndRendering(cmd_);
     }
 
     // State
+    // Each binding by a wrapper is followed by its twin by raw handles or a
+    // PipelineLayout, for pipelines and layouts made by other code (or
+    // adopted): the same single call.
     void bind_pipeline(const Pipeline& pipeline) const VKRC_UNCHECKED_NOEXCEPT {
         bind_pipeline(pipeline.bind_point(), pipeline.vk());
+    }
+    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
+        fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
     }
     void bind_vertex_buffer(std::uint32_t binding, Raw<VkBuffer> buffer,
                             VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
@@ -240,6 +164,14 @@ public:
                               Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
         bind_descriptor_sets(pipeline.bind_point(), pipeline.layout().vk(), first_set, sets, dynamic_offsets);
     }
+    void bind_descriptor_sets(VkPipelineBindPoint bind_point, Raw<VkPipelineLayout> layout, std::uint32_t first_set,
+                              Span<const VkDescriptorSet> sets,
+                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
+        fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
+                                     sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
+                                     dynamic_offsets.data());
+    }
     // Push descriptors (VK_KHR_push_descriptor, which must be enabled on the
     // device: the function is called as loaded). Writes set `set` of layout,
     // whose set layout has PUSH_DESCRIPTOR_BIT_KHR; the writes' dstSet is ignored.
@@ -265,6 +197,11 @@ public:
     void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         push_constants(layout, stages, offset, sizeof(T), &value);
+    }
+    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, std::uint32_t offset,
+                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
+        fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
     }
     void set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
@@ -330,9 +267,22 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
         fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
     }
+    // The barriers' structs: vkrc/barrier.hpp.
     void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
                           Span<const VkImageMemoryBarrier2> images,
-                          VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT;
+                          VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
+        VkDependencyInfo d{};
+        d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
+        d.dependencyFlags = flags;
+        d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
+        d.pMemoryBarriers = memory.data();
+        d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+        d.pBufferMemoryBarriers = buffers.data();
+        d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+        d.pImageMemoryBarriers = images.data();
+        fn_->vkCmdPipelineBarrier2(cmd_, &d);
+    }
     void set_event(Raw<VkEvent> event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
         fn_->vkCmdSetEvent2(cmd_, event, &dependency);
@@ -343,7 +293,16 @@ public:
     }
 
     // Secondaries: any number, passed to Vulkan in chunks from the stack.
-    void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT;
+    void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+        constexpr std::size_t chunk = 32;
+        VkCommandBuffer raw[chunk];
+        for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
+            std::uint32_t n = 0;
+            for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
+            fn_->vkCmdExecuteCommands(cmd_, n, raw);
+        }
+    }
     // Raw secondaries (recorded by other code): passed as they are, in one call.
     void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
@@ -595,26 +554,6 @@ public:
             "vkrc::CommandBuffer::set_primitive_restart_enable", enable);
     }
 
-    // Binding by raw handles or by a PipelineLayout, for pipelines and
-    // layouts made by other code (or adopted): the same single calls.
-    void bind_pipeline(VkPipelineBindPoint bind_point, VkPipeline pipeline) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_pipeline");
-        fn_->vkCmdBindPipeline(cmd_, bind_point, pipeline);
-    }
-    void bind_descriptor_sets(VkPipelineBindPoint bind_point, Raw<VkPipelineLayout> layout, std::uint32_t first_set,
-                              Span<const VkDescriptorSet> sets,
-                              Span<const std::uint32_t> dynamic_offsets = {}) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_descriptor_sets");
-        fn_->vkCmdBindDescriptorSets(cmd_, bind_point, layout, first_set, static_cast<std::uint32_t>(sets.size()),
-                                     sets.data(), static_cast<std::uint32_t>(dynamic_offsets.size()),
-                                     dynamic_offsets.data());
-    }
-    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, std::uint32_t offset,
-                        std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
-        fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
-    }
-
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
@@ -635,212 +574,11 @@ private:
     }
 };
 
-// The recording methods of more than one call.
-inline void CommandBuffer::begin_rendering(const RenderingInfo& info) const {
-#if VKRC_RUNTIME_CHECKS
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_rendering");
-    if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {
-        detail::throw_too_many_color_attachments(info.color_attachments.size());
-    }
-#endif
-    VkRenderingAttachmentInfo colors[RenderingInfo::max_color_attachments];
-    const RenderingAttachment* color_attachments = info.color_attachments.data();
-    const std::size_t color_count = info.color_attachments.size();
-    std::uint32_t count = 0;
-    for (; count < color_count && count < RenderingInfo::max_color_attachments; ++count) {
-        colors[count] = detail::rendering_attachment_info(color_attachments[count]);
-    }
-    VkRenderingAttachmentInfo depth, stencil;
-    VkRenderingInfo r{};
-    r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-    r.pNext = info.next;
-    r.flags = info.flags;
-    r.viewMask = info.view_mask;
-    r.renderArea = info.render_area;
-    r.layerCount = info.layer_count;
-    r.colorAttachmentCount = count;
-    r.pColorAttachments = colors;
-    if (info.depth_attachment) {
-        depth = detail::rendering_attachment_info(*info.depth_attachment);
-        r.pDepthAttachment = &depth;
-    }
-    if (info.stencil_attachment) {
-        stencil = detail::rendering_attachment_info(*info.stencil_attachment);
-        r.pStencilAttachment = &stencil;
-    }
-    fn_->vkCmdBeginRendering(cmd_, &r);
-}
-
-inline void CommandBuffer::pipeline_barrier(Span<const VkMemoryBarrier2> memory,
-                                            Span<const VkBufferMemoryBarrier2> buffers,
-                                            Span<const VkImageMemoryBarrier2> images,
-                                            VkDependencyFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-    VkDependencyInfo d{};
-    d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-    d.dependencyFlags = flags;
-    d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
-    d.pMemoryBarriers = memory.data();
-    d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
-    d.pBufferMemoryBarriers = buffers.data();
-    d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
-    d.pImageMemoryBarriers = images.data();
-    fn_->vkCmdPipelineBarrier2(cmd_, &d);
-}
-
-inline void CommandBuffer::execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
-    constexpr std::size_t chunk = 32;
-    VkCommandBuffer raw[chunk];
-    for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
-        std::uint32_t n = 0;
-        for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
-        fn_->vkCmdExecuteCommands(cmd_, n, raw);
-    }
-}
-
-namespace detail {
-// What the memory, buffer and image barrier helpers fill alike: the stage
-// and access scopes and, where the barrier has them, ignored queue families
-// (no ownership transfer unless the caller sets one).
-template <class Barrier>
-inline Barrier scoped_barrier(VkStructureType type, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    Barrier b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
-    b.sType = type;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    if constexpr (requires { b.srcQueueFamilyIndex; }) {
-        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    }
-    return b;
-}
-}  // namespace detail
-
-// An image barrier over every mip level and layer of one aspect. Inline: it
-// only fills a struct, which the caller's compiler folds into its own stores.
-inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
-                                           VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                           VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
-    auto b = detail::scoped_barrier<VkImageMemoryBarrier2>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, src_stage,
-                                                           src_access, dst_stage, dst_access);
-    b.oldLayout = old_layout;
-    b.newLayout = new_layout;
-    b.image = image;
-    b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-    return b;
-}
-// A global memory barrier.
-inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    return detail::scoped_barrier<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, src_stage, src_access,
-                                                    dst_stage, dst_access);
-}
-
-// An image barrier over range (see mip_range and layer_range).
-VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range, VkImageLayout old_layout,
-                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
-                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                                    VkAccessFlags2 dst_access) noexcept;
-// count mip levels from base_level, every layer.
-VkImageSubresourceRange mip_range(std::uint32_t base_level, std::uint32_t level_count = 1,
-                                  VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
-// count array layers from base_layer, every mip level.
-VkImageSubresourceRange layer_range(std::uint32_t base_layer, std::uint32_t layer_count = 1,
-                                    VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
-// A buffer barrier over size bytes from offset (VK_WHOLE_SIZE: to the end).
-VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                      VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                      VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE) noexcept;
-
-// A queue-family ownership transfer of an EXCLUSIVE image: record release()
-// on a queue of src_family, then, after a semaphore, acquire() on a queue of
-// dst_family. Vulkan wants both barriers to name the same families, layouts
-// and range; one description makes both, so they cannot disagree.
-struct ImageOwnershipTransfer {
-    // Required.
-    VkImage image = VK_NULL_HANDLE;
-    // Optional (default every level and layer of the colour aspect).
-    VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-    // The layout transition that travels with the transfer (equal: none).
-    VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    VkImageLayout new_layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    // Required: the family giving the image up and the one taking it.
-    std::uint32_t src_family = VK_QUEUE_FAMILY_IGNORED;
-    std::uint32_t dst_family = VK_QUEUE_FAMILY_IGNORED;
-
-    // The barrier after the writes that src_family's queue made (its
-    // destination scope is empty: Vulkan ignores it).
-    VkImageMemoryBarrier2 release(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) const noexcept;
-    // The barrier before dst_family's queue uses the image (empty source scope).
-    VkImageMemoryBarrier2 acquire(VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) const noexcept;
-};
-
-// The same for an EXCLUSIVE buffer's size bytes from offset (VK_WHOLE_SIZE: to the end).
-struct BufferOwnershipTransfer {
-    // Required.
-    VkBuffer buffer = VK_NULL_HANDLE;
-    // Required: the family giving the buffer up and the one taking it.
-    std::uint32_t src_family = VK_QUEUE_FAMILY_IGNORED;
-    std::uint32_t dst_family = VK_QUEUE_FAMILY_IGNORED;
-    // Optional (default the whole buffer).
-    VkDeviceSize offset = 0;
-    VkDeviceSize size = VK_WHOLE_SIZE;
-
-    VkBufferMemoryBarrier2 release(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access) const noexcept;
-    VkBufferMemoryBarrier2 acquire(VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) const noexcept;
-};
-
-// What generate_mipmaps starts from and leaves behind.
-struct MipmapInfo {
-    // Level 0's layout now and the writes that filled it (an upload's copy by default).
-    VkImageLayout base_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    VkPipelineStageFlags2 src_stage = VK_PIPELINE_STAGE_2_COPY_BIT;
-    VkAccessFlags2 src_access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    // Every level's layout afterwards, and who reads it next.
-    VkImageLayout final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    VkPipelineStageFlags2 dst_stage = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-    VkAccessFlags2 dst_access = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    VkFilter filter = VK_FILTER_LINEAR;
-    // The layers to process (VK_REMAINING_ARRAY_LAYERS: to the last).
-    std::uint32_t base_layer = 0;
-    std::uint32_t layer_count = VK_REMAINING_ARRAY_LAYERS;
-};
-
-// Records the blits that fill mip levels 1.. of image from level 0, each
-// level from the one above, with the barriers between them; the other
-// levels' old contents are discarded. Throws UsageError when the image lacks
-// TRANSFER_SRC and TRANSFER_DST usage, is multisampled, its format cannot be
-// blitted (or linearly filtered, for VK_FILTER_LINEAR) with optimal tiling,
-// the command buffer's queue family has no graphics, or the layers are out of range.
-void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const MipmapInfo& info = {});
-
 namespace detail {
 
 // After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
 // (OpenCommandBuffers), whose held drops then wait for that submission.
 void close_submitted(Span<const CommandBuffer> command_buffers) noexcept;
-
-class CommandPoolState final : public DeviceChildState<VkCommandPool> {
-public:
-    static constexpr const char* type_name = "vkrc::CommandPool";
-    ~CommandPoolState() override;
-    // Under mutex: frees the dropped command buffers the GPU is done with.
-    // Inline: a frame loop's begin and reset find nothing pending.
-    void free_completed() {
-        if (!pending.empty()) free_ready();
-    }
-    void free_ready();
-
-    std::uint32_t queue_family_index = 0;
-    mutable Mutex mutex;
-    PoolFreeList<VkCommandBuffer> pending;  // under mutex
-    List<VkCommandBuffer> scratch;          // under mutex
-};
 
 class CommandBufferState final : public RefCounted {
 public:
@@ -857,10 +595,6 @@ public:
 };
 
 }  // namespace detail
-
-inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::CommandPool::queue_family_index").queue_family_index;
-}
 
 inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::CommandBuffer::pool").pool;

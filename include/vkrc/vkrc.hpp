@@ -1,7 +1,9 @@
 // The whole of vkrc. Each object family also has its own header.
 #pragma once
 
+#include "vkrc/barrier.hpp"
 #include "vkrc/command.hpp"
+#include "vkrc/command_pool.hpp"
 #include "vkrc/config.hpp"
 #include "vkrc/debug_utils.hpp"
 #include "vkrc/descriptor.hpp"
@@ -12,8 +14,10 @@
 #include "vkrc/handle.hpp"
 #include "vkrc/instance.hpp"
 #include "vkrc/memory.hpp"
+#include "vkrc/mipmap.hpp"
 #include "vkrc/pipeline.hpp"
 #include "vkrc/private_data.hpp"
+#include "vkrc/rendering.hpp"
 #include "vkrc/resource.hpp"
 #include "vkrc/shader.hpp"
 #include "vkrc/submit.hpp"

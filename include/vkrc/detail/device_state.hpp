@@ -339,7 +339,9 @@ inline std::uint64_t covering_value(const Queue& queue) noexcept { return queue.
 // Asks queue's next submit to signal its timeline.
 inline void request_signal(const Queue& queue) noexcept { queue.state()->timeline.request_signal(); }
 // DeviceState::read_completed and DeviceState::await of queue.
-inline std::uint64_t read_completed(const Queue& queue) { return queue.device().state()->read_completed(*queue.state()); }
+inline std::uint64_t read_completed(const Queue& queue) {
+    return queue.device().state()->read_completed(*queue.state());
+}
 inline void await(const Queue& queue, std::uint64_t number) { queue.device().state()->await(*queue.state(), number); }
 
 // Queue::submit that always signals the queue's timeline with the

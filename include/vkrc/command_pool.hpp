@@ -1,0 +1,82 @@
+// Command pools: where command buffers come from and return to (recording:
+// vkrc/command.hpp).
+#pragma once
+
+#include "vkrc/device.hpp"
+
+#include "vkrc/detail/list.hpp"
+#include "vkrc/detail/pool_free_list.hpp"
+
+VKRC_BEGIN_NAMESPACE
+
+namespace detail {
+class CommandPoolState;
+}  // namespace detail
+
+// Mirrors VkCommandPoolCreateInfo.
+struct CommandPoolCreateInfo {
+    // Optional (default: command buffers reset one by one).
+    VkCommandPoolCreateFlags flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    // The family the pool's command buffers are submitted to (default 0; usually queue.family_index()).
+    std::uint32_t queue_family_index = 0;
+    // Optional pNext chain; read during create only.
+    const void* next = nullptr;
+};
+
+class CommandBuffer;
+
+// A command pool, externally synchronised as Vulkan requires: record into the
+// command buffers of one pool from one thread at a time (use a pool per
+// thread). Under the multi-thread policy the pool's lock is taken by
+// allocate, reset, begin and end (never per recorded command), so that the
+// frees vkrc does on its own when a command buffer is dropped (on any thread)
+// never race with them.
+class CommandPool : public DeviceChild<detail::CommandPoolState, VkCommandPool> {
+public:
+    static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
+    // Wraps a pool made elsewhere from device for queue_family_index. With
+    // Ownership::owned vkrc destroys it once the GPU is done. Borrowed, its
+    // maker destroys it, after the GPU is done with every command buffer vkrc
+    // allocated from it; those dropped last stay allocated until then.
+    static CommandPool adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
+                             Ownership ownership);
+
+    std::uint32_t queue_family_index() const VKRC_UNCHECKED_NOEXCEPT;
+
+    CommandBuffer allocate(VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY) const;
+    // vkResetCommandPool: every command buffer of the pool returns to the
+    // initial state. The caller ensures none is pending on the GPU.
+    void reset_commands(VkCommandPoolResetFlags flags = 0) const;
+    // Command buffers dropped while the GPU may use them, not yet freed.
+    std::size_t pending_free_count() const;
+
+private:
+    using DeviceChild::DeviceChild;
+};
+
+namespace detail {
+
+class CommandPoolState final : public DeviceChildState<VkCommandPool> {
+public:
+    static constexpr const char* type_name = "vkrc::CommandPool";
+    ~CommandPoolState() override;
+    // Under mutex: frees the dropped command buffers the GPU is done with.
+    // Inline: a frame loop's begin and reset find nothing pending.
+    void free_completed() {
+        if (!pending.empty()) free_ready();
+    }
+    void free_ready();
+
+    std::uint32_t queue_family_index = 0;
+    mutable Mutex mutex;
+    PoolFreeList<VkCommandBuffer> pending;  // under mutex
+    List<VkCommandBuffer> scratch;          // under mutex
+};
+
+}  // namespace detail
+
+inline std::uint32_t CommandPool::queue_family_index() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::CommandPool::queue_family_index").queue_family_index;
+}
+
+VKRC_END_NAMESPACE
