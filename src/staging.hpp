@@ -1,33 +1,34 @@
-// The checks and sizes shared by the blocking staging functions (upload.cpp)
-// and the Uploader (stream.cpp).
+// The one transfer path (stream.cpp), as the blocking helpers (upload.cpp)
+// and the Uploader's methods both call it: each records into an Uploader's
+// open batch after its checks, which name the public function that caller
+// gives.
 #pragma once
 
-#include "vkrc/upload.hpp"
+#include "vkrc/stream.hpp"
+
+#include "caller.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-// The buffer or image exists, belongs to the queue's device and has the
-// transfer usage (usage_name) it needs; UsageError naming who otherwise.
-void check_transfer(const Queue& queue, const Buffer& buffer, VkBufferUsageFlags usage, const char* usage_name,
-                    const char* who);
-void check_transfer(const Queue& queue, const Image& image, VkImageUsageFlags usage, const char* usage_name,
-                    const char* who);
-// size bytes at offset lie in the buffer.
-void check_buffer_range(const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size, const char* who);
-// The image's copy unit; UsageError for formats the staging code does not handle.
-FormatBlock checked_block(const Image& image, const char* who);
-// Bytes of one array layer of a mip level, in whole blocks.
-VkDeviceSize level_size(const Image& image, std::uint32_t level, const FormatBlock& block, const char* who);
-// The number of levels an upload of level_count (VK_REMAINING_MIP_LEVELS:
-// all) covers; UsageError when it is 0 or more than the image has.
-std::uint32_t uploaded_levels(const Image& image, std::uint32_t level_count, const char* who);
-// upload_image's checks of data and info against the image.
-void check_image_upload(const Image& image, Span<const std::byte> data, const ImageUploadInfo& info, const char* who);
-// download_image's checks of the level, layer and layout.
-void check_image_download(const Image& image, VkImageLayout layout, std::uint32_t mip_level, std::uint32_t array_layer,
-                          const char* who);
+// Uploader::create's work, refusals named after caller.
+Uploader create_uploader(const UploaderCreateInfo& info, const Caller& caller);
+// The blocking helpers' Uploader: on queue, for its own family, with room
+// for size bytes (at least 1), its batch ending with the copies made visible
+// so that later submissions need not wait on its semaphore.
+Uploader one_time_uploader(const Queue& queue, VkDeviceSize size, const Caller& caller);
+
+// Uploader::upload_buffer, upload_image, download_buffer and download_image
+// into s's open batch; caller names the refusals.
+void record_upload(UploaderState& s, const Buffer& buffer, VkDeviceSize offset, Span<const std::byte> data,
+                   const Caller& caller);
+void record_upload(UploaderState& s, const Image& image, Span<const std::byte> data, const ImageUploadInfo& info,
+                   const Caller& caller);
+Download record_download(UploaderState& s, const Buffer& buffer, VkDeviceSize offset, VkDeviceSize size,
+                         const Caller& caller);
+Download record_download(UploaderState& s, const Image& image, VkImageLayout layout, std::uint32_t mip_level,
+                         std::uint32_t array_layer, const Caller& caller);
 
 }  // namespace detail
 

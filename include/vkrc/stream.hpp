@@ -7,13 +7,14 @@
 #include "vkrc/descriptor.hpp"
 #include "vkrc/detail/fifo.hpp"
 #include "vkrc/submit.hpp"
-#include "vkrc/upload.hpp"
 
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 class UploaderState;
 class FrameRingState;
+// What stream.cpp reaches inside Downloads and Uploaders.
+struct StreamAccess;
 }  // namespace detail
 
 // The end of an Uploader's batch: the value its queue's timeline semaphore
@@ -66,12 +67,32 @@ public:
     VkDeviceSize size() const noexcept { return size_; }
 
 private:
-    friend class Uploader;
+    friend struct detail::StreamAccess;
     Queue queue_;
     detail::Ref<detail::BatchValue> batch_;
     Buffer readback_;
     VkDeviceSize size_ = 0;
 };
+
+// Every member is optional.
+struct ImageUploadInfo {
+    // The image's layout before the upload; UNDEFINED (the default) discards its contents.
+    VkImageLayout old_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    // The layout the image is left in, for the work that reads it next (default shader read-only).
+    VkImageLayout new_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    // The levels uploaded, from level 0 (default all). Fewer, e.g. level 0
+    // alone for generate_mipmaps to fill the rest on the GPU: the data then
+    // holds just those levels, and the others are left in new_layout with
+    // undefined contents. Must be 1 to the image's mip_levels.
+    std::uint32_t level_count = VK_REMAINING_MIP_LEVELS;
+};
+
+// Bytes upload_image expects: every mip level of every array layer, tightly
+// packed (block-compressed levels in whole blocks, rounded up), level by level and within a level layer by layer (level 0 layer 0,
+// level 0 layer 1, ..., level 1 layer 0, ...). With level_count, only the
+// first level_count levels (ImageUploadInfo::level_count); UsageError when
+// it is 0 or more than the image has.
+VkDeviceSize image_data_size(const Image& image, std::uint32_t level_count = VK_REMAINING_MIP_LEVELS);
 
 // Every member but queue is optional.
 struct UploaderCreateInfo {
@@ -124,6 +145,7 @@ public:
     Ticket submit(Span<const SemaphoreSubmit> waits = {}) const;
 
 private:
+    friend struct detail::StreamAccess;
     using Handle::Handle;
 };
 
