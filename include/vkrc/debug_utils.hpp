@@ -93,7 +93,7 @@ void set_name(const Device& device, const Object& object, const char* name) {
         set_name(device, object.vk(), name);
     } else {
         static_assert(object_type_of<Object> != VK_OBJECT_TYPE_UNKNOWN, "vkrc::set_name: not a Vulkan handle type");
-        set_name(device, object_type_of<Object>, (std::uint64_t)(object), name);
+        set_name(device, object_type_of<Object>, detail::handle_bits(object), name);
     }
 }
 

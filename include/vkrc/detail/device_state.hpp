@@ -7,6 +7,9 @@
 
 #include "vkrc/device.hpp"
 
+#include <cstdint>
+#include <type_traits>
+
 VKRC_BEGIN_NAMESPACE
 
 namespace detail {
@@ -350,13 +353,22 @@ inline void await(const Queue& queue, std::uint64_t number) { queue.device().sta
 std::uint64_t submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits);
 
 // Converts any Vulkan handle to the word stored in a DeferredAction.
+// (Pointers on 64-bit targets; non-dispatchable handles are 64-bit integers elsewhere.)
 template <class VkHandle>
 std::uint64_t handle_bits(VkHandle handle) noexcept {
-    return (std::uint64_t)(handle);
+    if constexpr (std::is_pointer_v<VkHandle>) {
+        return reinterpret_cast<std::uintptr_t>(handle);
+    } else {
+        return static_cast<std::uint64_t>(handle);
+    }
 }
 template <class VkHandle>
 VkHandle handle_from_bits(std::uint64_t bits) noexcept {
-    return (VkHandle)(bits);
+    if constexpr (std::is_pointer_v<VkHandle>) {
+        return reinterpret_cast<VkHandle>(static_cast<std::uintptr_t>(bits));
+    } else {
+        return static_cast<VkHandle>(bits);
+    }
 }
 
 // Queues vkDestroyX(device, handle, nullptr) to run after the GPU is done.
