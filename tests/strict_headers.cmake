@@ -3,6 +3,7 @@
 # vkrc header must add no diagnostic to its includer's build.
 # -DCXX=compiler -DINCLUDE_DIRS="dir;dir" -DDEFINES="-D..." (the policy)
 # -DSKIP="header;..." (headers whose dependencies are not installed)
+cmake_policy(SET CMP0057 NEW)  # if(IN_LIST) in script mode
 set(flags -std=c++20 -fsyntax-only -Wall -Wextra -Wpedantic -Wshadow -Wconversion -Wsign-conversion
           -Wold-style-cast -Wnon-virtual-dtor -Werror)
 set(includes)
