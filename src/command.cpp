@@ -138,7 +138,7 @@ void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& i
     // Only a primary's submit closes it: a ONE_TIME secondary stays open until reset, re-begin or free.
     const bool one_time =
         s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && (info.flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0;
-    s.device().open_window(s.window, one_time);
+    p.device.state()->open_window(s.window, one_time);
 }
 }  // namespace
 
@@ -189,7 +189,7 @@ void CommandBuffer::end() const {
     auto& p = *state_->pool.state();
     LockGuard lock(p.mutex);
     check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
-    state_->device().end_window(state_->window);
+    p.device.state()->end_window(state_->window);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
@@ -199,7 +199,7 @@ void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
         LockGuard lock(p.mutex);
         check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
     }
-    state_->device().close_window(state_->window);
+    p.device.state()->close_window(state_->window);
 }
 
 namespace detail {
