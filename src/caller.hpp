@@ -5,6 +5,7 @@
 #include "vkrc/error.hpp"
 
 #include "enum_names.hpp"
+#include "text.hpp"
 
 #include <string>
 #include <string_view>
@@ -30,6 +31,15 @@ template <named_enum Enum>
 void append_piece(std::string& out, Enum e) {
     out += enum_text(e);
 }
+// A number shown in hexadecimal with a 0x prefix (flags and bit masks):
+// caller.require(ok, "flags ", Hex{flags}).
+struct Hex {
+    std::uint64_t value;
+};
+inline void append_piece(std::string& out, Hex h) {
+    out += "0x";
+    out += hex(h.value);
+}
 
 // The public function that checks its arguments. Usage, once per function:
 //     const detail::Caller caller{"vkrc::DescriptorPool::create"};
@@ -40,6 +50,9 @@ void append_piece(std::string& out, Enum e) {
 class Caller {
 public:
     explicit constexpr Caller(const char* name) noexcept : name_(name) {}
+    // The same for a function working on one named thing, e.g. a file: its
+    // refusals read "name: about: what". about must outlive the Caller.
+    constexpr Caller(const char* name, const char* about) noexcept : name_(name), about_(about) {}
     const char* name() const noexcept { return name_; }
 
     // Throws UsageError "name: what..." unless ok.
@@ -52,6 +65,10 @@ public:
     [[noreturn]] void refuse(const What&... what) const {
         std::string message(name_);
         message += ": ";
+        if (about_) {
+            message += about_;
+            message += ": ";
+        }
         (append_piece(message, what), ...);
         throw UsageError(message);
     }
@@ -69,6 +86,7 @@ public:
 
 private:
     const char* name_;
+    const char* about_ = nullptr;
 };
 
 }  // namespace detail

@@ -1,5 +1,6 @@
 #include "vkrc/error.hpp"
 
+#include "caller.hpp"
 #include "enum_names.hpp"
 #include "vkrc/handle.hpp"
 
@@ -69,9 +70,9 @@ std::string enum_text(VkColorSpaceKHR value) { return enum_text_of(value, "VkCol
 std::string enum_text(VkImageLayout value) { return enum_text_of(value, "VkImageLayout"); }
 
 void throw_empty_handle(const char* call) {
-    throw UsageError(std::string(call) +
-                     ": the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image "
-                     "has no Allocation)");
+    Caller(call).refuse(
+        "the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image has no "
+        "Allocation)");
 }
 void throw_empty_handle(const char* type, const char* member) {
     throw_empty_handle((std::string(type) + "::" + member).c_str());

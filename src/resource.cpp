@@ -113,13 +113,11 @@ VkDeviceAddress query_device_address(const Device& device, VkBuffer buffer, VkBu
 
 // VkSamplerYcbcrConversionInfo for conversion (if any) ahead of next; the
 // conversion must belong to device.
-VkSamplerYcbcrConversionInfo conversion_info(const Device& device, const SamplerYcbcrConversion& conversion,
-                                             const void* next, const char* who) {
+VkSamplerYcbcrConversionInfo conversion_info(const detail::Caller& caller, const Device& device,
+                                             const SamplerYcbcrConversion& conversion, const void* next) {
     VkSamplerYcbcrConversionInfo info{VK_STRUCTURE_TYPE_SAMPLER_YCBCR_CONVERSION_INFO, next};
     if (!conversion) return info;
-    if (!(conversion.device() == device)) {
-        throw UsageError(std::string(who) + ": the SamplerYcbcrConversion belongs to another device");
-    }
+    caller.require(conversion.device() == device, "the SamplerYcbcrConversion belongs to another device");
     info.conversion = conversion.vk();
     return info;
 }
@@ -154,16 +152,15 @@ detail::Ref<detail::ImageState> image_state(const Device& device, const ImageCre
 }  // namespace
 
 Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
-    detail::require_handle(device, "vkrc::Buffer::create", "the Device");
-    if (info.size == 0) throw UsageError("vkrc::Buffer::create: size is 0");
-    if (info.usage == 0) throw UsageError("vkrc::Buffer::create: usage is 0");
+    const detail::Caller caller{"vkrc::Buffer::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(info.size != 0, "size is 0");
+    caller.require(info.usage != 0, "usage is 0");
     constexpr VkBufferCreateFlags sparse = VK_BUFFER_CREATE_SPARSE_BINDING_BIT | VK_BUFFER_CREATE_SPARSE_RESIDENCY_BIT |
                                            VK_BUFFER_CREATE_SPARSE_ALIASED_BIT;
-    if (info.flags & sparse) {
-        throw UsageError(
-            "vkrc::Buffer::create: sparse flags are not supported (vkrc binds one allocation to each buffer; create "
-            "a sparse buffer with vkCreateBuffer and bind it with vkQueueBindSparse)");
-    }
+    caller.require(!(info.flags & sparse),
+                   "sparse flags are not supported (vkrc binds one allocation to each buffer; create a sparse buffer "
+                   "with vkCreateBuffer and bind it with vkQueueBindSparse)");
     {
         // A size no heap can hold (a negative number cast to VkDeviceSize, a
         // product that wrapped) fails here with its value, not later with
@@ -172,11 +169,8 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
         VkDeviceSize largest = 0;
         for (std::uint32_t i = 0; i < memory.memoryHeapCount; ++i)
             largest = std::max(largest, memory.memoryHeaps[i].size);
-        if (info.size > largest) {
-            throw UsageError("vkrc::Buffer::create: size " + std::to_string(info.size) +
-                             " is larger than every memory heap of the device (the largest has " +
-                             std::to_string(largest) + " bytes)");
-        }
+        caller.require(info.size <= largest, "size ", info.size,
+                       " is larger than every memory heap of the device (the largest has ", largest, " bytes)");
     }
     VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO, info.next};
     ci.flags = info.flags;
@@ -195,8 +189,9 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
 
 Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
                      Ownership ownership, Function<void()> cleanup) {
-    detail::require_handle(device, "vkrc::Buffer::adopt", "the Device");
-    if (buffer == VK_NULL_HANDLE) throw UsageError("vkrc::Buffer::adopt: the VkBuffer is VK_NULL_HANDLE");
+    const detail::Caller caller{"vkrc::Buffer::adopt"};
+    caller.require_handle(device, "the Device");
+    caller.require_not_null(buffer, "VkBuffer");
     auto state = buffer_state(device, size, usage, ownership);
     state->handle = buffer;
     state->cleanup = std::move(cleanup);
@@ -268,22 +263,18 @@ FormatBlock format_block(VkFormat format) noexcept {
 }
 
 Image Image::create(const Device& device, const ImageCreateInfo& info) {
-    detail::require_handle(device, "vkrc::Image::create", "the Device");
-    if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::Image::create: format is VK_FORMAT_UNDEFINED");
-    if (info.extent.width == 0 || info.extent.height == 0 || info.extent.depth == 0) {
-        throw UsageError("vkrc::Image::create: extent has a zero dimension");
-    }
-    if (info.mip_levels == 0 || info.array_layers == 0) {
-        throw UsageError("vkrc::Image::create: mip_levels and array_layers must be at least 1");
-    }
-    if (info.usage == 0) throw UsageError("vkrc::Image::create: usage is 0");
+    const detail::Caller caller{"vkrc::Image::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(info.format != VK_FORMAT_UNDEFINED, "format is VK_FORMAT_UNDEFINED");
+    caller.require(info.extent.width != 0 && info.extent.height != 0 && info.extent.depth != 0,
+                   "extent has a zero dimension");
+    caller.require(info.mip_levels != 0 && info.array_layers != 0, "mip_levels and array_layers must be at least 1");
+    caller.require(info.usage != 0, "usage is 0");
     constexpr VkImageCreateFlags sparse =
         VK_IMAGE_CREATE_SPARSE_BINDING_BIT | VK_IMAGE_CREATE_SPARSE_RESIDENCY_BIT | VK_IMAGE_CREATE_SPARSE_ALIASED_BIT;
-    if (info.flags & sparse) {
-        throw UsageError(
-            "vkrc::Image::create: sparse flags are not supported (vkrc binds one allocation to each image; create a "
-            "sparse image with vkCreateImage and bind it with vkQueueBindSparse)");
-    }
+    caller.require(!(info.flags & sparse),
+                   "sparse flags are not supported (vkrc binds one allocation to each image; create a sparse image "
+                   "with vkCreateImage and bind it with vkQueueBindSparse)");
     VkImageCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, info.next};
     ci.flags = info.flags;
     ci.imageType = info.image_type;
@@ -306,8 +297,9 @@ Image Image::create(const Device& device, const ImageCreateInfo& info) {
 
 Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& info, Ownership ownership,
                    Function<void()> cleanup) {
-    detail::require_handle(device, "vkrc::Image::adopt", "the Device");
-    if (image == VK_NULL_HANDLE) throw UsageError("vkrc::Image::adopt: the VkImage is VK_NULL_HANDLE");
+    const detail::Caller caller{"vkrc::Image::adopt"};
+    caller.require_handle(device, "the Device");
+    caller.require_not_null(image, "VkImage");
     auto state = image_state(device, info, ownership);
     state->handle = image;
     state->cleanup = std::move(cleanup);
@@ -315,9 +307,9 @@ Image Image::adopt(const Device& device, VkImage image, const ImageCreateInfo& i
 }
 
 ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info) {
-    detail::require_handle(image, "vkrc::ImageView::create", "the Image");
-    VkSamplerYcbcrConversionInfo conversion =
-        conversion_info(image.device(), info.ycbcr_conversion, info.next, "vkrc::ImageView::create");
+    const detail::Caller caller{"vkrc::ImageView::create"};
+    caller.require_handle(image, "the Image");
+    VkSamplerYcbcrConversionInfo conversion = conversion_info(caller, image.device(), info.ycbcr_conversion, info.next);
     VkImageViewCreateInfo ci{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};
     ci.flags = info.flags;
     ci.image = image.vk();
@@ -328,36 +320,25 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     if (ci.subresourceRange.aspectMask == 0) ci.subresourceRange.aspectMask = format_aspects(ci.format);
     // Free checks (create is a cold path): the range within the image, the
     // format the image's or, with MUTABLE_FORMAT_BIT, one of the same texel size.
-    constexpr const char* who = "vkrc::ImageView::create";
     const auto& r = ci.subresourceRange;
     auto range_fits = [](std::uint32_t base, std::uint32_t count, std::uint32_t total) {
         return base < total && (count == VK_REMAINING_MIP_LEVELS || (count != 0 && count <= total - base));
     };
-    if (!range_fits(r.baseMipLevel, r.levelCount, image.mip_levels())) {
-        throw UsageError(
-            std::string(who) + ": mip levels " + std::to_string(r.baseMipLevel) + "+" +
-            (r.levelCount == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(r.levelCount)) +
-            " are outside the image's " + std::to_string(image.mip_levels()) + " levels");
-    }
-    if (!range_fits(r.baseArrayLayer, r.layerCount, image.array_layers())) {
-        throw UsageError(
-            std::string(who) + ": array layers " + std::to_string(r.baseArrayLayer) + "+" +
-            (r.layerCount == VK_REMAINING_ARRAY_LAYERS ? std::string("remaining") : std::to_string(r.layerCount)) +
-            " are outside the image's " + std::to_string(image.array_layers()) + " layers");
-    }
+    auto count_text = [](std::uint32_t count) {
+        return count == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(count);
+    };
+    caller.require(range_fits(r.baseMipLevel, r.levelCount, image.mip_levels()), "mip levels ", r.baseMipLevel, "+",
+                   count_text(r.levelCount), " are outside the image's ", image.mip_levels(), " levels");
+    caller.require(range_fits(r.baseArrayLayer, r.layerCount, image.array_layers()), "array layers ", r.baseArrayLayer,
+                   "+", count_text(r.layerCount), " are outside the image's ", image.array_layers(), " layers");
     if (ci.format != image.format()) {
-        if (!(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT)) {
-            throw UsageError(std::string(who) + ": format " + detail::enum_text(ci.format) +
-                             " differs from the image's " + detail::enum_text(image.format()) +
-                             " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
-        }
+        caller.require(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT, "format ", ci.format,
+                       " differs from the image's ", image.format(),
+                       " and the image lacks VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT");
         const std::uint32_t view_texel = format_texel_size(ci.format);
         const std::uint32_t image_texel = format_texel_size(image.format());
-        if (view_texel != 0 && image_texel != 0 && view_texel != image_texel) {
-            throw UsageError(std::string(who) + ": format " + detail::enum_text(ci.format) + " has " +
-                             std::to_string(view_texel) + "-byte texels, the image's format " +
-                             detail::enum_text(image.format()) + " has " + std::to_string(image_texel));
-        }
+        caller.require(view_texel == 0 || image_texel == 0 || view_texel == image_texel, "format ", ci.format, " has ",
+                       view_texel, "-byte texels, the image's format ", image.format(), " has ", image_texel);
     }
     detail::Ref<detail::ImageViewState> state(new detail::ImageViewState);
     const auto& device = image.device();
@@ -370,8 +351,9 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
 }
 
 BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& info) {
-    detail::require_handle(buffer, "vkrc::BufferView::create", "the Buffer");
-    if (info.format == VK_FORMAT_UNDEFINED) throw UsageError("vkrc::BufferView::create: format is VK_FORMAT_UNDEFINED");
+    const detail::Caller caller{"vkrc::BufferView::create"};
+    caller.require_handle(buffer, "the Buffer");
+    caller.require(info.format != VK_FORMAT_UNDEFINED, "format is VK_FORMAT_UNDEFINED");
     VkBufferViewCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO, info.next};
     ci.flags = info.flags;
     ci.buffer = buffer.vk();
@@ -388,7 +370,7 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
                            const VkImageSubresourceRange& subresource_range, Ownership ownership) {
     auto state = detail::adopted_state<detail::ImageViewState, &detail::ImageViewState::image>(
-        "vkrc::ImageView::adopt", image, "the Image", view, "VkImageView", ownership);
+        detail::Caller{"vkrc::ImageView::adopt"}, image, "the Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
     return ImageView(std::move(state));
@@ -396,18 +378,18 @@ ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
     return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
-        "vkrc::BufferView::adopt", buffer, "the Buffer", view, "VkBufferView", ownership));
+        detail::Caller{"vkrc::BufferView::adopt"}, buffer, "the Buffer", view, "VkBufferView", ownership));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    return Sampler(detail::adopted_state<detail::SamplerState>("vkrc::Sampler::adopt", device, "the Device", sampler,
-                                                               "VkSampler", ownership));
+    return Sampler(detail::adopted_state<detail::SamplerState>(detail::Caller{"vkrc::Sampler::adopt"}, device,
+                                                               "the Device", sampler, "VkSampler", ownership));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
-    detail::require_handle(device, "vkrc::Sampler::create", "the Device");
-    VkSamplerYcbcrConversionInfo conversion =
-        conversion_info(device, info.ycbcr_conversion, info.next, "vkrc::Sampler::create");
+    const detail::Caller caller{"vkrc::Sampler::create"};
+    caller.require_handle(device, "the Device");
+    VkSamplerYcbcrConversionInfo conversion = conversion_info(caller, device, info.ycbcr_conversion, info.next);
     VkSamplerCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, info.ycbcr_conversion ? &conversion : info.next};
     ci.flags = info.flags;
     ci.magFilter = info.mag_filter;
