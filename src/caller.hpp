@@ -7,6 +7,7 @@
 #include "enum_names.hpp"
 #include "text.hpp"
 
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -30,6 +31,12 @@ void append_piece(std::string& out, Integer n) {
 template <named_enum Enum>
 void append_piece(std::string& out, Enum e) {
     out += enum_text(e);
+}
+// Floats as printf's %g prints them (0.5, 16, 1e+03).
+inline void append_piece(std::string& out, double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", x);
+    out += text;
 }
 // A number shown in hexadecimal with a 0x prefix (flags and bit masks):
 // caller.require(ok, "flags ", Hex{flags}).

@@ -395,6 +395,16 @@ struct FeatureChain {
     }
     FeatureChain(const FeatureChain&) = delete;
     FeatureChain& operator=(const FeatureChain&) = delete;
+    // What the chain enables, unchained.
+    DeviceFeatures enabled() const {
+        DeviceFeatures d;
+        d.core = features.features;
+        d.vulkan11 = f11;
+        d.vulkan12 = f12;
+        d.vulkan13 = f13;
+        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
+        return d;
+    }
 
     VkPhysicalDeviceVulkan13Features f13;
     VkPhysicalDeviceVulkan12Features f12;
@@ -403,7 +413,8 @@ struct FeatureChain {
 };
 
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
-                 Span<const char* const> extensions, detail::Ref<detail::DeviceState>& state) {
+                 Span<const char* const> extensions, const DeviceFeatures& features,
+                 detail::Ref<detail::DeviceState>& state) {
     state = detail::Ref<detail::DeviceState>(new detail::DeviceState);
     auto& s = *state;
     s.device = raw;
@@ -412,6 +423,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
     s.fn = DeviceFunctions::load(physical.fn().vkGetDeviceProcAddr, raw);
     drop_unless_debug_utils(physical, s.fn);
     for (const char* e : extensions) s.enabled_extensions.push_back(e);
+    s.enabled_features = features;
     init_queues(s, queues);
     assign_roles(s);
 }
@@ -439,7 +451,7 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     check(physical.fn().vkCreateDevice(physical.vk(), &ci, nullptr, &raw), "vkCreateDevice");
     detail::Ref<detail::DeviceState> state;
     try {
-        make_device(physical, raw, Ownership::owned, requests, extensions, state);
+        make_device(physical, raw, Ownership::owned, requests, extensions, features.enabled(), state);
     } catch (...) {
         if (!state) destroy_raw_device(physical, raw);
         throw;  // otherwise the state's destructor destroyed the device
@@ -454,7 +466,7 @@ Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership own
     caller.require_not_null(raw, "VkDevice");
     detail::Ref<detail::DeviceState> state;
     try {
-        make_device(physical, raw, ownership, queues, enabled_extensions, state);
+        make_device(physical, raw, ownership, queues, enabled_extensions, physical.features(), state);
     } catch (...) {
         if (!state && ownership == Ownership::owned) destroy_raw_device(physical, raw);
         throw;
