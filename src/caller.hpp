@@ -15,8 +15,11 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// One piece of a refusal's message: text as is, integers in decimal, the
-// Vulkan enums enum_names.hpp knows by name.
+// One piece of a refusal's message: text as is, integers in decimal, floats
+// as %g, Hex in hexadecimal, Count with "remaining", extents as WxHxD, the Vulkan enums
+// enum_names.hpp knows by name. Pieces are passed by reference and formatted
+// only on refusal: a piece that needs building (a std::string) is better
+// built in a branch that then calls refuse().
 inline void append_piece(std::string& out, std::string_view text) { out += text; }
 template <class T>
 concept decimal_number = std::is_integral_v<T> && !std::is_same_v<T, bool>;
@@ -46,6 +49,19 @@ struct Hex {
 inline void append_piece(std::string& out, Hex h) {
     out += "0x";
     out += hex(h.value);
+}
+
+// A level or layer count that may be VK_REMAINING_MIP_LEVELS or
+// VK_REMAINING_ARRAY_LAYERS (both ~0U): "remaining", else the number.
+struct Count {
+    std::uint32_t value;
+};
+inline void append_piece(std::string& out, Count c) {
+    out += c.value == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(c.value);
+}
+// An extent as WxHxD.
+inline void append_piece(std::string& out, const VkExtent3D& e) {
+    out += std::to_string(e.width) + "x" + std::to_string(e.height) + "x" + std::to_string(e.depth);
 }
 
 // The public function that checks its arguments. Usage, once per function:

@@ -176,27 +176,23 @@ void check_sharing(const detail::Caller& caller, const Device& device, VkSharing
     }
 }
 
-std::string extent_text(const VkExtent3D& e) {
-    return std::to_string(e.width) + "x" + std::to_string(e.height) + "x" + std::to_string(e.depth);
-}
-
 // The rules of image type, extent, flags, samples and layout that need no query.
 void check_image_shape(const detail::Caller& caller, const ImageCreateInfo& info) {
     const VkExtent3D& e = info.extent;
     const VkImageType type = info.image_type;
     caller.require(type != VK_IMAGE_TYPE_1D || (e.height == 1 && e.depth == 1), "a VK_IMAGE_TYPE_1D image has extent ",
-                   extent_text(e), "; height and depth must be 1");
-    caller.require(type != VK_IMAGE_TYPE_2D || e.depth == 1, "a VK_IMAGE_TYPE_2D image has extent ", extent_text(e),
+                   e, "; height and depth must be 1");
+    caller.require(type != VK_IMAGE_TYPE_2D || e.depth == 1, "a VK_IMAGE_TYPE_2D image has extent ", e,
                    "; depth must be 1");
     caller.require(type != VK_IMAGE_TYPE_3D || info.array_layers == 1, "a VK_IMAGE_TYPE_3D image has array_layers ",
                    info.array_layers, "; it must be 1");
     const auto levels = static_cast<std::uint32_t>(std::bit_width(std::max({e.width, e.height, e.depth})));
-    caller.require(info.mip_levels <= levels, "mip_levels ", info.mip_levels, " exceeds the ", levels, " levels a ",
-                   extent_text(e), " image can have");
+    caller.require(info.mip_levels <= levels, "mip_levels ", info.mip_levels, " exceeds the ", levels, " levels a ", e,
+                   " image can have");
     if (info.flags & VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT) {
         caller.require(type == VK_IMAGE_TYPE_2D && e.width == e.height && info.array_layers >= 6,
                        "CUBE_COMPATIBLE needs a square VK_IMAGE_TYPE_2D image with at least 6 layers, not ", type, " ",
-                       extent_text(e), " with ", info.array_layers);
+                       e, " with ", info.array_layers);
     }
     caller.require(!(info.flags & VK_IMAGE_CREATE_2D_ARRAY_COMPATIBLE_BIT) || type == VK_IMAGE_TYPE_3D,
                    "2D_ARRAY_COMPATIBLE needs a VK_IMAGE_TYPE_3D image, not ", type);
@@ -228,9 +224,8 @@ void check_image_usage(const detail::Caller& caller, const Device& device, const
     if (info.usage & attachment_usage) {
         caller.require(
             info.extent.width <= limits.maxFramebufferWidth && info.extent.height <= limits.maxFramebufferHeight,
-            "an attachment image of extent ", extent_text(info.extent),
-            " exceeds maxFramebufferWidth x maxFramebufferHeight ", limits.maxFramebufferWidth, "x",
-            limits.maxFramebufferHeight);
+            "an attachment image of extent ", info.extent, " exceeds maxFramebufferWidth x maxFramebufferHeight ",
+            limits.maxFramebufferWidth, "x", limits.maxFramebufferHeight);
     }
     caller.require(!(info.usage & VK_IMAGE_USAGE_STORAGE_BIT) || info.samples == VK_SAMPLE_COUNT_1_BIT ||
                        device.state()->enabled_features.core.shaderStorageImageMultisample,
@@ -251,8 +246,7 @@ void check_image_format(const detail::Caller& caller, const Device& device, cons
     check(r, "vkGetPhysicalDeviceImageFormatProperties");
     const VkExtent3D& e = info.extent;
     caller.require(e.width <= p.maxExtent.width && e.height <= p.maxExtent.height && e.depth <= p.maxExtent.depth,
-                   "extent ", extent_text(e), " exceeds the ", extent_text(p.maxExtent), " maximum for ", info.format,
-                   " as a ", info.image_type);
+                   "extent ", e, " exceeds the ", p.maxExtent, " maximum for ", info.format, " as a ", info.image_type);
     caller.require(info.mip_levels <= p.maxMipLevels, "mip_levels ", info.mip_levels, " exceeds the ", p.maxMipLevels,
                    " levels the device allows for ", info.format);
     caller.require(info.array_layers <= p.maxArrayLayers, "array_layers ", info.array_layers, " exceeds the ",
@@ -308,8 +302,7 @@ void check_view_type(const detail::Caller& caller, const Device& device, const I
     if (type == VK_IMAGE_TYPE_3D && view != VK_IMAGE_VIEW_TYPE_3D) {
         // The rule counts levelCount as given: VK_REMAINING_MIP_LEVELS is not 1.
         caller.require(r.levelCount == 1, "a ", view, " view of a 3D image needs levelCount 1, not ",
-                       r.levelCount == VK_REMAINING_MIP_LEVELS ? std::string("VK_REMAINING_MIP_LEVELS")
-                                                               : std::to_string(r.levelCount));
+                       detail::Count{r.levelCount});
     }
     const std::uint32_t layers =
         r.layerCount == VK_REMAINING_ARRAY_LAYERS ? view_layer_total(image, ci) - r.baseArrayLayer : r.layerCount;
@@ -350,14 +343,11 @@ void check_view_range_and_format(const detail::Caller& caller, const Image& imag
     auto range_fits = [](std::uint32_t base, std::uint32_t count, std::uint32_t total) {
         return base < total && (count == VK_REMAINING_MIP_LEVELS || (count != 0 && count <= total - base));
     };
-    auto count_text = [](std::uint32_t count) {
-        return count == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(count);
-    };
     caller.require(range_fits(r.baseMipLevel, r.levelCount, image.mip_levels()), "mip levels ", r.baseMipLevel, "+",
-                   count_text(r.levelCount), " are outside the image's ", image.mip_levels(), " levels");
+                   detail::Count{r.levelCount}, " are outside the image's ", image.mip_levels(), " levels");
     const std::uint32_t layers = view_layer_total(image, ci);
     caller.require(range_fits(r.baseArrayLayer, r.layerCount, layers), "array layers ", r.baseArrayLayer, "+",
-                   count_text(r.layerCount), " are outside the image's ", layers, " layers");
+                   detail::Count{r.layerCount}, " are outside the image's ", layers, " layers");
     if (ci.format != image.format()) {
         caller.require(image.state()->flags & VK_IMAGE_CREATE_MUTABLE_FORMAT_BIT, "format ", ci.format,
                        " differs from the image's ", image.format(),

@@ -25,8 +25,8 @@ detail::Ref<detail::ShaderModuleState> make(const detail::Caller& caller, const 
     caller.require(bytes % 4 == 0, "the SPIR-V size (", bytes, " bytes) is not a multiple of 4");
     std::uint32_t magic = 0;
     std::memcpy(&magic, code, 4);
-    caller.require(magic == spirv_magic, "not SPIR-V (magic number 0x", detail::hex(magic, 8),
-                   ", expected 0x07230203)");
+    if (magic != spirv_magic)
+        caller.refuse("not SPIR-V (magic number 0x", detail::hex(magic, 8), ", expected 0x07230203)");
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = bytes;
     ci.pCode = static_cast<const std::uint32_t*>(code);

@@ -121,17 +121,17 @@ vkrc::ImageCreateInfo fuzz_image(Fuzzer& f, const VkPhysicalDeviceLimits& limits
                             VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSIENT_ATTACHMENT_BIT |
                             VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT,
                         20);
-    info.initial_layout = f.chance(90) ? VK_IMAGE_LAYOUT_UNDEFINED
-                                       : f.pick({VK_IMAGE_LAYOUT_PREINITIALIZED, VK_IMAGE_LAYOUT_GENERAL});
+    info.initial_layout =
+        f.chance(90) ? VK_IMAGE_LAYOUT_UNDEFINED : f.pick({VK_IMAGE_LAYOUT_PREINITIALIZED, VK_IMAGE_LAYOUT_GENERAL});
     fuzz_sharing(f, info.sharing_mode, info.queue_family_indices);
     return info;
 }
 
 vkrc::ImageViewCreateInfo fuzz_view(Fuzzer& f, const vkrc::Image& image) {
     vkrc::ImageViewCreateInfo info;
-    info.view_type = f.pick({VK_IMAGE_VIEW_TYPE_1D, VK_IMAGE_VIEW_TYPE_2D, VK_IMAGE_VIEW_TYPE_3D,
-                             VK_IMAGE_VIEW_TYPE_CUBE, VK_IMAGE_VIEW_TYPE_1D_ARRAY, VK_IMAGE_VIEW_TYPE_2D_ARRAY,
-                             VK_IMAGE_VIEW_TYPE_CUBE_ARRAY});
+    info.view_type =
+        f.pick({VK_IMAGE_VIEW_TYPE_1D, VK_IMAGE_VIEW_TYPE_2D, VK_IMAGE_VIEW_TYPE_3D, VK_IMAGE_VIEW_TYPE_CUBE,
+                VK_IMAGE_VIEW_TYPE_1D_ARRAY, VK_IMAGE_VIEW_TYPE_2D_ARRAY, VK_IMAGE_VIEW_TYPE_CUBE_ARRAY});
     if (f.chance(20) && vkrc::format_texel_size(image.format()) != 0) info.format = pick_format(f, colour_formats);
     auto& r = info.subresource_range;
     r.baseMipLevel = f.chance(80) ? 0 : f.between(0, image.mip_levels());
