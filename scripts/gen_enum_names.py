@@ -13,7 +13,9 @@ REGISTRY = sys.argv[1] if len(sys.argv) > 1 else "/usr/share/vulkan/registry/vk.
 OUT = sys.argv[2] if len(sys.argv) > 2 else "src/enum_names.inl"
 FEATURES = ["VK_VERSION_1_0", "VK_VERSION_1_1", "VK_VERSION_1_2", "VK_VERSION_1_3"]
 EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils"]
-ENUMS = ["VkDescriptorType", "VkFormat", "VkPhysicalDeviceType", "VkColorSpaceKHR", "VkImageLayout"]
+ENUMS = ["VkDescriptorType", "VkFormat", "VkPhysicalDeviceType", "VkColorSpaceKHR", "VkImageLayout", "VkImageType",
+         "VkImageTiling", "VkImageViewType", "VkSampleCountFlagBits", "VkSamplerAddressMode", "VkFilter",
+         "VkSamplerMipmapMode"]
 
 root = ET.parse(REGISTRY).getroot()
 values = {e: [] for e in ENUMS}

@@ -52,33 +52,32 @@ void AllocationState::on_last_release() noexcept {
                          serial());
 }
 
+// The public header's inline checks hand over the caller's name as text.
 [[noreturn]] void throw_not_host_visible(const char* who) {
-    throw UsageError(std::string(who) +
-                     ": the memory is not host-visible (allocate with MemoryUsage::upload or readback, or require "
-                     "VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)");
+    Caller(who).refuse(
+        "the memory is not host-visible (allocate with MemoryUsage::upload or readback, or require "
+        "VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)");
 }
 
 [[noreturn]] void throw_not_host_coherent(const char* who) {
-    throw UsageError(std::string(who) +
-                     ": the memory is not host-coherent (require VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, or use "
-                     "Allocation::write, which flushes)");
+    Caller(who).refuse(
+        "the memory is not host-coherent (require VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, or use "
+        "Allocation::write, which flushes)");
 }
 
 [[noreturn]] void throw_out_of_range(const char* who, VkDeviceSize offset, std::size_t count, std::size_t element,
                                      VkDeviceSize size) {
-    throw UsageError(std::string(who) + ": " + std::to_string(count) + " elements of " + std::to_string(element) +
-                     " bytes at offset " + std::to_string(offset) + " do not fit in the " + std::to_string(size) +
-                     "-byte allocation" +
-                     (element != 0 && count > std::numeric_limits<VkDeviceSize>::max() / element
-                          ? " (the byte count overflows)"
-                          : ""));
+    const bool overflows = element != 0 && count > std::numeric_limits<VkDeviceSize>::max() / element;
+    Caller(who).refuse(count, " elements of ", element, " bytes at offset ", offset, " do not fit in the ", size,
+                       "-byte allocation", overflows ? " (the byte count overflows)" : "");
 }
 
 }  // namespace detail
 
 Allocation Allocation::create(const Device& device, const AllocationRequest& request,
                               const SharedAllocator& allocator) {
-    detail::require_handle(device, "vkrc::Allocation::create", "the Device");
+    const detail::Caller caller{"vkrc::Allocation::create"};
+    caller.require_handle(device, "the Device");
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
     if (a) {
@@ -87,9 +86,7 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
         a = &s.default_allocator();
     }
     AllocationInfo info = a->allocate(DeviceView(s), request);
-    if (info.allocator != a) {
-        throw UsageError("vkrc::Allocation::create: the allocator returned a range that names another allocator");
-    }
+    caller.require(info.allocator == a, "the allocator returned a range that names another allocator");
     if (info.memory == VK_NULL_HANDLE) {
         // An allocator that reports no memory instead of throwing: the same as running out.
         throw Error(VK_ERROR_OUT_OF_DEVICE_MEMORY, "vkrc::DeviceAllocator::allocate");

@@ -5,7 +5,9 @@
 #include "vkrc/error.hpp"
 
 #include "enum_names.hpp"
+#include "text.hpp"
 
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -13,8 +15,11 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// One piece of a refusal's message: text as is, integers in decimal, the
-// Vulkan enums enum_names.hpp knows by name.
+// One piece of a refusal's message: text as is, integers in decimal, floats
+// as %g, Hex in hexadecimal, Count with "remaining", extents as WxHxD, the Vulkan enums
+// enum_names.hpp knows by name. Pieces are passed by reference and formatted
+// only on refusal: a piece that needs building (a std::string) is better
+// built in a branch that then calls refuse().
 inline void append_piece(std::string& out, std::string_view text) { out += text; }
 template <class T>
 concept decimal_number = std::is_integral_v<T> && !std::is_same_v<T, bool>;
@@ -30,6 +35,34 @@ template <named_enum Enum>
 void append_piece(std::string& out, Enum e) {
     out += enum_text(e);
 }
+// Floats as printf's %g prints them (0.5, 16, 1e+03).
+inline void append_piece(std::string& out, double x) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", x);
+    out += text;
+}
+// A number shown in hexadecimal with a 0x prefix (flags and bit masks):
+// caller.require(ok, "flags ", Hex{flags}).
+struct Hex {
+    std::uint64_t value;
+};
+inline void append_piece(std::string& out, Hex h) {
+    out += "0x";
+    out += hex(h.value);
+}
+
+// A level or layer count that may be VK_REMAINING_MIP_LEVELS or
+// VK_REMAINING_ARRAY_LAYERS (both ~0U): "remaining", else the number.
+struct Count {
+    std::uint32_t value;
+};
+inline void append_piece(std::string& out, Count c) {
+    out += c.value == VK_REMAINING_MIP_LEVELS ? std::string("remaining") : std::to_string(c.value);
+}
+// An extent as WxHxD.
+inline void append_piece(std::string& out, const VkExtent3D& e) {
+    out += std::to_string(e.width) + "x" + std::to_string(e.height) + "x" + std::to_string(e.depth);
+}
 
 // The public function that checks its arguments. Usage, once per function:
 //     const detail::Caller caller{"vkrc::DescriptorPool::create"};
@@ -40,6 +73,9 @@ void append_piece(std::string& out, Enum e) {
 class Caller {
 public:
     explicit constexpr Caller(const char* name) noexcept : name_(name) {}
+    // The same for a function working on one named thing, e.g. a file: its
+    // refusals read "name: about: what". about must outlive the Caller.
+    constexpr Caller(const char* name, const char* about) noexcept : name_(name), about_(about) {}
     const char* name() const noexcept { return name_; }
 
     // Throws UsageError "name: what..." unless ok.
@@ -52,6 +88,10 @@ public:
     [[noreturn]] void refuse(const What&... what) const {
         std::string message(name_);
         message += ": ";
+        if (about_) {
+            message += about_;
+            message += ": ";
+        }
         (append_piece(message, what), ...);
         throw UsageError(message);
     }
@@ -69,6 +109,7 @@ public:
 
 private:
     const char* name_;
+    const char* about_ = nullptr;
 };
 
 }  // namespace detail

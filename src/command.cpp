@@ -9,8 +9,8 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 
 void throw_too_many_color_attachments(std::size_t count) {
-    throw UsageError("vkrc::CommandBuffer::begin_rendering: " + std::to_string(count) +
-                     " colour attachments; at most " + std::to_string(RenderingInfo::max_color_attachments));
+    Caller("vkrc::CommandBuffer::begin_rendering")
+        .refuse(count, " colour attachments; at most ", RenderingInfo::max_color_attachments);
 }
 
 CommandPoolState::~CommandPoolState() {
@@ -42,7 +42,7 @@ CommandBufferState::~CommandBufferState() {
 }  // namespace detail
 
 CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInfo& info) {
-    detail::require_handle(device, "vkrc::CommandPool::create", "the Device");
+    detail::Caller("vkrc::CommandPool::create").require_handle(device, "the Device");
     VkCommandPoolCreateInfo ci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     ci.pNext = info.next;
     ci.flags = info.flags;
@@ -55,8 +55,8 @@ CommandPool CommandPool::create(const Device& device, const CommandPoolCreateInf
 
 CommandPool CommandPool::adopt(const Device& device, VkCommandPool pool, std::uint32_t queue_family_index,
                                Ownership ownership) {
-    auto s = detail::adopted_state<detail::CommandPoolState>("vkrc::CommandPool::adopt", device, "the Device", pool,
-                                                             "VkCommandPool", ownership);
+    auto s = detail::adopted_state<detail::CommandPoolState>(detail::Caller{"vkrc::CommandPool::adopt"}, device,
+                                                             "the Device", pool, "VkCommandPool", ownership);
     s->queue_family_index = queue_family_index;
     return CommandPool(std::move(s));
 }
@@ -96,14 +96,11 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
 
 CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
                                    Ownership ownership) {
-    constexpr const char* who = "vkrc::CommandBuffer::adopt";
-    detail::require_handle(pool, who, "the CommandPool");
-    if (command_buffer == VK_NULL_HANDLE)
-        throw UsageError(std::string(who) + ": the VkCommandBuffer is VK_NULL_HANDLE");
-    if (level != VK_COMMAND_BUFFER_LEVEL_PRIMARY && level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
-        throw UsageError(std::string(who) + ": level " + std::to_string(static_cast<int>(level)) +
-                         " is neither PRIMARY nor SECONDARY");
-    }
+    const detail::Caller caller{"vkrc::CommandBuffer::adopt"};
+    caller.require_handle(pool, "the CommandPool");
+    caller.require_not_null(command_buffer, "VkCommandBuffer");
+    caller.require(level == VK_COMMAND_BUFFER_LEVEL_PRIMARY || level == VK_COMMAND_BUFFER_LEVEL_SECONDARY, "level ",
+                   static_cast<int>(level), " is neither PRIMARY nor SECONDARY");
     auto s = new_command_buffer_state(pool, level);
     s->ownership = ownership;
     // Registered like an allocated one, so that drops during its recording are held.
@@ -146,10 +143,10 @@ CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noex
     : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
 
 void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin");
-    if (state_->level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) {
-        throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
-    }
+    const detail::Caller caller{"vkrc::CommandBuffer::begin"};
+    VKRC_REQUIRE_STATE(caller.name());
+    caller.require(state_->level == VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+                   "a secondary command buffer needs begin_secondary");
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = flags;
     begin_with(*state_, info);
@@ -157,10 +154,9 @@ void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
                                     VkCommandBufferUsageFlags flags) const {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_secondary");
-    if (state_->level != VK_COMMAND_BUFFER_LEVEL_SECONDARY) {
-        throw UsageError("vkrc::CommandBuffer::begin_secondary: the command buffer is primary");
-    }
+    const detail::Caller caller{"vkrc::CommandBuffer::begin_secondary"};
+    VKRC_REQUIRE_STATE(caller.name());
+    caller.require(state_->level == VK_COMMAND_BUFFER_LEVEL_SECONDARY, "the command buffer is primary");
     VkCommandBufferInheritanceRenderingInfo rendering{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_RENDERING_INFO};
     VkCommandBufferInheritanceInfo inherit{VK_STRUCTURE_TYPE_COMMAND_BUFFER_INHERITANCE_INFO};
     if (inheritance.render_pass) {

@@ -12,8 +12,8 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size) {
-    throw UsageError("vkrc::CommandBuffer::update_buffer: offset " + std::to_string(offset) + " and size " +
-                     std::to_string(size) + "; both must be multiples of 4 and size in 4..65536");
+    Caller("vkrc::CommandBuffer::update_buffer")
+        .refuse("offset ", offset, " and size ", size, "; both must be multiples of 4 and size in 4..65536");
 }
 }  // namespace detail
 
@@ -90,34 +90,31 @@ VkBufferMemoryBarrier2 BufferOwnershipTransfer::acquire(VkPipelineStageFlags2 ds
 
 namespace {
 
-const char* const mipmaps_who = "vkrc::generate_mipmaps";
-
 // The checks Vulkan would otherwise report as undefined behaviour or a device loss.
-void check_mipmap_image(const CommandBuffer& cmd, const Image& image, const MipmapInfo& info) {
-    detail::require_handle(cmd, mipmaps_who, "the CommandBuffer");
-    detail::require_handle(image, mipmaps_who, "the Image");
+void check_mipmap_image(const detail::Caller& caller, const CommandBuffer& cmd, const Image& image,
+                        const MipmapInfo& info) {
+    caller.require_handle(cmd, "the CommandBuffer");
+    caller.require_handle(image, "the Image");
     constexpr VkImageUsageFlags transfer = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    detail::require((image.usage() & transfer) == transfer, mipmaps_who,
-                    "the image lacks TRANSFER_SRC and TRANSFER_DST usage");
-    detail::require(image.samples() == VK_SAMPLE_COUNT_1_BIT, mipmaps_who, "the image is multisampled");
-    detail::require(info.base_layout != VK_IMAGE_LAYOUT_UNDEFINED, mipmaps_who,
-                    "base_layout is UNDEFINED: level 0 has no contents");
-    detail::require(info.base_layer < image.array_layers() &&
-                        (info.layer_count == VK_REMAINING_ARRAY_LAYERS ||
-                         (info.layer_count > 0 && info.layer_count <= image.array_layers() - info.base_layer)),
-                    mipmaps_who, "layers out of the image's range");
+    caller.require((image.usage() & transfer) == transfer, "the image lacks TRANSFER_SRC and TRANSFER_DST usage");
+    caller.require(image.samples() == VK_SAMPLE_COUNT_1_BIT, "the image is multisampled");
+    caller.require(info.base_layout != VK_IMAGE_LAYOUT_UNDEFINED, "base_layout is UNDEFINED: level 0 has no contents");
+    caller.require(info.base_layer < image.array_layers() &&
+                       (info.layer_count == VK_REMAINING_ARRAY_LAYERS ||
+                        (info.layer_count > 0 && info.layer_count <= image.array_layers() - info.base_layer)),
+                   "layers out of the image's range");
     const auto& physical = image.device().physical_device();
     const auto& families = physical.queue_families();
     const auto family = cmd.pool().queue_family_index();
-    detail::require(family < families.size() && (families[family].queueFlags & VK_QUEUE_GRAPHICS_BIT), mipmaps_who,
-                    "blits need a queue family with graphics");
+    caller.require(family < families.size() && (families[family].queueFlags & VK_QUEUE_GRAPHICS_BIT),
+                   "blits need a queue family with graphics");
     VkFormatProperties props{};
     physical.instance().fn().vkGetPhysicalDeviceFormatProperties(physical.vk(), image.format(), &props);
     const auto features = props.optimalTilingFeatures;
-    detail::require((features & VK_FORMAT_FEATURE_BLIT_SRC_BIT) && (features & VK_FORMAT_FEATURE_BLIT_DST_BIT),
-                    mipmaps_who, "the format cannot be blitted");
-    detail::require(info.filter != VK_FILTER_LINEAR || (features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT),
-                    mipmaps_who, "the format cannot be filtered linearly; use VK_FILTER_NEAREST");
+    caller.require((features & VK_FORMAT_FEATURE_BLIT_SRC_BIT) && (features & VK_FORMAT_FEATURE_BLIT_DST_BIT),
+                   "the format ", image.format(), " cannot be blitted");
+    caller.require(info.filter != VK_FILTER_LINEAR || (features & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT),
+                   "the format ", image.format(), " cannot be filtered linearly; use VK_FILTER_NEAREST");
 }
 
 VkOffset3D end_of(VkExtent3D e) {
@@ -128,7 +125,8 @@ VkOffset3D end_of(VkExtent3D e) {
 }  // namespace
 
 void generate_mipmaps(const CommandBuffer& cmd, const Image& image, const MipmapInfo& info) {
-    check_mipmap_image(cmd, image, info);
+    const detail::Caller caller{"vkrc::generate_mipmaps"};
+    check_mipmap_image(caller, cmd, image, info);
     const VkImage raw = image.vk();
     const std::uint32_t levels = image.mip_levels();
     const std::uint32_t layers =

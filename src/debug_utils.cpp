@@ -14,17 +14,17 @@ DebugMessengerState::~DebugMessengerState() {
 }  // namespace detail
 
 namespace {
-void require_debug_utils(const Instance& instance, const char* call) {
-    detail::require_handle(instance, call, "the Instance");
-    if (!instance.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME)) {
-        throw UsageError(std::string(call) + ": the instance was created without VK_EXT_debug_utils");
-    }
+void require_debug_utils(const detail::Caller& caller, const Instance& instance) {
+    caller.require_handle(instance, "the Instance");
+    caller.require(instance.extension_enabled(VK_EXT_DEBUG_UTILS_EXTENSION_NAME),
+                   "the instance was created without VK_EXT_debug_utils");
 }
 }  // namespace
 
 DebugMessenger DebugMessenger::create(const Instance& instance, const DebugMessengerCreateInfo& info) {
-    require_debug_utils(instance, "vkrc::DebugMessenger::create");
-    if (!info.callback) throw UsageError("vkrc::DebugMessenger::create: the callback is empty");
+    const detail::Caller caller{"vkrc::DebugMessenger::create"};
+    require_debug_utils(caller, instance);
+    caller.require(static_cast<bool>(info.callback), "the callback is empty");
     // The state exists first: its callback's address is the user data.
     detail::Ref<detail::DebugMessengerState> state(new detail::DebugMessengerState);
     state->instance = instance;
@@ -41,10 +41,10 @@ DebugMessenger DebugMessenger::create(const Instance& instance, const DebugMesse
 
 DebugMessenger DebugMessenger::adopt(const Instance& instance, VkDebugUtilsMessengerEXT messenger,
                                      Ownership ownership) {
-    constexpr const char* who = "vkrc::DebugMessenger::adopt";
-    require_debug_utils(instance, who);
+    const detail::Caller caller{"vkrc::DebugMessenger::adopt"};
+    require_debug_utils(caller, instance);
     return DebugMessenger(detail::adopted_state<detail::DebugMessengerState, &detail::DebugMessengerState::instance>(
-        who, instance, "the Instance", messenger, "VkDebugUtilsMessengerEXT", ownership));
+        caller, instance, "the Instance", messenger, "VkDebugUtilsMessengerEXT", ownership));
 }
 
 void set_name(const Device& device, VkObjectType type, std::uint64_t handle, const char* name) {

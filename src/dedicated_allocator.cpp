@@ -6,10 +6,11 @@
 VKRC_BEGIN_NAMESPACE
 
 AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationRequest& request) {
-    constexpr const char* who = "vkrc::DedicatedAllocator::allocate";
+    const detail::Caller caller{"vkrc::DedicatedAllocator::allocate"};
     const auto& props = device.memory_properties();
-    const std::uint32_t type = choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, who);
-    detail::check_request(device, request, type, who);
+    const std::uint32_t type =
+        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
+    detail::check_request(caller, device, request, type);
     const bool dedicated_info = request.requires_dedicated || request.prefers_dedicated || request.intent.dedicated;
     {
         // Reserved now, so that concurrent calls cannot pass the limit together.
@@ -43,9 +44,8 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
 }
 
 void DedicatedAllocator::free(DeviceView device, const AllocationInfo& allocation) {
-    if (allocation.allocator != this) {
-        throw UsageError("vkrc::DedicatedAllocator::free: the allocation was made by another allocator");
-    }
+    detail::Caller("vkrc::DedicatedAllocator::free")
+        .require(allocation.allocator == this, "the allocation was made by another allocator");
     device.fn().vkFreeMemory(device.vk(), allocation.memory, nullptr);
     LockGuard lock(mutex_);
     auto& heap = stats_.heaps[device.memory_properties().memoryTypes[allocation.memory_type].heapIndex];

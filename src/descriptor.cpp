@@ -35,19 +35,16 @@ namespace {
 
 // Immutable samplers: one per descriptor of a sampler binding, of the
 // layout's device (VUID-VkDescriptorSetLayoutBinding-descriptorType-00282).
-void check_immutable_samplers(const Device& device, const DescriptorSetLayoutBinding& b) {
+void check_immutable_samplers(const detail::Caller& caller, const Device& device, const DescriptorSetLayoutBinding& b) {
     if (b.immutable_samplers.empty()) return;
-    const std::string where = "vkrc::DescriptorSetLayout::create: binding " + std::to_string(b.binding);
-    if (b.descriptor_type != VK_DESCRIPTOR_TYPE_SAMPLER &&
-        b.descriptor_type != VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER)
-        throw UsageError(where + " has immutable samplers but type " + detail::enum_text(b.descriptor_type));
-    if (b.immutable_samplers.size() != b.descriptor_count) {
-        throw UsageError(where + " has " + std::to_string(b.immutable_samplers.size()) + " immutable samplers for " +
-                         std::to_string(b.descriptor_count) + " descriptors");
-    }
+    caller.require(b.descriptor_type == VK_DESCRIPTOR_TYPE_SAMPLER ||
+                       b.descriptor_type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                   "binding ", b.binding, " has immutable samplers but type ", b.descriptor_type);
+    caller.require(b.immutable_samplers.size() == b.descriptor_count, "binding ", b.binding, " has ",
+                   b.immutable_samplers.size(), " immutable samplers for ", b.descriptor_count, " descriptors");
     for (const auto& sampler : b.immutable_samplers) {
-        if (!sampler || !(sampler.device() == device))
-            throw UsageError(where + ": an immutable sampler is empty or belongs to another device");
+        caller.require(sampler && sampler.device() == device, "binding ", b.binding,
+                       ": an immutable sampler is empty or belongs to another device");
     }
 }
 
@@ -55,22 +52,19 @@ void check_immutable_samplers(const Device& device, const DescriptorSetLayoutBin
 // the validation layer: immutable samplers, and binding flags
 // (VUID-VkDescriptorSetLayoutCreateInfo-flags-03000,
 // VUID-VkDescriptorSetLayoutBindingFlagsCreateInfo-pBindingFlags-03004).
-void check_bindings(const Device& device, const DescriptorSetLayoutCreateInfo& info, const char* who) {
+void check_bindings(const detail::Caller& caller, const Device& device, const DescriptorSetLayoutCreateInfo& info) {
     std::uint32_t highest = 0;
     for (const auto& b : info.bindings) highest = std::max(highest, b.binding);
     for (const auto& b : info.bindings) {
-        check_immutable_samplers(device, b);
-        if ((b.binding_flags & VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT) &&
-            !(info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT)) {
-            throw UsageError(std::string(who) + ": binding " + std::to_string(b.binding) +
-                             " is UPDATE_AFTER_BIND but the layout lacks "
-                             "VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT");
-        }
-        if ((b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) && b.binding != highest) {
-            throw UsageError(std::string(who) + ": binding " + std::to_string(b.binding) +
-                             " has VARIABLE_DESCRIPTOR_COUNT but is not the highest binding (" +
-                             std::to_string(highest) + ")");
-        }
+        check_immutable_samplers(caller, device, b);
+        caller.require(!(b.binding_flags & VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT) ||
+                           (info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT),
+                       "binding ", b.binding,
+                       " is UPDATE_AFTER_BIND but the layout lacks "
+                       "VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT");
+        caller.require(!(b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) || b.binding == highest,
+                       "binding ", b.binding, " has VARIABLE_DESCRIPTOR_COUNT but is not the highest binding (",
+                       highest, ")");
     }
 }
 
@@ -88,14 +82,12 @@ void keep_bindings(detail::DescriptorSetLayoutState& s, const List<DescriptorSet
 }  // namespace
 
 DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const DescriptorSetLayoutCreateInfo& info) {
-    detail::require_handle(device, "vkrc::DescriptorSetLayout::create", "the Device");
-    if ((info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR) &&
-        !device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)) {
-        throw UsageError(
-            "vkrc::DescriptorSetLayout::create: PUSH_DESCRIPTOR_BIT_KHR needs VK_KHR_push_descriptor enabled on the "
-            "device");
-    }
-    check_bindings(device, info, "vkrc::DescriptorSetLayout::create");
+    const detail::Caller caller{"vkrc::DescriptorSetLayout::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(!(info.flags & VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR) ||
+                       device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME),
+                   "PUSH_DESCRIPTOR_BIT_KHR needs VK_KHR_push_descriptor enabled on the device");
+    check_bindings(caller, device, info);
     std::vector<VkDescriptorSetLayoutBinding> bindings;
     std::vector<VkDescriptorBindingFlags> flags;
     // Every binding's immutable samplers, one after another; reserved whole
@@ -132,10 +124,10 @@ DescriptorSetLayout DescriptorSetLayout::create(const Device& device, const Desc
 
 DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescriptorSetLayout layout,
                                                const DescriptorSetLayoutCreateInfo& info, Ownership ownership) {
-    constexpr const char* who = "vkrc::DescriptorSetLayout::adopt";
-    detail::require_handle(device, who, "the Device");
-    if (layout == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSetLayout is VK_NULL_HANDLE");
-    check_bindings(device, info, who);
+    const detail::Caller caller{"vkrc::DescriptorSetLayout::adopt"};
+    caller.require_handle(device, "the Device");
+    caller.require_not_null(layout, "VkDescriptorSetLayout");
+    check_bindings(caller, device, info);
     // The bindings before the handle: a failed copy must not destroy the adopted layout.
     detail::Ref<detail::DescriptorSetLayoutState> s(new detail::DescriptorSetLayoutState);
     keep_bindings(*s, info.bindings);
@@ -147,16 +139,17 @@ DescriptorSetLayout DescriptorSetLayout::adopt(const Device& device, VkDescripto
 
 DescriptorPool DescriptorPool::adopt(const Device& device, VkDescriptorPool pool, VkDescriptorPoolCreateFlags flags,
                                      Ownership ownership) {
-    auto s = detail::adopted_state<detail::DescriptorPoolState>("vkrc::DescriptorPool::adopt", device, "the Device",
-                                                                pool, "VkDescriptorPool", ownership);
+    auto s = detail::adopted_state<detail::DescriptorPoolState>(detail::Caller{"vkrc::DescriptorPool::adopt"}, device,
+                                                                "the Device", pool, "VkDescriptorPool", ownership);
     s->can_free_sets = (flags & VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT) != 0;
     return DescriptorPool(std::move(s));
 }
 
 DescriptorPool DescriptorPool::create(const Device& device, const DescriptorPoolCreateInfo& info) {
-    detail::require_handle(device, "vkrc::DescriptorPool::create", "the Device");
-    if (info.max_sets == 0) throw UsageError("vkrc::DescriptorPool::create: max_sets is 0");
-    if (info.pool_sizes.empty()) throw UsageError("vkrc::DescriptorPool::create: pool_sizes is empty");
+    const detail::Caller caller{"vkrc::DescriptorPool::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(info.max_sets != 0, "max_sets is 0");
+    caller.require(!info.pool_sizes.empty(), "pool_sizes is empty");
     VkDescriptorPoolCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, info.next};
     ci.flags = info.flags;
     ci.maxSets = info.max_sets;
@@ -172,18 +165,17 @@ namespace {
 
 // The largest count a set of layout may ask for its variable binding; throws
 // when the layout has none and a count was given.
-void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::uint32_t count, const char* who) {
+void check_variable_count(const detail::Caller& caller, const detail::DescriptorSetLayoutState& layout,
+                          std::uint32_t count) {
     if (!layout.has_variable_binding) {
-        if (count == 0) return;
-        throw UsageError(std::string(who) + ": variable_descriptor_count is " + std::to_string(count) +
-                         " but the layout has no VARIABLE_DESCRIPTOR_COUNT binding");
+        caller.require(count == 0, "variable_descriptor_count is ", count,
+                       " but the layout has no VARIABLE_DESCRIPTOR_COUNT binding");
+        return;
     }
     for (const auto& b : layout.bindings) {
-        if (b.binding == layout.variable_binding && count > b.descriptor_count) {
-            throw UsageError(std::string(who) + ": variable_descriptor_count " + std::to_string(count) +
-                             " is more than binding " + std::to_string(b.binding) + "'s descriptor_count " +
-                             std::to_string(b.descriptor_count));
-        }
+        caller.require(b.binding != layout.variable_binding || count <= b.descriptor_count,
+                       "variable_descriptor_count ", count, " is more than binding ", b.binding, "'s descriptor_count ",
+                       b.descriptor_count);
     }
 }
 
@@ -191,11 +183,10 @@ void check_variable_count(const detail::DescriptorSetLayoutState& layout, std::u
 
 DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
                                        std::uint32_t variable_descriptor_count) const {
-    detail::require_handle(layout, "vkrc::DescriptorPool::allocate", "the DescriptorSetLayout");
-    if (!(layout.device() == device())) {
-        throw UsageError("vkrc::DescriptorPool::allocate: the DescriptorSetLayout belongs to another device");
-    }
-    check_variable_count(*layout.state(), variable_descriptor_count, "vkrc::DescriptorPool::allocate");
+    const detail::Caller caller{"vkrc::DescriptorPool::allocate"};
+    caller.require_handle(layout, "the DescriptorSetLayout");
+    caller.require(layout.device() == device(), "the DescriptorSetLayout belongs to another device");
+    check_variable_count(caller, *layout.state(), variable_descriptor_count);
     auto& p = *state_;
     auto& d = *p.device.state();
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
@@ -227,14 +218,12 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
 
 DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorSetLayout& layout, VkDescriptorSet set,
                                    Ownership ownership, std::uint32_t variable_descriptor_count) {
-    constexpr const char* who = "vkrc::DescriptorSet::adopt";
-    detail::require_handle(pool, who, "the DescriptorPool");
-    detail::require_handle(layout, who, "the DescriptorSetLayout");
-    if (set == VK_NULL_HANDLE) throw UsageError(std::string(who) + ": the VkDescriptorSet is VK_NULL_HANDLE");
-    if (!(layout.device() == pool.device())) {
-        throw UsageError(std::string(who) + ": the DescriptorSetLayout belongs to another device");
-    }
-    check_variable_count(*layout.state(), variable_descriptor_count, who);
+    const detail::Caller caller{"vkrc::DescriptorSet::adopt"};
+    caller.require_handle(pool, "the DescriptorPool");
+    caller.require_handle(layout, "the DescriptorSetLayout");
+    caller.require_not_null(set, "VkDescriptorSet");
+    caller.require(layout.device() == pool.device(), "the DescriptorSetLayout belongs to another device");
+    check_variable_count(caller, *layout.state(), variable_descriptor_count);
     detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
     s->pool = pool;
     s->layout = layout;
@@ -275,59 +264,49 @@ bool is_image_type(VkDescriptorType t) {
 // hold the count elements from array_element on (VUID-VkWriteDescriptorSet-dstBinding-00315,
 // -descriptorType-00319, -dstArrayElement-00321); vkrc does not let a write
 // run on into the next binding. The variable binding holds the set's count.
-void check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                 std::uint32_t array_element, std::size_t count, const char* who) {
+void check_write(const detail::Caller& caller, const detail::DescriptorSetState& s, std::uint32_t binding,
+                 VkDescriptorType type, std::uint32_t array_element, std::size_t count) {
     if (!s.layout) return;
     const auto& layout = *s.layout.state();
     for (const auto& b : layout.bindings) {
         if (b.binding != binding) continue;
-        if (b.descriptor_type != type) {
-            throw UsageError(std::string(who) + ": binding " + std::to_string(binding) + " has descriptor type " +
-                             detail::enum_text(b.descriptor_type) + " in the set layout, the write has type " +
-                             detail::enum_text(type));
-        }
+        caller.require(b.descriptor_type == type, "binding ", binding, " has descriptor type ", b.descriptor_type,
+                       " in the set layout, the write has type ", type);
         const bool variable = layout.has_variable_binding && layout.variable_binding == binding;
         const std::uint32_t size = variable ? s.variable_count : b.descriptor_count;
         if (array_element >= size || count > size - array_element) {
             const std::string elements = count == 1 ? "array element " + std::to_string(array_element) + " is"
                                                     : "array elements " + std::to_string(array_element) + " to " +
                                                           std::to_string(array_element + count - 1) + " are";
-            throw UsageError(std::string(who) + ": " + elements + " past binding " + std::to_string(binding) + "'s " +
-                             std::to_string(size) + " descriptors");
+            caller.refuse(elements, " past binding ", binding, "'s ", size, " descriptors");
         }
         return;
     }
-    throw UsageError(std::string(who) + ": the set layout has no binding " + std::to_string(binding));
+    caller.refuse("the set layout has no binding ", binding);
 }
 
 }  // namespace
 
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer,
                                  VkDeviceSize offset, VkDeviceSize range, std::uint32_t array_element) const {
-    constexpr const char* who = "vkrc::DescriptorSet::write_buffer";
-    detail::require_handle(buffer, who, "the Buffer");
-    if (!(buffer.device() == pool().device()))
-        throw UsageError(std::string(who) + ": the buffer belongs to another device");
+    const detail::Caller caller{"vkrc::DescriptorSet::write_buffer"};
+    caller.require_handle(buffer, "the Buffer");
+    caller.require(buffer.device() == pool().device(), "the buffer belongs to another device");
     const VkBufferUsageFlags needs =
         type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC
             ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
             : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    if (is_buffer_type(type) && !(buffer.usage() & needs)) {
-        throw UsageError(std::string(who) + ": the buffer lacks the usage descriptor type " + detail::enum_text(type) +
-                         " needs (VUID-VkWriteDescriptorSet-descriptorType-00330/00331)");
-    }
+    caller.require(!is_buffer_type(type) || (buffer.usage() & needs), "the buffer lacks the usage descriptor type ",
+                   type, " needs (VUID-VkWriteDescriptorSet-descriptorType-00330/00331)");
     write_buffer(binding, type, buffer.vk(), offset, range, array_element);
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, const ImageView& view,
                                 VkImageLayout layout, const Sampler& sampler, std::uint32_t array_element) const {
-    constexpr const char* who = "vkrc::DescriptorSet::write_image";
+    const detail::Caller caller{"vkrc::DescriptorSet::write_image"};
     const auto& device = pool().device();
-    if (view && !(view.image().device() == device)) {
-        throw UsageError(std::string(who) + ": the image view belongs to another device");
-    }
-    if (sampler && !(sampler.device() == device))
-        throw UsageError(std::string(who) + ": the sampler belongs to another device");
+    caller.require(!view || view.image().device() == device, "the image view belongs to another device");
+    caller.require(!sampler || sampler.device() == device, "the sampler belongs to another device");
     write_image(binding, type, view ? view.vk() : VK_NULL_HANDLE, layout, sampler ? sampler.vk() : VK_NULL_HANDLE,
                 array_element);
 }
@@ -353,21 +332,18 @@ void update(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescri
 namespace {
 
 void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                        Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element, const char* who) {
-    if (!is_buffer_type(type)) {
-        throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) + " is not a buffer type");
-    }
-    check_write(s, binding, type, array_element, infos.size(), who);
+                        Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element,
+                        const detail::Caller& caller) {
+    caller.require(is_buffer_type(type), "descriptor type ", type, " is not a buffer type");
+    check_write(caller, s, binding, type, array_element, infos.size());
     if (!infos.empty()) update(s, binding, type, array_element, infos.size(), infos.data(), nullptr);
 }
 
 void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                       Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element, const char* who) {
-    if (!is_image_type(type)) {
-        throw UsageError(std::string(who) + ": descriptor type " + detail::enum_text(type) +
-                         " is not an image or sampler type");
-    }
-    check_write(s, binding, type, array_element, infos.size(), who);
+                       Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element,
+                       const detail::Caller& caller) {
+    caller.require(is_image_type(type), "descriptor type ", type, " is not an image or sampler type");
+    check_write(caller, s, binding, type, array_element, infos.size());
     if (!infos.empty()) update(s, binding, type, array_element, infos.size(), nullptr, infos.data());
 }
 
@@ -375,42 +351,44 @@ void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t bindin
 
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffer");
+    const detail::Caller caller{"vkrc::DescriptorSet::write_buffer"};
+    VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, "vkrc::DescriptorSet::write_buffer");
+    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_image");
+    const detail::Caller caller{"vkrc::DescriptorSet::write_image"};
+    VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorImageInfo info{sampler, view, layout};
-    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, "vkrc::DescriptorSet::write_image");
+    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
 }
 
 void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,
                                   Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffers");
-    write_buffer_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_buffers");
+    const detail::Caller caller{"vkrc::DescriptorSet::write_buffers"};
+    VKRC_REQUIRE_STATE(caller.name());
+    write_buffer_infos(*state_, binding, type, infos, array_element, caller);
 }
 
 void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
                                  std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_images");
-    write_image_infos(*state_, binding, type, infos, array_element, "vkrc::DescriptorSet::write_images");
+    const detail::Caller caller{"vkrc::DescriptorSet::write_images"};
+    VKRC_REQUIRE_STATE(caller.name());
+    write_image_infos(*state_, binding, type, infos, array_element, caller);
 }
 
 void DescriptorSet::update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::update_with_template");
-    constexpr const char* who = "vkrc::DescriptorSet::update_with_template";
-    detail::require_handle(update_template, who, "the DescriptorUpdateTemplate");
-    if (update_template.template_type() != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET) {
-        throw UsageError(std::string(who) + ": the template is for push descriptors");
-    }
+    const detail::Caller caller{"vkrc::DescriptorSet::update_with_template"};
+    VKRC_REQUIRE_STATE(caller.name());
+    caller.require_handle(update_template, "the DescriptorUpdateTemplate");
+    caller.require(update_template.template_type() == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET,
+                   "the template is for push descriptors");
     // VUID-vkUpdateDescriptorSetWithTemplate-descriptorUpdateTemplate-00387 asks
     // for a compatible layout; vkrc asks for the same one.
-    if (state_->layout && !(update_template.descriptor_set_layout() == state_->layout)) {
-        throw UsageError(std::string(who) + ": the template was made for another descriptor set layout");
-    }
+    caller.require(!state_->layout || update_template.descriptor_set_layout() == state_->layout,
+                   "the template was made for another descriptor set layout");
     const auto& d = state_->pool.device();
     d.fn().vkUpdateDescriptorSetWithTemplate(d.vk(), state_->handle, update_template.vk(), data);
 }

@@ -18,23 +18,17 @@ DescriptorUpdateTemplateState::~DescriptorUpdateTemplateState() {
 namespace {
 
 // adopt() passes need_entries false: the template exists, its entries are not read.
-void check_template_info(const Device& device, const DescriptorUpdateTemplateCreateInfo& info, const char* who,
-                         bool need_entries) {
-    detail::require_handle(device, who, "the Device");
-    if (need_entries && info.entries.empty()) throw UsageError(std::string(who) + ": entries is empty");
-    if (!info.descriptor_set_layout) throw UsageError(std::string(who) + ": descriptor_set_layout is empty");
-    if (!(info.descriptor_set_layout.device() == device)) {
-        throw UsageError(std::string(who) + ": descriptor_set_layout belongs to another device");
-    }
+void check_template_info(const detail::Caller& caller, const Device& device,
+                         const DescriptorUpdateTemplateCreateInfo& info, bool need_entries) {
+    caller.require_handle(device, "the Device");
+    caller.require(!need_entries || !info.entries.empty(), "entries is empty");
+    caller.require(static_cast<bool>(info.descriptor_set_layout), "descriptor_set_layout is empty");
+    caller.require(info.descriptor_set_layout.device() == device, "descriptor_set_layout belongs to another device");
     if (info.template_type != VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) return;
-    if (!device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME)) {
-        throw UsageError(std::string(who) +
-                         ": a PUSH_DESCRIPTORS_KHR template needs VK_KHR_push_descriptor enabled on the device");
-    }
-    if (!info.pipeline_layout) throw UsageError(std::string(who) + ": a push template needs pipeline_layout");
-    if (!(info.pipeline_layout.device() == device)) {
-        throw UsageError(std::string(who) + ": pipeline_layout belongs to another device");
-    }
+    caller.require(device.extension_enabled(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME),
+                   "a PUSH_DESCRIPTORS_KHR template needs VK_KHR_push_descriptor enabled on the device");
+    caller.require(static_cast<bool>(info.pipeline_layout), "a push template needs pipeline_layout");
+    caller.require(info.pipeline_layout.device() == device, "pipeline_layout belongs to another device");
 }
 
 // What the template was made for: its type, its set layout and, for a push
@@ -52,7 +46,7 @@ void keep_template_info(detail::DescriptorUpdateTemplateState& s, const Descript
 
 DescriptorUpdateTemplate DescriptorUpdateTemplate::create(const Device& device,
                                                           const DescriptorUpdateTemplateCreateInfo& info) {
-    check_template_info(device, info, "vkrc::DescriptorUpdateTemplate::create", true);
+    check_template_info(detail::Caller{"vkrc::DescriptorUpdateTemplate::create"}, device, info, true);
     const bool push = info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR;
     VkDescriptorUpdateTemplateCreateInfo ci{VK_STRUCTURE_TYPE_DESCRIPTOR_UPDATE_TEMPLATE_CREATE_INFO, info.next};
     ci.flags = info.flags;
@@ -76,9 +70,9 @@ DescriptorUpdateTemplate DescriptorUpdateTemplate::adopt(const Device& device,
                                                          VkDescriptorUpdateTemplate update_template,
                                                          const DescriptorUpdateTemplateCreateInfo& info,
                                                          Ownership ownership) {
-    constexpr const char* who = "vkrc::DescriptorUpdateTemplate::adopt";
-    check_template_info(device, info, who, false);
-    auto s = detail::adopted_state<detail::DescriptorUpdateTemplateState>(who, device, "the Device", update_template,
+    const detail::Caller caller{"vkrc::DescriptorUpdateTemplate::adopt"};
+    check_template_info(caller, device, info, false);
+    auto s = detail::adopted_state<detail::DescriptorUpdateTemplateState>(caller, device, "the Device", update_template,
                                                                           "VkDescriptorUpdateTemplate", ownership);
     keep_template_info(*s, info);
     return DescriptorUpdateTemplate(std::move(s));

@@ -13,7 +13,7 @@
 VKRC_BEGIN_NAMESPACE
 
 int find_dedicated_queue_family(const PhysicalDevice& physical, QueueRole role) {
-    detail::require_handle(physical, "vkrc::find_dedicated_queue_family", "the PhysicalDevice");
+    detail::Caller("vkrc::find_dedicated_queue_family").require_handle(physical, "the PhysicalDevice");
     constexpr VkQueueFlags graphics = VK_QUEUE_GRAPHICS_BIT, compute = VK_QUEUE_COMPUTE_BIT;
     const auto& families = physical.queue_families();
     for (std::uint32_t i = 0; i < families.size(); ++i) {
@@ -320,7 +320,7 @@ void assign_roles(detail::DeviceState& s) {
 
 // The default request, and those of the roles asked for: a dedicated family
 // when there is one, else another queue of the graphics family if it has room.
-void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& info,
+void add_role_requests(const detail::Caller& caller, const PhysicalDevice& physical, const DeviceCreateInfo& info,
                        std::vector<QueueRequest>& requests) {
     // The family select() chose (one that presents, when it was given a
     // surface), else the first with graphics and compute.
@@ -328,7 +328,7 @@ void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& i
     if (graphics < 0 ||
         !family_has(physical, static_cast<std::uint32_t>(graphics), VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT))
         graphics = find_dedicated_queue_family(physical, QueueRole::graphics);
-    if (graphics < 0) throw UsageError("vkrc::Device::create: no queue family with graphics and compute");
+    caller.require(graphics >= 0, "no queue family with graphics and compute");
     requests.push_back(QueueRequest{static_cast<std::uint32_t>(graphics)});
     for (QueueRole role : {QueueRole::transfer, QueueRole::compute}) {
         if (!(role == QueueRole::transfer ? info.transfer_queue : info.compute_queue)) continue;
@@ -342,25 +342,21 @@ void add_role_requests(const PhysicalDevice& physical, const DeviceCreateInfo& i
 }
 
 // Throws UsageError unless the physical device has request's family and that many queues in it.
-void check_queue_request(const PhysicalDevice& physical, const QueueRequest& r) {
+void check_queue_request(const detail::Caller& caller, const PhysicalDevice& physical, const QueueRequest& r) {
     const auto& families = physical.queue_families();
-    if (r.queue_family_index >= families.size()) {
-        throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) +
-                         " does not exist (the device has " + std::to_string(families.size()) + ")");
-    }
-    if (r.queue_priorities.empty() || r.queue_priorities.size() > families[r.queue_family_index].queueCount) {
-        throw UsageError("vkrc::Device::create: queue family " + std::to_string(r.queue_family_index) + " has " +
-                         std::to_string(families[r.queue_family_index].queueCount) + " queues; asked for " +
-                         std::to_string(r.queue_priorities.size()));
-    }
+    caller.require(r.queue_family_index < families.size(), "queue family ", r.queue_family_index,
+                   " does not exist (the device has ", families.size(), ")");
+    const std::uint32_t available = families[r.queue_family_index].queueCount;
+    caller.require(!r.queue_priorities.empty() && r.queue_priorities.size() <= available, "queue family ",
+                   r.queue_family_index, " has ", available, " queues; asked for ", r.queue_priorities.size());
 }
 
 // The create infos of the checked requests; they point into requests.
-std::vector<VkDeviceQueueCreateInfo> queue_create_infos(const PhysicalDevice& physical,
+std::vector<VkDeviceQueueCreateInfo> queue_create_infos(const detail::Caller& caller, const PhysicalDevice& physical,
                                                         const std::vector<QueueRequest>& requests) {
     std::vector<VkDeviceQueueCreateInfo> infos;
     for (const auto& r : requests) {
-        check_queue_request(physical, r);
+        check_queue_request(caller, physical, r);
         VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
         q.pNext = r.next;
         q.queueFamilyIndex = r.queue_family_index;
@@ -405,6 +401,16 @@ struct FeatureChain {
     }
     FeatureChain(const FeatureChain&) = delete;
     FeatureChain& operator=(const FeatureChain&) = delete;
+    // What the chain enables, unchained.
+    DeviceFeatures enabled() const {
+        DeviceFeatures d;
+        d.core = features.features;
+        d.vulkan11 = f11;
+        d.vulkan12 = f12;
+        d.vulkan13 = f13;
+        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
+        return d;
+    }
 
     VkPhysicalDeviceVulkan13Features f13;
     VkPhysicalDeviceVulkan12Features f12;
@@ -413,7 +419,8 @@ struct FeatureChain {
 };
 
 void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
-                 Span<const char* const> extensions, detail::Ref<detail::DeviceState>& state) {
+                 Span<const char* const> extensions, const DeviceFeatures& features,
+                 detail::Ref<detail::DeviceState>& state) {
     state = detail::Ref<detail::DeviceState>(new detail::DeviceState);
     auto& s = *state;
     s.device = raw;
@@ -422,6 +429,7 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
     s.fn = DeviceFunctions::load(physical.fn().vkGetDeviceProcAddr, raw);
     drop_unless_debug_utils(physical, s.fn);
     for (const char* e : extensions) s.enabled_extensions.push_back(e);
+    s.enabled_features = features;
     init_queues(s, queues);
     assign_roles(s);
 }
@@ -431,10 +439,11 @@ void make_device(const PhysicalDevice& physical, VkDevice raw, Ownership ownersh
 Device Device::create(const PhysicalDevice& physical) { return create(physical, DeviceCreateInfo{}); }
 
 Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
-    detail::require_handle(physical, "vkrc::Device::create", "the PhysicalDevice");
+    const detail::Caller caller{"vkrc::Device::create"};
+    caller.require_handle(physical, "the PhysicalDevice");
     std::vector<QueueRequest> requests(info.queue_requests.begin(), info.queue_requests.end());
-    if (requests.empty()) add_role_requests(physical, info, requests);
-    const auto queue_infos = queue_create_infos(physical, requests);
+    if (requests.empty()) add_role_requests(caller, physical, info, requests);
+    const auto queue_infos = queue_create_infos(caller, physical, requests);
     const auto extensions = device_extensions(physical, info);
     const FeatureChain features(info);
 
@@ -448,7 +457,7 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
     check(physical.fn().vkCreateDevice(physical.vk(), &ci, nullptr, &raw), "vkCreateDevice");
     detail::Ref<detail::DeviceState> state;
     try {
-        make_device(physical, raw, Ownership::owned, requests, extensions, state);
+        make_device(physical, raw, Ownership::owned, requests, extensions, features.enabled(), state);
     } catch (...) {
         if (!state) destroy_raw_device(physical, raw);
         throw;  // otherwise the state's destructor destroyed the device
@@ -458,11 +467,12 @@ Device Device::create(const PhysicalDevice& physical, const DeviceCreateInfo& in
 
 Device Device::adopt(const PhysicalDevice& physical, VkDevice raw, Ownership ownership, Span<const QueueRequest> queues,
                      Span<const char* const> enabled_extensions) {
-    detail::require_handle(physical, "vkrc::Device::adopt", "the PhysicalDevice");
-    if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Device::adopt: the VkDevice is VK_NULL_HANDLE");
+    const detail::Caller caller{"vkrc::Device::adopt"};
+    caller.require_handle(physical, "the PhysicalDevice");
+    caller.require_not_null(raw, "VkDevice");
     detail::Ref<detail::DeviceState> state;
     try {
-        make_device(physical, raw, ownership, queues, enabled_extensions, state);
+        make_device(physical, raw, ownership, queues, enabled_extensions, physical.features(), state);
     } catch (...) {
         if (!state && ownership == Ownership::owned) destroy_raw_device(physical, raw);
         throw;
@@ -476,23 +486,25 @@ bool Device::extension_enabled(const char* name) const VKRC_UNCHECKED_NOEXCEPT {
 }
 
 Queue Device::queue(std::uint32_t family_index, std::uint32_t index) const {
-    VKRC_REQUIRE_STATE("vkrc::Device::queue");
+    const detail::Caller caller{"vkrc::Device::queue"};
+    VKRC_REQUIRE_STATE(caller.name());
     for (auto& q : state_->queues) {
         if (q.family_index == family_index && q.index == index) return Queue(*this, &q);
     }
-    throw UsageError("vkrc::Device::queue: queue " + std::to_string(index) + " of family " +
-                     std::to_string(family_index) + " was not requested when the device was created");
+    caller.refuse("queue ", index, " of family ", family_index, " was not requested when the device was created");
 }
 
 Queue Device::default_queue() const {
-    VKRC_REQUIRE_STATE("vkrc::Device::default_queue");
-    if (state_->queues.empty()) throw UsageError("vkrc::Device::default_queue: the device has no queues");
+    const detail::Caller caller{"vkrc::Device::default_queue"};
+    VKRC_REQUIRE_STATE(caller.name());
+    caller.require(!state_->queues.empty(), "the device has no queues");
     return Queue(*this, &state_->queues.front());
 }
 
 QueueAssignment Device::queue_for(QueueRole role) const {
-    VKRC_REQUIRE_STATE("vkrc::Device::queue_for");
-    if (state_->queues.empty()) throw UsageError("vkrc::Device::queue_for: the device has no queues");
+    const detail::Caller caller{"vkrc::Device::queue_for"};
+    VKRC_REQUIRE_STATE(caller.name());
+    caller.require(!state_->queues.empty(), "the device has no queues");
     const std::size_t index = state_->role_queues[static_cast<int>(role)];
     const std::size_t graphics = state_->role_queues[static_cast<int>(QueueRole::graphics)];
     QueueAssignment a;

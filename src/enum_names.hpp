@@ -16,6 +16,13 @@ std::string enum_text(VkFormat value);
 std::string enum_text(VkPhysicalDeviceType value);
 std::string enum_text(VkColorSpaceKHR value);
 std::string enum_text(VkImageLayout value);
+std::string enum_text(VkImageType value);
+std::string enum_text(VkImageTiling value);
+std::string enum_text(VkImageViewType value);
+std::string enum_text(VkSampleCountFlagBits value);
+std::string enum_text(VkSamplerAddressMode value);
+std::string enum_text(VkFilter value);
+std::string enum_text(VkSamplerMipmapMode value);
 
 }  // namespace detail
 VKRC_END_NAMESPACE

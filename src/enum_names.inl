@@ -300,3 +300,66 @@ const char* enum_name(VkImageLayout value) noexcept {
         default: return nullptr;
     }
 }
+const char* enum_name(VkImageType value) noexcept {
+    switch (value) {
+        case VK_IMAGE_TYPE_1D: return "VK_IMAGE_TYPE_1D";
+        case VK_IMAGE_TYPE_2D: return "VK_IMAGE_TYPE_2D";
+        case VK_IMAGE_TYPE_3D: return "VK_IMAGE_TYPE_3D";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkImageTiling value) noexcept {
+    switch (value) {
+        case VK_IMAGE_TILING_OPTIMAL: return "VK_IMAGE_TILING_OPTIMAL";
+        case VK_IMAGE_TILING_LINEAR: return "VK_IMAGE_TILING_LINEAR";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkImageViewType value) noexcept {
+    switch (value) {
+        case VK_IMAGE_VIEW_TYPE_1D: return "VK_IMAGE_VIEW_TYPE_1D";
+        case VK_IMAGE_VIEW_TYPE_2D: return "VK_IMAGE_VIEW_TYPE_2D";
+        case VK_IMAGE_VIEW_TYPE_3D: return "VK_IMAGE_VIEW_TYPE_3D";
+        case VK_IMAGE_VIEW_TYPE_CUBE: return "VK_IMAGE_VIEW_TYPE_CUBE";
+        case VK_IMAGE_VIEW_TYPE_1D_ARRAY: return "VK_IMAGE_VIEW_TYPE_1D_ARRAY";
+        case VK_IMAGE_VIEW_TYPE_2D_ARRAY: return "VK_IMAGE_VIEW_TYPE_2D_ARRAY";
+        case VK_IMAGE_VIEW_TYPE_CUBE_ARRAY: return "VK_IMAGE_VIEW_TYPE_CUBE_ARRAY";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkSampleCountFlagBits value) noexcept {
+    switch (value) {
+        case VK_SAMPLE_COUNT_1_BIT: return "VK_SAMPLE_COUNT_1_BIT";
+        case VK_SAMPLE_COUNT_2_BIT: return "VK_SAMPLE_COUNT_2_BIT";
+        case VK_SAMPLE_COUNT_4_BIT: return "VK_SAMPLE_COUNT_4_BIT";
+        case VK_SAMPLE_COUNT_8_BIT: return "VK_SAMPLE_COUNT_8_BIT";
+        case VK_SAMPLE_COUNT_16_BIT: return "VK_SAMPLE_COUNT_16_BIT";
+        case VK_SAMPLE_COUNT_32_BIT: return "VK_SAMPLE_COUNT_32_BIT";
+        case VK_SAMPLE_COUNT_64_BIT: return "VK_SAMPLE_COUNT_64_BIT";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkSamplerAddressMode value) noexcept {
+    switch (value) {
+        case VK_SAMPLER_ADDRESS_MODE_REPEAT: return "VK_SAMPLER_ADDRESS_MODE_REPEAT";
+        case VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT: return "VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT";
+        case VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE: return "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE";
+        case VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER: return "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER";
+        case VK_SAMPLER_ADDRESS_MODE_MIRROR_CLAMP_TO_EDGE: return "VK_SAMPLER_ADDRESS_MODE_MIRROR_CLAMP_TO_EDGE";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkFilter value) noexcept {
+    switch (value) {
+        case VK_FILTER_NEAREST: return "VK_FILTER_NEAREST";
+        case VK_FILTER_LINEAR: return "VK_FILTER_LINEAR";
+        default: return nullptr;
+    }
+}
+const char* enum_name(VkSamplerMipmapMode value) noexcept {
+    switch (value) {
+        case VK_SAMPLER_MIPMAP_MODE_NEAREST: return "VK_SAMPLER_MIPMAP_MODE_NEAREST";
+        case VK_SAMPLER_MIPMAP_MODE_LINEAR: return "VK_SAMPLER_MIPMAP_MODE_LINEAR";
+        default: return nullptr;
+    }
+}

@@ -1,5 +1,6 @@
 #include "vkrc/error.hpp"
 
+#include "caller.hpp"
 #include "enum_names.hpp"
 #include "vkrc/handle.hpp"
 
@@ -67,11 +68,18 @@ std::string enum_text(VkFormat value) { return enum_text_of(value, "VkFormat"); 
 std::string enum_text(VkPhysicalDeviceType value) { return enum_text_of(value, "VkPhysicalDeviceType"); }
 std::string enum_text(VkColorSpaceKHR value) { return enum_text_of(value, "VkColorSpaceKHR"); }
 std::string enum_text(VkImageLayout value) { return enum_text_of(value, "VkImageLayout"); }
+std::string enum_text(VkImageType value) { return enum_text_of(value, "VkImageType"); }
+std::string enum_text(VkImageTiling value) { return enum_text_of(value, "VkImageTiling"); }
+std::string enum_text(VkImageViewType value) { return enum_text_of(value, "VkImageViewType"); }
+std::string enum_text(VkSampleCountFlagBits value) { return enum_text_of(value, "VkSampleCountFlagBits"); }
+std::string enum_text(VkSamplerAddressMode value) { return enum_text_of(value, "VkSamplerAddressMode"); }
+std::string enum_text(VkFilter value) { return enum_text_of(value, "VkFilter"); }
+std::string enum_text(VkSamplerMipmapMode value) { return enum_text_of(value, "VkSamplerMipmapMode"); }
 
 void throw_empty_handle(const char* call) {
-    throw UsageError(std::string(call) +
-                     ": the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image "
-                     "has no Allocation)");
+    Caller(call).refuse(
+        "the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image has no "
+        "Allocation)");
 }
 void throw_empty_handle(const char* type, const char* member) {
     throw_empty_handle((std::string(type) + "::" + member).c_str());

@@ -4,6 +4,8 @@
 
 #include "vkrc/device.hpp"
 
+#include "caller.hpp"
+
 #include <algorithm>
 #include <cstddef>
 #include <cstring>
@@ -46,11 +48,12 @@ constexpr Command commands[] = {
     const Command& c = commands[index];
     std::string providers(c.providers);
     std::replace(providers.begin(), providers.end(), ' ', '|');
-    throw UsageError(std::string("vkrc: ") + c.name + " was called but is not loaded: it needs " + providers +
-                     (c.device_table          ? " enabled on the device or instance"
-                      : c.of_device_extension ? " offered by a driver"
-                                              : " enabled on the instance") +
-                     (c.core_name ? std::string(" (or Vulkan with ") + c.core_name + ")" : std::string()));
+    // The caller is the application's call through the table, not a vkrc function.
+    detail::Caller("vkrc").refuse(c.name, " was called but is not loaded: it needs ", providers,
+                                  c.device_table          ? " enabled on the device or instance"
+                                  : c.of_device_extension ? " offered by a driver"
+                                                          : " enabled on the instance",
+                                  c.core_name ? std::string(" (or Vulkan with ") + c.core_name + ")" : std::string());
 }
 
 // What an unloaded slot holds: a function of the command's own type that throws.

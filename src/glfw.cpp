@@ -41,8 +41,9 @@ List<const char*> required_instance_extensions() {
 }
 
 Surface create_surface(const Instance& instance, GLFWwindow* window) {
-    detail::require_handle(instance, "vkrc::glfw::create_surface", "the Instance");
-    if (!window) throw UsageError("vkrc::glfw::create_surface: the window is null");
+    const detail::Caller caller{"vkrc::glfw::create_surface"};
+    caller.require_handle(instance, "the Instance");
+    caller.require(window != nullptr, "the window is null");
     VkSurfaceKHR surface = VK_NULL_HANDLE;
     check(glfwCreateWindowSurface(instance.vk(), window, nullptr, &surface), "glfwCreateWindowSurface");
     try {

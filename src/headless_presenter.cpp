@@ -2,6 +2,8 @@
 #include "vkrc/swapchain.hpp"
 #include "vkrc/upload.hpp"
 
+#include "caller.hpp"
+
 #include <atomic>
 #include <string>
 #include <vector>
@@ -46,11 +48,10 @@ detail::Ref<detail::FrameImages> make_ring(const detail::HeadlessPresenterState&
 }  // namespace
 
 HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPresenterCreateInfo& info) {
-    if (!queue) throw UsageError("vkrc::HeadlessPresenter::create: the Queue is empty");
-    if (info.extent.width == 0 || info.extent.height == 0) {
-        throw UsageError("vkrc::HeadlessPresenter::create: extent is zero");
-    }
-    if (info.image_count == 0) throw UsageError("vkrc::HeadlessPresenter::create: image_count is 0");
+    const detail::Caller caller{"vkrc::HeadlessPresenter::create"};
+    caller.require(static_cast<bool>(queue), "the Queue is empty");
+    caller.require(info.extent.width != 0 && info.extent.height != 0, "extent is zero");
+    caller.require(info.image_count != 0, "image_count is 0");
     detail::Ref<detail::HeadlessPresenterState> state(new detail::HeadlessPresenterState);
     state->queue = queue;
     state->info = info;
@@ -87,9 +88,8 @@ PresentStatus HeadlessPresenter::refill(Frame& frame, detail::HeadlessPresenterS
 
 PresentStatus HeadlessPresenter::present(const Frame& frame) {
     auto& s = *state_;
-    if (!frame || frame.source_ != &s) {
-        throw UsageError("vkrc::HeadlessPresenter::present: the frame was not acquired from this presenter");
-    }
+    detail::Caller("vkrc::HeadlessPresenter::present")
+        .require(frame && frame.source_ == &s, "the frame was not acquired from this presenter");
     s.last_presented.store(frame.image_index, std::memory_order_relaxed);
     return PresentStatus::success;
 }
@@ -101,10 +101,9 @@ List<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {
         LockGuard lock(s.lock);
         ring = s.ring;
     }
-    if (image_index >= ring->images.size()) {
-        throw UsageError("vkrc::HeadlessPresenter::read_back: image " + std::to_string(image_index) +
-                         " does not exist (the ring has " + std::to_string(ring->images.size()) + ")");
-    }
+    detail::Caller("vkrc::HeadlessPresenter::read_back")
+        .require(image_index < ring->images.size(), "image ", image_index, " does not exist (the ring has ",
+                 ring->images.size(), ")");
     const Image& image = ring->images[image_index];
     detail::await(s.queue, detail::last_submitted(s.queue));
     return download_image(s.queue, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);

@@ -2,6 +2,7 @@
 
 #include "vkrc/extension_functions.hpp"
 
+#include "caller.hpp"
 #include "debug_message.hpp"
 #include "text.hpp"
 
@@ -152,7 +153,7 @@ Instance Instance::create(const InstanceCreateInfo& info) {
 Instance Instance::adopt(VkInstance raw, Ownership ownership, std::uint32_t api_version,
                          PFN_vkGetInstanceProcAddr get_instance_proc_addr, Span<const char* const> enabled_extensions,
                          Span<const char* const> enabled_layers) {
-    if (raw == VK_NULL_HANDLE) throw UsageError("vkrc::Instance::adopt: the VkInstance is VK_NULL_HANDLE");
+    detail::Caller("vkrc::Instance::adopt").require_not_null(raw, "VkInstance");
     auto global = GlobalFunctions::load(get_instance_proc_addr);
     Instance instance(detail::Ref<detail::InstanceState>(new detail::InstanceState));
     auto& s = *instance.state_;

@@ -53,20 +53,15 @@ void fill_budget(DeviceView device, AllocatorStatistics& stats) noexcept {
 
 namespace detail {
 
-std::string bytes_text(VkDeviceSize n) { return std::to_string(n) + " bytes"; }
-
-void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who) {
-    if (request.requirements.size == 0) throw UsageError(std::string(who) + ": size is 0");
-    if (request.dedicated_buffer != VK_NULL_HANDLE && request.dedicated_image != VK_NULL_HANDLE) {
-        throw UsageError(std::string(who) + ": both dedicated_buffer and dedicated_image are set");
-    }
+void check_request(const Caller& caller, DeviceView device, const AllocationRequest& request, std::uint32_t type) {
+    caller.require(request.requirements.size != 0, "size is 0");
+    caller.require(request.dedicated_buffer == VK_NULL_HANDLE || request.dedicated_image == VK_NULL_HANDLE,
+                   "both dedicated_buffer and dedicated_image are set");
     const auto& props = device.memory_properties();
     const std::uint32_t heap = props.memoryTypes[type].heapIndex;
-    if (request.requirements.size > props.memoryHeaps[heap].size) {
-        throw UsageError(std::string(who) + ": " + bytes_text(request.requirements.size) +
-                         " requested, more than the whole of memory heap " + std::to_string(heap) + " (" +
-                         bytes_text(props.memoryHeaps[heap].size) + ")");
-    }
+    caller.require(request.requirements.size <= props.memoryHeaps[heap].size, request.requirements.size,
+                   " bytes requested, more than the whole of memory heap ", heap, " (", props.memoryHeaps[heap].size,
+                   " bytes)");
 }
 
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,

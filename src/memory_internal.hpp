@@ -1,6 +1,7 @@
 // Helpers shared by the allocators (not installed).
 #pragma once
 
+#include "caller.hpp"
 #include "text.hpp"
 #include "vkrc/memory.hpp"
 
@@ -9,9 +10,8 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-std::string bytes_text(VkDeviceSize n);
 // Throws UsageError for a zero size, two dedicated resources, or a size larger than the heap.
-void check_request(DeviceView device, const AllocationRequest& request, std::uint32_t type, const char* who);
+void check_request(const Caller& caller, DeviceView device, const AllocationRequest& request, std::uint32_t type);
 // vkAllocateMemory (with VkMemoryDedicatedAllocateInfo when a resource is
 // given, VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT when device_address), mapped
 // whole when host-visible.

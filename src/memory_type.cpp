@@ -1,6 +1,7 @@
 // Memory-type choice: the flags an intent implies and the best type for them.
 #include "vkrc/memory.hpp"
 
+#include "caller.hpp"
 #include "text.hpp"
 
 #include <string>
@@ -74,12 +75,11 @@ int find_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::ui
 
 std::uint32_t choose_memory_type(const VkPhysicalDeviceMemoryProperties& properties, std::uint32_t type_bits,
                                  const MemoryIntent& intent, const char* who) {
-    int type = find_memory_type(properties, type_bits, intent);
-    if (type < 0) {
-        throw UsageError(std::string(who) + ": no memory type of the device has the required property flags 0x" +
-                         detail::hex(flags_of(intent).required) + " among the resource's allowed types 0x" +
-                         detail::hex(type_bits));
-    }
+    const int type = find_memory_type(properties, type_bits, intent);
+    // Public, so the caller's name comes as text.
+    detail::Caller(who).require(type >= 0, "no memory type of the device has the required property flags ",
+                                detail::Hex{flags_of(intent).required}, " among the resource's allowed types ",
+                                detail::Hex{type_bits});
     return static_cast<std::uint32_t>(type);
 }
 

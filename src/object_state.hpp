@@ -5,28 +5,18 @@
 
 #include "caller.hpp"
 
-#include <string_view>
-
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// The older two forms of Caller's checks, until every site names its Caller.
-inline void require(bool ok, const char* who, std::string_view problem) { Caller(who).require(ok, problem); }
-template <class Handle>
-void require_handle(const Handle& handle, const char* who, const char* the_name) {
-    Caller(who).require_handle(handle, the_name);
-}
-
 // The state of an adopted handle: refuses an empty parent (require_handle
-// with the_parent, e.g. "the Device") and a null handle ("who: the
-// handle_name is VK_NULL_HANDLE") with UsageError, then holds both (the parent in
+// with the_parent, e.g. "the Device") and a null handle (require_not_null
+// with handle_name, e.g. "VkBuffer") with UsageError, then holds both (the parent in
 // parent_member, by default a DeviceChildState's device) and the ownership.
 // The caller fills in the rest; nothing it does after this may throw, or the
 // state would destroy an owned handle that adopt() did not take.
 template <class State, auto parent_member = &State::device, class Parent, class VkHandle>
-Ref<State> adopted_state(const char* who, const Parent& parent, const char* the_parent, VkHandle handle,
+Ref<State> adopted_state(const Caller& caller, const Parent& parent, const char* the_parent, VkHandle handle,
                          const char* handle_name, Ownership ownership) {
-    const Caller caller(who);
     caller.require_handle(parent, the_parent);
     caller.require_not_null(handle, handle_name);
     Ref<State> s(new State);

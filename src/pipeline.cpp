@@ -26,20 +26,18 @@ PipelineState::~PipelineState() {
 }
 }  // namespace detail
 
-using detail::require;
-
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
 
 PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {
     return PipelineLayout(detail::adopted_state<detail::PipelineLayoutState>(
-        "vkrc::PipelineLayout::adopt", device, "the Device", layout, "VkPipelineLayout", ownership));
+        detail::Caller{"vkrc::PipelineLayout::adopt"}, device, "the Device", layout, "VkPipelineLayout", ownership));
 }
 
 RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
                              Span<const std::uint32_t> color_attachment_counts, Ownership ownership) {
     List<std::uint32_t> counts(color_attachment_counts);  // before the state: a failed copy must not destroy
-    auto s = detail::adopted_state<detail::RenderPassState>("vkrc::RenderPass::adopt", device, "the Device",
-                                                            render_pass, "VkRenderPass", ownership);
+    auto s = detail::adopted_state<detail::RenderPassState>(detail::Caller{"vkrc::RenderPass::adopt"}, device,
+                                                            "the Device", render_pass, "VkRenderPass", ownership);
     s->color_counts = std::move(counts);
     return RenderPass(std::move(s));
 }
@@ -47,31 +45,32 @@ RenderPass RenderPass::adopt(const Device& device, VkRenderPass render_pass,
 Framebuffer Framebuffer::adopt(const RenderPass& render_pass, VkFramebuffer framebuffer, VkExtent2D extent,
                                Ownership ownership) {
     auto s = detail::adopted_state<detail::FramebufferState, &detail::FramebufferState::render_pass>(
-        "vkrc::Framebuffer::adopt", render_pass, "the RenderPass", framebuffer, "VkFramebuffer", ownership);
+        detail::Caller{"vkrc::Framebuffer::adopt"}, render_pass, "the RenderPass", framebuffer, "VkFramebuffer",
+        ownership);
     s->extent = extent;
     return Framebuffer(std::move(s));
 }
 
 PipelineCache PipelineCache::adopt(const Device& device, VkPipelineCache cache, Ownership ownership) {
     return PipelineCache(detail::adopted_state<detail::PipelineCacheState>(
-        "vkrc::PipelineCache::adopt", device, "the Device", cache, "VkPipelineCache", ownership));
+        detail::Caller{"vkrc::PipelineCache::adopt"}, device, "the Device", cache, "VkPipelineCache", ownership));
 }
 
 Pipeline Pipeline::adopt(const PipelineLayout& layout, VkPipeline pipeline, VkPipelineBindPoint bind_point,
                          Ownership ownership) {
     auto s = detail::adopted_state<detail::PipelineState, &detail::PipelineState::layout>(
-        "vkrc::Pipeline::adopt", layout, "the PipelineLayout", pipeline, "VkPipeline", ownership);
+        detail::Caller{"vkrc::Pipeline::adopt"}, layout, "the PipelineLayout", pipeline, "VkPipeline", ownership);
     s->bind_point = bind_point;
     return Pipeline(std::move(s));
 }
 
 PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayoutCreateInfo& info) {
-    detail::require_handle(device, "vkrc::PipelineLayout::create", "the Device");
+    const detail::Caller caller{"vkrc::PipelineLayout::create"};
+    caller.require_handle(device, "the Device");
     std::vector<VkDescriptorSetLayout> sets;
     for (const auto& l : info.set_layouts) {
-        detail::require_handle(l, "vkrc::PipelineLayout::create", "a DescriptorSetLayout");
-        require(l.device() == device, "vkrc::PipelineLayout::create",
-                "a DescriptorSetLayout belongs to another device");
+        caller.require_handle(l, "a DescriptorSetLayout");
+        caller.require(l.device() == device, "a DescriptorSetLayout belongs to another device");
         sets.push_back(l.vk());
     }
     VkPipelineLayoutCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
@@ -86,14 +85,14 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
 }
 
 RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& info) {
-    const char* who = "vkrc::RenderPass::create";
-    detail::require_handle(device, who, "the Device");
-    require(!info.subpasses.empty(), who, "subpasses is empty");
+    const detail::Caller caller{"vkrc::RenderPass::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(!info.subpasses.empty(), "subpasses is empty");
     std::vector<VkSubpassDescription> subpasses;
     std::vector<std::uint32_t> color_counts;
     for (const auto& sp : info.subpasses) {
-        require(sp.resolve_attachments.empty() || sp.resolve_attachments.size() == sp.color_attachments.size(), who,
-                "resolve_attachments must be empty or one per colour attachment");
+        caller.require(sp.resolve_attachments.empty() || sp.resolve_attachments.size() == sp.color_attachments.size(),
+                       "resolve_attachments must be empty or one per colour attachment");
         VkSubpassDescription d{};
         d.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
         d.inputAttachmentCount = static_cast<std::uint32_t>(sp.input_attachments.size());
@@ -124,19 +123,19 @@ RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& 
 }
 
 std::uint32_t RenderPass::color_attachment_count(std::uint32_t subpass) const {
-    require(subpass < state_->color_counts.size(), "vkrc::RenderPass::color_attachment_count",
-            "the subpass does not exist");
+    detail::Caller("vkrc::RenderPass::color_attachment_count")
+        .require(subpass < state_->color_counts.size(), "the subpass does not exist");
     return state_->color_counts[subpass];
 }
 
 Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInfo& info) {
-    const char* who = "vkrc::Framebuffer::create";
-    detail::require_handle(device, who, "the Device");
-    require(static_cast<bool>(info.render_pass), who, "render_pass is empty");
-    require(info.width > 0 && info.height > 0 && info.layers > 0, who, "width, height and layers must be non-zero");
+    const detail::Caller caller{"vkrc::Framebuffer::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(static_cast<bool>(info.render_pass), "render_pass is empty");
+    caller.require(info.width > 0 && info.height > 0 && info.layers > 0, "width, height and layers must be non-zero");
     std::vector<VkImageView> views;
     for (const auto& v : info.attachments) {
-        detail::require_handle(v, who, "an attachment ImageView");
+        caller.require_handle(v, "an attachment ImageView");
         views.push_back(v.vk());
     }
     VkFramebufferCreateInfo ci{VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
@@ -159,7 +158,7 @@ Framebuffer Framebuffer::create(const Device& device, const FramebufferCreateInf
 // Pipeline caches
 
 PipelineCache PipelineCache::create(const Device& device, Span<const std::byte> initial_data) {
-    detail::require_handle(device, "vkrc::PipelineCache::create", "the Device");
+    detail::Caller("vkrc::PipelineCache::create").require_handle(device, "the Device");
     VkPipelineCacheCreateInfo ci{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
     ci.initialDataSize = initial_data.size();
     ci.pInitialData = initial_data.data();
@@ -189,7 +188,7 @@ const char* cache_data_problem(const PhysicalDevice& physical, const std::vector
 }  // namespace
 
 PipelineCache PipelineCache::load(const Device& device, const char* file) {
-    detail::require_handle(device, "vkrc::PipelineCache::load", "the Device");
+    detail::Caller("vkrc::PipelineCache::load").require_handle(device, "the Device");
     std::vector<std::byte> data;
     const char* problem = nullptr;
     std::ifstream in(file, std::ios::binary);
@@ -251,9 +250,10 @@ GraphicsPipelineBuilder::GraphicsPipelineBuilder(PipelineLayout layout)
 
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                                          const char* entry_point) {
-    detail::require_handle(module, "vkrc::GraphicsPipelineBuilder::shader", "the ShaderModule");
-    require(module.device() == layout_.device(), "vkrc::GraphicsPipelineBuilder::shader",
-            "the ShaderModule belongs to another device than the pipeline layout");
+    const detail::Caller caller{"vkrc::GraphicsPipelineBuilder::shader"};
+    caller.require_handle(module, "the ShaderModule");
+    caller.require(module.device() == layout_.device(),
+                   "the ShaderModule belongs to another device than the pipeline layout");
     stages_.push_back({stage, module, entry_point});
     return *this;
 }

@@ -10,15 +10,13 @@
 
 VKRC_BEGIN_NAMESPACE
 
-using detail::require;
-
 namespace {
 
-void check_specialization(const Specialization& spec, const char* who) {
+void check_specialization(const detail::Caller& caller, const Specialization& spec) {
     for (const auto& e : spec.map_entries) {
-        require(e.offset <= spec.data.size() && e.size <= spec.data.size() - e.offset, who,
-                "specialization constant " + std::to_string(e.constantID) + " lies outside the data (" +
-                    std::to_string(spec.data.size()) + " bytes)");
+        caller.require(e.offset <= spec.data.size() && e.size <= spec.data.size() - e.offset,
+                       "specialization constant ", e.constantID, " lies outside the data (", spec.data.size(),
+                       " bytes)");
     }
 }
 
@@ -35,7 +33,9 @@ bool contains(Span<const VkDynamicState> states, VkDynamicState state) {
 
 VkBool32 vk_bool(bool b) { return b ? VK_TRUE : VK_FALSE; }
 
-constexpr const char* build_who = "vkrc::GraphicsPipelineBuilder::build";
+// build() and the private members it calls (declared in the public header,
+// which does not know detail::Caller) refuse as one function.
+constexpr detail::Caller build_caller{"vkrc::GraphicsPipelineBuilder::build"};
 
 // The state of a new pipeline of layout, its handle made by create
 // (vkCreateGraphicsPipelines or vkCreateComputePipelines; call names it) from ci.
@@ -54,12 +54,12 @@ detail::Ref<detail::PipelineState> created_pipeline(const PipelineLayout& layout
 }  // namespace
 
 ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const ComputePipelineCreateInfo& info) {
-    const char* who = "vkrc::ComputePipeline::create";
-    detail::require_handle(layout, who, "the PipelineLayout");
-    detail::require_handle(info.module, who, "the ShaderModule");
-    require(info.module.device() == layout.device(), who,
-            "the ShaderModule belongs to another device than the pipeline layout");
-    check_specialization(info.specialization, who);
+    const detail::Caller caller{"vkrc::ComputePipeline::create"};
+    caller.require_handle(layout, "the PipelineLayout");
+    caller.require_handle(info.module, "the ShaderModule");
+    caller.require(info.module.device() == layout.device(),
+                   "the ShaderModule belongs to another device than the pipeline layout");
+    check_specialization(caller, info.specialization);
     const auto spec = specialization_info(info.specialization.map_entries, info.specialization.data);
     VkComputePipelineCreateInfo ci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     ci.pNext = info.next;
@@ -120,7 +120,7 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::primitive_restart(bool enable)
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::specialization(VkShaderStageFlagBits stage,
                                                                  const Specialization& spec) {
-    check_specialization(spec, "vkrc::GraphicsPipelineBuilder::specialization");
+    check_specialization(detail::Caller{"vkrc::GraphicsPipelineBuilder::specialization"}, spec);
     Specialized copy{stage, spec.map_entries, spec.data};
     for (auto& s : specializations_) {
         if (s.stage == stage) {
@@ -151,7 +151,7 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::next(const void* chain) {
 List<VkPipelineShaderStageCreateInfo> GraphicsPipelineBuilder::shader_stages() const {
     List<VkPipelineShaderStageCreateInfo> stages;
     for (const auto& st : stages_) {
-        detail::require_handle(st.module, build_who, "a ShaderModule");
+        build_caller.require_handle(st.module, "a ShaderModule");
         VkPipelineShaderStageCreateInfo si{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
         si.stage = st.stage;
         si.module = st.module.vk();
@@ -165,7 +165,7 @@ void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageC
                                                      Span<VkSpecializationInfo> infos) const {
     for (const auto& sp : specializations_) {
         auto it = std::find_if(stages.begin(), stages.end(), [&](const auto& st) { return st.stage == sp.stage; });
-        require(it != stages.end(), build_who, "a specialization names a stage without a shader");
+        build_caller.require(it != stages.end(), "a specialization names a stage without a shader");
         auto& info = infos[static_cast<std::size_t>(it - stages.begin())];
         info = specialization_info(sp.entries, sp.data);
         it->pSpecializationInfo = &info;
@@ -175,24 +175,26 @@ void GraphicsPipelineBuilder::attach_specializations(Span<VkPipelineShaderStageC
 void GraphicsPipelineBuilder::check_tessellation() const {
     bool tessellated = false;
     for (const auto& st : stages_) tessellated |= (st.stage & tessellation_stages) != 0;
-    require(!tessellated || patch_control_points_ > 0, build_who, "tessellation shaders without tessellation()");
-    require(!tessellated || topology_ == VK_PRIMITIVE_TOPOLOGY_PATCH_LIST, build_who,
-            "tessellation shaders need topology PATCH_LIST");
+    build_caller.require(!tessellated || patch_control_points_ > 0, "tessellation shaders without tessellation()");
+    build_caller.require(!tessellated || topology_ == VK_PRIMITIVE_TOPOLOGY_PATCH_LIST,
+                         "tessellation shaders need topology PATCH_LIST");
 }
 
 VkPipelineViewportStateCreateInfo GraphicsPipelineBuilder::viewport_state() const {
-    require(viewports_.empty() || scissors_.empty() || viewports_.size() == scissors_.size(), build_who,
-            "viewports and scissors differ in count");
+    build_caller.require(viewports_.empty() || scissors_.empty() || viewports_.size() == scissors_.size(),
+                         "viewports and scissors differ in count");
     const auto count = static_cast<std::uint32_t>(std::max<std::size_t>({1, viewports_.size(), scissors_.size()}));
     VkPipelineViewportStateCreateInfo v{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
     // With counts dynamic, Vulkan wants 0 here.
     const bool dynamic_viewports = contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT_WITH_COUNT);
     const bool dynamic_scissors = contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR_WITH_COUNT);
     // Static ones must be given: Vulkan would read them from a null pointer.
-    require(viewports_.size() > 0 || dynamic_viewports || contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT),
-            build_who, "viewports are neither dynamic nor given with viewports()");
-    require(scissors_.size() > 0 || dynamic_scissors || contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR), build_who,
-            "scissors are neither dynamic nor given with scissors()");
+    build_caller.require(
+        viewports_.size() > 0 || dynamic_viewports || contains(dynamic_states_, VK_DYNAMIC_STATE_VIEWPORT),
+        "viewports are neither dynamic nor given with viewports()");
+    build_caller.require(
+        scissors_.size() > 0 || dynamic_scissors || contains(dynamic_states_, VK_DYNAMIC_STATE_SCISSOR),
+        "scissors are neither dynamic nor given with scissors()");
     v.viewportCount = dynamic_viewports ? 0 : count;
     v.pViewports = viewports_.empty() ? nullptr : viewports_.data();
     v.scissorCount = dynamic_scissors ? 0 : count;
@@ -260,8 +262,8 @@ VkPipelineInputAssemblyStateCreateInfo GraphicsPipelineBuilder::input_assembly_s
 }
 
 VkPipelineRenderingCreateInfo GraphicsPipelineBuilder::rendering_info() const {
-    require(!render_pass_ || view_mask_ == 0, build_who,
-            "view_mask is for dynamic rendering; a render pass has its own");
+    build_caller.require(!render_pass_ || view_mask_ == 0,
+                         "view_mask is for dynamic rendering; a render pass has its own");
     VkPipelineRenderingCreateInfo r{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
     r.pNext = next_;
     if (render_pass_) return r;  // unused: the render pass describes the attachments
@@ -275,10 +277,8 @@ VkPipelineRenderingCreateInfo GraphicsPipelineBuilder::rendering_info() const {
 
 VkPipelineColorBlendStateCreateInfo GraphicsPipelineBuilder::color_blend_state(
     std::uint32_t color_count, List<VkPipelineColorBlendAttachmentState>& attachments) const {
-    if (!blends_.empty() && blends_.size() != color_count) {
-        throw UsageError(std::string(build_who) + ": blend_attachments has " + std::to_string(blends_.size()) +
-                         " states for " + std::to_string(color_count) + " colour attachments");
-    }
+    build_caller.require(blends_.empty() || blends_.size() == color_count, "blend_attachments has ", blends_.size(),
+                         " states for ", color_count, " colour attachments");
     if (!blends_.empty()) {
         attachments = blends_;
     } else {
@@ -302,8 +302,8 @@ VkPipelineDynamicStateCreateInfo GraphicsPipelineBuilder::dynamic_state_info() c
 }
 
 GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) const {
-    detail::require_handle(layout_, build_who, "the PipelineLayout");
-    require(!stages_.empty(), build_who, "no shader stages");
+    build_caller.require_handle(layout_, "the PipelineLayout");
+    build_caller.require(!stages_.empty(), "no shader stages");
     auto stages = shader_stages();
     std::vector<VkSpecializationInfo> specs(stages_.size());
     attach_specializations(stages, specs);

@@ -289,7 +289,7 @@ struct PoolAllocator::Impl {
     // out to it; larger values put linear and optimal resources in separate blocks.
     static constexpr VkDeviceSize max_rounded_granularity = 4096;
 
-    void bind(DeviceView d, const char* who);
+    void bind(DeviceView d, const detail::Caller& caller);
     Shard& lock_shard() noexcept;
     void count_memory_object(DeviceView d);
     Block& new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least);
@@ -301,12 +301,12 @@ struct PoolAllocator::Impl {
     HeapStatistics& heap(Shard& shard, std::uint32_t type) noexcept { return shard.stats.heaps[heap_of[type]]; }
 };
 
-void PoolAllocator::Impl::bind(DeviceView d, const char* who) {
+void PoolAllocator::Impl::bind(DeviceView d, const detail::Caller& caller) {
     if (device.load(__ATOMIC_ACQUIRE) == &d.state()) return;
     LockGuard lock(bind_mutex);
     detail::DeviceState* now = device.load(__ATOMIC_ACQUIRE);
     if (now == &d.state()) return;
-    if (now) throw UsageError(std::string(who) + ": this PoolAllocator serves another device");
+    caller.require(!now, "this PoolAllocator serves another device");
     granularity = std::max<VkDeviceSize>(1, d.limits().bufferImageGranularity);
     atom = std::max<VkDeviceSize>(1, d.limits().nonCoherentAtomSize);
     const auto& props = d.memory_properties();
@@ -477,13 +477,11 @@ Pool& PoolAllocator::Impl::pool_for(Shard& shard, std::uint32_t type, const Allo
 }
 
 PoolAllocator::PoolAllocator(const PoolAllocatorCreateInfo& info) : impl_(nullptr) {
-    if (info.min_block_size == 0 || info.max_block_size < info.min_block_size) {
-        throw UsageError("vkrc::PoolAllocator: min_block_size must be non-zero and at most max_block_size");
-    }
-    if (info.shards > max_pool_shards) {
-        throw UsageError("vkrc::PoolAllocator: shards is " + std::to_string(info.shards) + ", more than " +
-                         std::to_string(max_pool_shards));
-    }
+    const detail::Caller caller{"vkrc::PoolAllocator"};
+    caller.require(info.min_block_size != 0 && info.max_block_size >= info.min_block_size, "min_block_size ",
+                   info.min_block_size, " and max_block_size ", info.max_block_size,
+                   ": min_block_size must be non-zero and at most max_block_size");
+    caller.require(info.shards <= max_pool_shards, "shards is ", info.shards, ", more than ", max_pool_shards);
     auto impl = std::make_unique<Impl>();
     impl->info = info;
     if (impl->info.dedicated_threshold == 0) impl->info.dedicated_threshold = info.max_block_size / 2;
@@ -500,12 +498,13 @@ PoolAllocator::~PoolAllocator() {
 std::uint32_t PoolAllocator::shard_count() const noexcept { return impl_->shard_count; }
 
 AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& request) {
-    constexpr const char* who = "vkrc::PoolAllocator::allocate";
+    const detail::Caller caller{"vkrc::PoolAllocator::allocate"};
     const auto& props = d.memory_properties();
-    const std::uint32_t type = choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, who);
-    detail::check_request(d, request, type, who);
+    const std::uint32_t type =
+        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
+    detail::check_request(caller, d, request, type);
     auto& m = *impl_;
-    m.bind(d, who);
+    m.bind(d, caller);
 
     AllocationInfo info;
     info.size = request.requirements.size;
@@ -520,13 +519,10 @@ AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& re
 }
 
 void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
-    if (allocation.allocator != this) {
-        throw UsageError("vkrc::PoolAllocator::free: the allocation was made by another allocator");
-    }
+    const detail::Caller caller{"vkrc::PoolAllocator::free"};
+    caller.require(allocation.allocator == this, "the allocation was made by another allocator");
     auto& m = *impl_;
-    if (m.device.load(__ATOMIC_ACQUIRE) != &d.state()) {
-        throw UsageError("vkrc::PoolAllocator::free: this PoolAllocator serves another device");
-    }
+    caller.require(m.device.load(__ATOMIC_ACQUIRE) == &d.state(), "this PoolAllocator serves another device");
     if (allocation.dedicated) {
         d.fn().vkFreeMemory(d.vk(), allocation.memory, nullptr);
         m.memory_objects.fetch_sub(1, __ATOMIC_RELAXED);

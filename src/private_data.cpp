@@ -14,11 +14,11 @@ PrivateDataSlotState::~PrivateDataSlotState() {
 
 PrivateDataSlot PrivateDataSlot::adopt(const Device& device, VkPrivateDataSlot slot, Ownership ownership) {
     return PrivateDataSlot(detail::adopted_state<detail::PrivateDataSlotState>(
-        "vkrc::PrivateDataSlot::adopt", device, "the Device", slot, "VkPrivateDataSlot", ownership));
+        detail::Caller{"vkrc::PrivateDataSlot::adopt"}, device, "the Device", slot, "VkPrivateDataSlot", ownership));
 }
 
 PrivateDataSlot PrivateDataSlot::create(const Device& device, const PrivateDataSlotCreateInfo& info) {
-    detail::require_handle(device, "vkrc::PrivateDataSlot::create", "the Device");
+    detail::Caller("vkrc::PrivateDataSlot::create").require_handle(device, "the Device");
     VkPrivateDataSlotCreateInfo ci{VK_STRUCTURE_TYPE_PRIVATE_DATA_SLOT_CREATE_INFO, info.next, info.flags};
     return PrivateDataSlot(
         detail::created_state<detail::PrivateDataSlotState, &DeviceFunctions::vkCreatePrivateDataSlot>(

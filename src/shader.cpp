@@ -18,20 +18,15 @@ ShaderModuleState::~ShaderModuleState() { destroy_owned<&DeviceFunctions::vkDest
 namespace {
 constexpr std::uint32_t spirv_magic = 0x07230203;
 
-detail::Ref<detail::ShaderModuleState> make(const Device& device, const void* code, std::size_t bytes,
-                                            const char* who) {
-    detail::require_handle(device, who, "the Device");
-    if (bytes == 0) throw UsageError(std::string(who) + ": the SPIR-V module is empty");
-    if (bytes % 4 != 0) {
-        throw UsageError(std::string(who) + ": the SPIR-V size (" + std::to_string(bytes) +
-                         " bytes) is not a multiple of 4");
-    }
+detail::Ref<detail::ShaderModuleState> make(const detail::Caller& caller, const Device& device, const void* code,
+                                            std::size_t bytes) {
+    caller.require_handle(device, "the Device");
+    caller.require(bytes != 0, "the SPIR-V module is empty");
+    caller.require(bytes % 4 == 0, "the SPIR-V size (", bytes, " bytes) is not a multiple of 4");
     std::uint32_t magic = 0;
     std::memcpy(&magic, code, 4);
-    if (magic != spirv_magic) {
-        throw UsageError(std::string(who) + ": not SPIR-V (magic number 0x" + detail::hex(magic, 8) +
-                         ", expected 0x07230203)");
-    }
+    if (magic != spirv_magic)
+        caller.refuse("not SPIR-V (magic number 0x", detail::hex(magic, 8), ", expected 0x07230203)");
     VkShaderModuleCreateInfo ci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     ci.codeSize = bytes;
     ci.pCode = static_cast<const std::uint32_t*>(code);
@@ -41,29 +36,29 @@ detail::Ref<detail::ShaderModuleState> make(const Device& device, const void* co
 }  // namespace
 
 ShaderModule ShaderModule::create(const Device& device, Span<const std::uint32_t> spirv) {
-    return ShaderModule(make(device, spirv.data(), spirv.size_bytes(), "vkrc::ShaderModule::create"));
+    return ShaderModule(make(detail::Caller{"vkrc::ShaderModule::create"}, device, spirv.data(), spirv.size_bytes()));
 }
 
 ShaderModule ShaderModule::create(const Device& device, Span<const std::byte> spirv) {
     // Vulkan wants 4-byte-aligned words; bytes from anywhere are copied into them.
     std::vector<std::uint32_t> words((spirv.size() + 3) / 4);
     if (!spirv.empty()) std::memcpy(words.data(), spirv.data(), spirv.size());
-    return ShaderModule(make(device, words.data(), spirv.size(), "vkrc::ShaderModule::create"));
+    return ShaderModule(make(detail::Caller{"vkrc::ShaderModule::create"}, device, words.data(), spirv.size()));
 }
 
 ShaderModule ShaderModule::adopt(const Device& device, VkShaderModule module, Ownership ownership) {
     return ShaderModule(detail::adopted_state<detail::ShaderModuleState>(
-        "vkrc::ShaderModule::adopt", device, "the Device", module, "VkShaderModule", ownership));
+        detail::Caller{"vkrc::ShaderModule::adopt"}, device, "the Device", module, "VkShaderModule", ownership));
 }
 
 ShaderModule ShaderModule::load(const Device& device, const char* spv_file) {
+    const detail::Caller caller{"vkrc::ShaderModule::load"};
     std::ifstream in(spv_file, std::ios::binary);
-    if (!in) throw UsageError("vkrc::ShaderModule::load: cannot open " + std::string(spv_file));
+    caller.require(static_cast<bool>(in), "cannot open ", spv_file);
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     std::vector<std::uint32_t> words((bytes.size() + 3) / 4);
     if (!bytes.empty()) std::memcpy(words.data(), bytes.data(), bytes.size());
-    const std::string who = "vkrc::ShaderModule::load: " + std::string(spv_file);
-    return ShaderModule(make(device, words.data(), bytes.size(), who.c_str()));
+    return ShaderModule(make(detail::Caller(caller.name(), spv_file), device, words.data(), bytes.size()));
 }
 
 VKRC_END_NAMESPACE

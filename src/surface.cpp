@@ -16,12 +16,11 @@ SurfaceState::~SurfaceState() {
 }  // namespace detail
 
 Surface Surface::adopt(const Instance& instance, VkSurfaceKHR surface, Ownership ownership) {
-    constexpr const char* who = "vkrc::Surface::adopt";
-    if (instance && !instance.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME)) {
-        throw UsageError(std::string(who) + ": the instance was created without VK_KHR_surface");
-    }
+    const detail::Caller caller{"vkrc::Surface::adopt"};
+    caller.require(!instance || instance.extension_enabled(VK_KHR_SURFACE_EXTENSION_NAME),
+                   "the instance was created without VK_KHR_surface");
     return Surface(detail::adopted_state<detail::SurfaceState, &detail::SurfaceState::instance>(
-        who, instance, "the Instance", surface, "VkSurfaceKHR", ownership));
+        caller, instance, "the Instance", surface, "VkSurfaceKHR", ownership));
 }
 
 VkSurfaceCapabilitiesKHR Surface::capabilities(const PhysicalDevice& physical_device) const {

@@ -17,7 +17,7 @@ namespace {
 struct SurfaceLease {
     // Marks the surface taken; waits once for a previous swapchain's
     // destruction still running, and throws UsageError when it stays.
-    static void take(const Surface& surface, const Device& device);
+    static void take(const detail::Caller& caller, const Surface& surface, const Device& device);
     // From ~SwapchainState: the surface is free again, or releasing until the
     // destruction of chain (the current Vulkan swapchain, if any) has run.
     static void give_back(detail::SurfaceState& surface, detail::SwapchainChainState* chain) noexcept;
@@ -25,25 +25,20 @@ struct SurfaceLease {
     static void end_release(detail::SurfaceState& surface) noexcept;
 };
 
-void SurfaceLease::take(const Surface& surface, const Device& device) {
+void SurfaceLease::take(const detail::Caller& caller, const Surface& surface, const Device& device) {
     auto& state = *surface.state();
     for (bool waited = false;; waited = true) {
         {
             LockGuard lock(state.mutex);
-            if (state.taken) {
-                throw UsageError(
-                    "vkrc::Swapchain::create: the surface already has a live Swapchain (re-create that one)");
-            }
+            caller.require(!state.taken, "the surface already has a live Swapchain (re-create that one)");
             if (!state.releasing) {
                 state.taken = true;
                 return;
             }
         }
-        if (waited) {
-            throw UsageError(
-                "vkrc::Swapchain::create: the surface's previous swapchain still exists (a Frame or "
-                "Image holds one of its images, or another device has not destroyed it)");
-        }
+        caller.require(!waited,
+                       "the surface's previous swapchain still exists (a Frame or Image holds one of its images, or "
+                       "another device has not destroyed it)");
         // The previous Swapchain's Vulkan swapchain is not retired: its
         // destruction must run before a new one can be made for the surface.
         device.wait_idle();
@@ -234,10 +229,10 @@ void log_images(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR&
 
 // Format, colour space and present mode: fixed for the swapchain's life,
 // so that pipelines made for its format stay valid across re-creation.
-void choose_format_and_mode(detail::SwapchainState& s) {
+void choose_format_and_mode(const detail::Caller& caller, detail::SwapchainState& s) {
     const auto& physical = s.queue.device().physical_device();
     auto formats = s.surface.formats(physical);
-    if (formats.empty()) throw UsageError("vkrc::Swapchain::create: the surface reports no formats");
+    caller.require(!formats.empty(), "the surface reports no formats");
     auto format = choose_format(formats, s.info.preferred_formats);
     s.surface_format = format.value;
     log_format(s, format.reason);
@@ -246,9 +241,10 @@ void choose_format_and_mode(detail::SwapchainState& s) {
 }
 
 void check_usage_supported(const VkSurfaceCapabilitiesKHR& caps, VkImageUsageFlags usage) {
-    if ((caps.supportedUsageFlags & usage) == usage) return;
-    throw UsageError("vkrc::Swapchain: the surface does not support image_usage " + std::to_string(usage) +
-                     " (supported: " + std::to_string(caps.supportedUsageFlags) + ")");
+    // Reached from create, acquire and recreate alike.
+    detail::Caller("vkrc::Swapchain")
+        .require((caps.supportedUsageFlags & usage) == usage, "the surface does not support image_usage ",
+                 detail::Hex{usage}, " (supported: ", detail::Hex{caps.supportedUsageFlags}, ")");
 }
 
 VkSwapchainCreateInfoKHR swapchain_create_info(const detail::SwapchainState& s, const VkSurfaceCapabilitiesKHR& caps,
@@ -354,26 +350,23 @@ Swapchain Swapchain::create(const Queue& queue, const Surface& surface) {
 }
 
 Swapchain Swapchain::create(const Queue& queue, const Surface& surface, const SwapchainCreateInfo& info) {
-    if (!queue) throw UsageError("vkrc::Swapchain::create: the Queue is empty");
-    detail::require_handle(surface, "vkrc::Swapchain::create", "the Surface");
+    const detail::Caller caller{"vkrc::Swapchain::create"};
+    caller.require(static_cast<bool>(queue), "the Queue is empty");
+    caller.require_handle(surface, "the Surface");
     const Device& device = queue.device();
-    if (!device.extension_enabled(VK_KHR_SWAPCHAIN_EXTENSION_NAME)) {
-        throw UsageError("vkrc::Swapchain::create: the device was created without VK_KHR_swapchain");
-    }
+    caller.require(device.extension_enabled(VK_KHR_SWAPCHAIN_EXTENSION_NAME),
+                   "the device was created without VK_KHR_swapchain");
     VkBool32 supported = VK_FALSE;
     check(device.instance().fn().vkGetPhysicalDeviceSurfaceSupportKHR(device.physical_device().vk(),
                                                                       queue.family_index(), surface.vk(), &supported),
           "vkGetPhysicalDeviceSurfaceSupportKHR");
-    if (!supported) {
-        throw UsageError("vkrc::Swapchain::create: queue family " + std::to_string(queue.family_index()) +
-                         " cannot present to the surface");
-    }
+    caller.require(supported == VK_TRUE, "queue family ", queue.family_index(), " cannot present to the surface");
     detail::Ref<detail::SwapchainState> state(new detail::SwapchainState);
-    SurfaceLease::take(surface, device);
+    SurfaceLease::take(caller, surface, device);
     state->surface = surface;  // from here the state's destructor gives the surface back
     state->queue = queue;
     state->info = info;
-    choose_format_and_mode(*state);
+    choose_format_and_mode(caller, *state);
     recreate_locked(*state);
     return Swapchain(std::move(state));
 }
@@ -422,9 +415,9 @@ PresentStatus Swapchain::acquire(Frame& frame) {
 
 PresentStatus Swapchain::present(const Frame& frame) {
     auto& s = *state_;
-    if (!frame || !frame.chain_ || frame.chain_->surface.state() != s.surface.state()) {
-        throw UsageError("vkrc::Swapchain::present: the frame was not acquired from this swapchain");
-    }
+    detail::Caller("vkrc::Swapchain::present")
+        .require(frame && frame.chain_ && frame.chain_->surface.state() == s.surface.state(),
+                 "the frame was not acquired from this swapchain");
     LockGuard lock(s.mutex);
     auto& chain = *frame.chain_;
     VkPresentInfoKHR info{VK_STRUCTURE_TYPE_PRESENT_INFO_KHR};

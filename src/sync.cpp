@@ -40,7 +40,7 @@ QueryPoolState::~QueryPoolState() { destroy_owned<&DeviceFunctions::vkDestroyQue
 }  // namespace detail
 
 Fence Fence::create(const Device& device, bool signaled) {
-    detail::require_handle(device, "vkrc::Fence::create", "the Device");
+    detail::Caller("vkrc::Fence::create").require_handle(device, "the Device");
     VkFenceCreateInfo ci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     if (signaled) ci.flags = VK_FENCE_CREATE_SIGNALED_BIT;
     return Fence(
@@ -48,8 +48,8 @@ Fence Fence::create(const Device& device, bool signaled) {
 }
 
 Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
-    return Fence(detail::adopted_state<detail::FenceState>("vkrc::Fence::adopt", device, "the Device", fence, "VkFence",
-                                                           ownership));
+    return Fence(detail::adopted_state<detail::FenceState>(detail::Caller{"vkrc::Fence::adopt"}, device, "the Device",
+                                                           fence, "VkFence", ownership));
 }
 
 VkResult Fence::wait(std::uint64_t timeout_ns) const {
@@ -84,31 +84,30 @@ detail::Ref<detail::SemaphoreState> make_semaphore(const Device& device, Semapho
 }  // namespace
 
 Semaphore Semaphore::create_binary(const Device& device) {
-    detail::require_handle(device, "vkrc::Semaphore::create_binary", "the Device");
+    detail::Caller("vkrc::Semaphore::create_binary").require_handle(device, "the Device");
     return Semaphore(make_semaphore(device, SemaphoreType::binary, 0));
 }
 
 Semaphore Semaphore::create_timeline(const Device& device, std::uint64_t initial_value) {
-    detail::require_handle(device, "vkrc::Semaphore::create_timeline", "the Device");
+    detail::Caller("vkrc::Semaphore::create_timeline").require_handle(device, "the Device");
     return Semaphore(make_semaphore(device, SemaphoreType::timeline, initial_value));
 }
 
 Semaphore Semaphore::adopt(const Device& device, VkSemaphore semaphore, SemaphoreType type, Ownership ownership) {
-    auto s = detail::adopted_state<detail::SemaphoreState>("vkrc::Semaphore::adopt", device, "the Device", semaphore,
-                                                           "VkSemaphore", ownership);
+    auto s = detail::adopted_state<detail::SemaphoreState>(detail::Caller{"vkrc::Semaphore::adopt"}, device,
+                                                           "the Device", semaphore, "VkSemaphore", ownership);
     s->type = type;
     return Semaphore(std::move(s));
 }
 
 namespace {
-void require_timeline(const Semaphore& s, const char* who) {
-    if (s.type() != SemaphoreType::timeline)
-        throw UsageError(std::string(who) + ": the semaphore is binary, not timeline");
+void require_timeline(const detail::Caller& caller, const Semaphore& s) {
+    caller.require(s.type() == SemaphoreType::timeline, "the semaphore is binary, not timeline");
 }
 }  // namespace
 
 std::uint64_t Semaphore::value() const {
-    require_timeline(*this, "vkrc::Semaphore::value");
+    require_timeline(detail::Caller{"vkrc::Semaphore::value"}, *this);
     const auto& d = state_->device;
     std::uint64_t v = 0;
     d.state()->finish_call(d.fn().vkGetSemaphoreCounterValue(d.vk(), state_->handle, &v), "vkGetSemaphoreCounterValue");
@@ -116,7 +115,7 @@ std::uint64_t Semaphore::value() const {
 }
 
 void Semaphore::signal(std::uint64_t value) const {
-    require_timeline(*this, "vkrc::Semaphore::signal");
+    require_timeline(detail::Caller{"vkrc::Semaphore::signal"}, *this);
     const auto& d = state_->device;
     VkSemaphoreSignalInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO};
     info.semaphore = state_->handle;
@@ -125,7 +124,7 @@ void Semaphore::signal(std::uint64_t value) const {
 }
 
 VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
-    require_timeline(*this, "vkrc::Semaphore::wait");
+    require_timeline(detail::Caller{"vkrc::Semaphore::wait"}, *this);
     const auto& d = state_->device;
     VkSemaphoreWaitInfo info{VK_STRUCTURE_TYPE_SEMAPHORE_WAIT_INFO};
     info.semaphoreCount = 1;
@@ -135,7 +134,7 @@ VkResult Semaphore::wait(std::uint64_t value, std::uint64_t timeout_ns) const {
 }
 
 Event Event::create(const Device& device, bool device_only) {
-    detail::require_handle(device, "vkrc::Event::create", "the Device");
+    detail::Caller("vkrc::Event::create").require_handle(device, "the Device");
     VkEventCreateInfo ci{VK_STRUCTURE_TYPE_EVENT_CREATE_INFO};
     if (device_only) ci.flags = VK_EVENT_CREATE_DEVICE_ONLY_BIT;
     return Event(
@@ -143,8 +142,8 @@ Event Event::create(const Device& device, bool device_only) {
 }
 
 Event Event::adopt(const Device& device, VkEvent event, Ownership ownership) {
-    return Event(detail::adopted_state<detail::EventState>("vkrc::Event::adopt", device, "the Device", event, "VkEvent",
-                                                           ownership));
+    return Event(detail::adopted_state<detail::EventState>(detail::Caller{"vkrc::Event::adopt"}, device, "the Device",
+                                                           event, "VkEvent", ownership));
 }
 
 void Event::set() const {
@@ -162,14 +161,13 @@ VkResult Event::status() const {
 
 namespace {
 // The state of a pool described by info, its VkQueryPool not yet set.
-detail::Ref<detail::QueryPoolState> query_pool_state(const Device& device, const QueryPoolCreateInfo& info,
-                                                     const char* who) {
-    detail::require_handle(device, who, "the Device");
-    if (info.query_count == 0) throw UsageError(std::string(who) + ": query_count is 0");
+detail::Ref<detail::QueryPoolState> query_pool_state(const detail::Caller& caller, const Device& device,
+                                                     const QueryPoolCreateInfo& info) {
+    caller.require_handle(device, "the Device");
+    caller.require(info.query_count != 0, "query_count is 0");
     const bool statistics = info.query_type == VK_QUERY_TYPE_PIPELINE_STATISTICS;
-    if (statistics && info.pipeline_statistics == 0) {
-        throw UsageError(std::string(who) + ": a PIPELINE_STATISTICS pool with no pipeline_statistics flags");
-    }
+    caller.require(!statistics || info.pipeline_statistics != 0,
+                   "a PIPELINE_STATISTICS pool with no pipeline_statistics flags");
     detail::Ref<detail::QueryPoolState> s(new detail::QueryPoolState);
     s->device = device;
     s->count = info.query_count;
@@ -181,15 +179,16 @@ detail::Ref<detail::QueryPoolState> query_pool_state(const Device& device, const
 
 QueryPool QueryPool::adopt(const Device& device, VkQueryPool pool, const QueryPoolCreateInfo& info,
                            Ownership ownership) {
-    auto s = query_pool_state(device, info, "vkrc::QueryPool::adopt");
-    if (pool == VK_NULL_HANDLE) throw UsageError("vkrc::QueryPool::adopt: the VkQueryPool is VK_NULL_HANDLE");
+    const detail::Caller caller{"vkrc::QueryPool::adopt"};
+    auto s = query_pool_state(caller, device, info);
+    caller.require_not_null(pool, "VkQueryPool");
     s->handle = pool;
     s->ownership = ownership;
     return QueryPool(std::move(s));
 }
 
 QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& info) {
-    auto s = query_pool_state(device, info, "vkrc::QueryPool::create");
+    auto s = query_pool_state(detail::Caller{"vkrc::QueryPool::create"}, device, info);
     VkQueryPoolCreateInfo ci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     ci.pNext = info.next;
     ci.queryType = info.query_type;
@@ -201,12 +200,11 @@ QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& inf
 
 VkResult QueryPool::results(std::uint32_t first_query, Span<std::uint64_t> out, VkQueryResultFlags flags,
                             std::uint32_t stride_words) const {
-    if (stride_words == 0) throw UsageError("vkrc::QueryPool::results: stride_words is 0");
+    const detail::Caller caller{"vkrc::QueryPool::results"};
+    caller.require(stride_words != 0, "stride_words is 0");
     const std::size_t count = out.size() / stride_words;
-    if (first_query > state_->count || count > state_->count - first_query) {
-        throw UsageError("vkrc::QueryPool::results: queries " + std::to_string(first_query) + "+" +
-                         std::to_string(count) + " exceed the pool's " + std::to_string(state_->count));
-    }
+    caller.require(first_query <= state_->count && count <= state_->count - first_query, "queries ", first_query, "+",
+                   count, " exceed the pool's ", state_->count);
     const auto& d = state_->device;
     VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->handle, first_query, static_cast<std::uint32_t>(count),
                                               out.size_bytes(), out.data(), stride_words * sizeof(std::uint64_t),

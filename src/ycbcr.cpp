@@ -16,10 +16,10 @@ SamplerYcbcrConversionState::~SamplerYcbcrConversionState() {
 
 SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSamplerYcbcrConversion conversion,
                                                      VkFormat format, Ownership ownership) {
-    constexpr const char* who = "vkrc::SamplerYcbcrConversion::adopt";
+    const detail::Caller caller{"vkrc::SamplerYcbcrConversion::adopt"};
     // Before the state exists: once it holds an owned conversion, a throw would destroy it.
-    if (format == VK_FORMAT_UNDEFINED) throw UsageError(std::string(who) + ": format is VK_FORMAT_UNDEFINED");
-    auto state = detail::adopted_state<detail::SamplerYcbcrConversionState>(who, device, "the Device", conversion,
+    caller.require(format != VK_FORMAT_UNDEFINED, "format is VK_FORMAT_UNDEFINED");
+    auto state = detail::adopted_state<detail::SamplerYcbcrConversionState>(caller, device, "the Device", conversion,
                                                                             "VkSamplerYcbcrConversion", ownership);
     state->format = format;
     return SamplerYcbcrConversion(std::move(state));
@@ -27,10 +27,9 @@ SamplerYcbcrConversion SamplerYcbcrConversion::adopt(const Device& device, VkSam
 
 SamplerYcbcrConversion SamplerYcbcrConversion::create(const Device& device,
                                                       const SamplerYcbcrConversionCreateInfo& info) {
-    detail::require_handle(device, "vkrc::SamplerYcbcrConversion::create", "the Device");
-    if (info.format == VK_FORMAT_UNDEFINED) {
-        throw UsageError("vkrc::SamplerYcbcrConversion::create: format is VK_FORMAT_UNDEFINED");
-    }
+    const detail::Caller caller{"vkrc::SamplerYcbcrConversion::create"};
+    caller.require_handle(device, "the Device");
+    caller.require(info.format != VK_FORMAT_UNDEFINED, "format is VK_FORMAT_UNDEFINED");
     VkSamplerYcbcrConversionCreateInfo ci{VK_STRUCTURE_TYPE_SAMPLER_YCBCR_CONVERSION_CREATE_INFO, info.next};
     ci.format = info.format;
     ci.ycbcrModel = info.ycbcr_model;

@@ -214,4 +214,48 @@ TEST_F(VulkanTest, MoreThanEightColourAttachmentsAreRejected) {
 }
 #endif
 
+// What the device's limits, features and format properties rule out is
+// refused at creation, naming the value and the limit (docs/validation.md).
+TEST_F(VulkanTest, CreationRespectsTheDevicesLimitsFeaturesAndFormats) {
+    vkrc::ImageCreateInfo image{.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                .extent = {1024, 1024, 1},
+                                .mip_levels = 12,
+                                .usage = VK_IMAGE_USAGE_SAMPLED_BIT};
+    expect_usage_error([&] { vkrc::Image::create(device, image); },
+                       {"vkrc::Image::create: mip_levels 12 exceeds the 11 levels a 1024x1024x1 image can have"});
+    image.mip_levels = 1;
+    image.samples = VK_SAMPLE_COUNT_64_BIT;  // lavapipe offers 1 and 4
+    expect_usage_error(
+        [&] { vkrc::Image::create(device, image); },
+        {"samples VK_SAMPLE_COUNT_64_BIT not supported for VK_FORMAT_R8G8B8A8_UNORM", "sampleCounts 0x"});
+    image.samples = VK_SAMPLE_COUNT_1_BIT;
+    image.initial_layout = VK_IMAGE_LAYOUT_GENERAL;
+    expect_usage_error([&] { vkrc::Image::create(device, image); },
+                       {"initial_layout VK_IMAGE_LAYOUT_GENERAL is neither UNDEFINED nor PREINITIALIZED"});
+    image.initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    image.format = VK_FORMAT_BC1_RGB_UNORM_BLOCK;  // never a colour attachment
+    image.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+    expect_usage_error([&] { vkrc::Image::create(device, image); },
+                       {"format VK_FORMAT_BC1_RGB_UNORM_BLOCK", "usage 0x10", "is not supported by the device"});
+    image.format = VK_FORMAT_R8G8B8A8_UNORM;
+    image.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+    image.sharing_mode = VK_SHARING_MODE_CONCURRENT;
+    image.queue_family_indices = {0};
+    expect_usage_error([&] { vkrc::Image::create(device, image); },
+                       {"concurrent sharing needs at least 2 queue_family_indices, got 1"});
+    image.sharing_mode = VK_SHARING_MODE_EXCLUSIVE;
+    const auto flat = vkrc::Image::create(device, image);
+    expect_usage_error([&] { vkrc::ImageView::create(flat, {.view_type = VK_IMAGE_VIEW_TYPE_CUBE}); },
+                       {"vkrc::ImageView::create: view_type VK_IMAGE_VIEW_TYPE_CUBE cannot view a VK_IMAGE_TYPE_2D"});
+    expect_usage_error([&] { vkrc::Sampler::create(device, {.min_lod = 4.0f, .max_lod = 2.0f}); },
+                       {"vkrc::Sampler::create: max_lod 2 is less than min_lod 4"});
+    expect_usage_error([&] { vkrc::Sampler::create(device, {.anisotropy_enable = true, .max_anisotropy = 4.0f}); },
+                       {"anisotropy_enable needs the samplerAnisotropy feature enabled"});
+    const float bias = physical_device.properties().limits.maxSamplerLodBias * 2;
+    expect_usage_error([&] { vkrc::Sampler::create(device, {.mip_lod_bias = bias}); },
+                       {"mip_lod_bias", "exceeds maxSamplerLodBias"});
+    expect_usage_error([&] { vkrc::Sampler::create(device, {.unnormalized_coordinates = true}); },
+                       {"unnormalized_coordinates needs mipmap_mode NEAREST, not VK_SAMPLER_MIPMAP_MODE_LINEAR"});
+}
+
 }  // namespace

@@ -271,6 +271,7 @@ public:
     VkSampleCountFlagBits samples = VK_SAMPLE_COUNT_1_BIT;
     VkImageUsageFlags usage = 0;
     VkImageCreateFlags flags = 0;
+    VkImageTiling tiling = VK_IMAGE_TILING_OPTIMAL;
     Allocation allocation;
     Function<void()> cleanup{};  // an adopted image's, queued after its destruction
     // What a borrowed image belongs to and keeps alive (a swapchain's images

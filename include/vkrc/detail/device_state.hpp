@@ -316,6 +316,8 @@ public:
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     List<Text> enabled_extensions;
+    // As enabled at creation (adopted: as the physical device offers them), for create-time checks.
+    DeviceFeatures enabled_features;
     List<QueueState> queues;                 // made once, never grows: Queue handles point into it
     std::size_t role_queues[3] = {0, 0, 0};  // by QueueRole: an index into queues
     Atomic<bool> lost{false};
