@@ -4,6 +4,7 @@
 #include "vkrc/instance.hpp"
 
 #include "vkrc/detail/list.hpp"
+#include "vkrc/detail/object_registry.hpp"
 #include "vkrc/detail/span.hpp"
 
 VKRC_BEGIN_NAMESPACE
@@ -471,6 +472,8 @@ public:
     OpenCommandBuffers commands;
     DeferredDestructor deferred;
     AllocatorRegistry allocators;
+    // Raw handle -> state of what descriptors point to (descriptor writes of raw handles).
+    ObjectRegistry objects;
 
 private:
     // Reads one queue's timeline into its completed cache; false on failure.
