@@ -6,6 +6,8 @@
 #include "support/vk_test.hpp"
 
 #include "shaders/descriptor_types.comp.h"
+#include "shaders/descriptor_types.frag.h"
+#include "shaders/fullscreen.vert.h"
 
 #include <span>
 #include <vector>
@@ -42,7 +44,7 @@ vkrc::Image uint_image(const vkrc::Device& device, const vkrc::CommandBuffer& cm
     cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&whole, 1));
     auto to_read = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout,
                                        VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_READ_BIT);
+                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
     cmd.pipeline_barrier({}, {}, std::span(&to_read, 1));
     return image;
 }
@@ -53,8 +55,11 @@ vkrc::Sampler nearest_sampler(const vkrc::Device& device) {
                                           .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST});
 }
 
-// The layout of shaders/descriptor_types.comp: one binding per descriptor type, the output last.
-vkrc::DescriptorSetLayout every_type_layout(const vkrc::Device& device) {
+// The layout of shaders/descriptor_types.comp (.frag with input_attachment):
+// one binding per descriptor type, the output, then the input attachment.
+vkrc::DescriptorSetLayout every_type_layout(const vkrc::Device& device,
+                                            VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT,
+                                            bool input_attachment = false) {
     const VkDescriptorType types[] = {
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC,
@@ -64,7 +69,9 @@ vkrc::DescriptorSetLayout every_type_layout(const vkrc::Device& device) {
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     vkrc::DescriptorSetLayoutCreateInfo info;
     for (std::uint32_t b = 0; b < std::size(types); ++b)
-        info.bindings.push_back({.binding = b, .descriptor_type = types[b], .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT});
+        info.bindings.push_back({.binding = b, .descriptor_type = types[b], .stage_flags = stages});
+    if (input_attachment)
+        info.bindings.push_back({.binding = 11, .descriptor_type = VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT, .stage_flags = stages});
     return vkrc::DescriptorSetLayout::create(device, info);
 }
 
@@ -74,7 +81,8 @@ vkrc::DescriptorPool every_type_pool(const vkrc::Device& device, std::uint32_t s
                                VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC,
                                VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
                                VK_DESCRIPTOR_TYPE_SAMPLER, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
-                               VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE})
+                               VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                               VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT})
         info.pool_sizes.push_back({t, 2 * sets});
     return vkrc::DescriptorPool::create(device, info);
 }
@@ -87,9 +95,63 @@ void submit_gated(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd, cons
     vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, fence);
 }
 
-// Every descriptor type a compute shader reads, each object's last handle
-// dropped right after its write and before any command buffer records the
-// set: the set alone keeps them, and the dispatch reads every value.
+// Writes bindings 0 to 10 of an every_type_layout set (values 100 to 109,
+// skipping 106: the sampler reads the sampled image), each object's last
+// handle dropped right after its write: the set alone keeps them.
+void write_every_type_and_drop(const vkrc::Device& device, const vkrc::Queue& queue, const vkrc::DescriptorSet& set,
+                               const vkrc::Buffer& out) {
+    vkrc_test::OneShotCommands prepare(queue);
+    auto sampled =
+        uint_image(device, prepare.cmd, 107, VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    auto combined =
+        uint_image(device, prepare.cmd, 108, VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    auto storage = uint_image(device, prepare.cmd, 109, VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_LAYOUT_GENERAL);
+    prepare.run(queue);
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, value_buffer(device, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 100));
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, value_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 101));
+    // The raw-handle forms, of objects vkrc made: found by handle, counted the same.
+    {
+        auto dynamic_uniform = value_buffer(device, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 102);
+        set.write_buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, dynamic_uniform.vk(), 0, 16);
+        auto dynamic_storage = value_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 103);
+        const VkDescriptorBufferInfo info{dynamic_storage.vk(), 0, 16};
+        set.write_buffers(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, std::span(&info, 1));
+    }
+    set.write_buffer_view(4, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                          vkrc::BufferView::create(value_buffer(device, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, 104),
+                                                   {.format = VK_FORMAT_R32_UINT}));
+    {
+        auto view = vkrc::BufferView::create(value_buffer(device, VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, 105),
+                                             {.format = VK_FORMAT_R32_UINT});
+        const VkBufferView raw = view.vk();
+        set.write_buffer_views(5, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, std::span(&raw, 1));
+    }
+    set.write_image(6, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED,
+                    nearest_sampler(device));
+    set.write_image(7, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, vkrc::ImageView::create(sampled),
+                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    {
+        auto view = vkrc::ImageView::create(combined);
+        auto sampler = nearest_sampler(device);
+        const VkDescriptorImageInfo info{sampler.vk(), view.vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+        set.write_images(8, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, std::span(&info, 1));
+        EXPECT_EQ(view.use_count(), 2u) << "the set keeps the view written by raw handle";
+        EXPECT_EQ(sampler.use_count(), 2u) << "and its sampler";
+    }
+    set.write_image(9, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, vkrc::ImageView::create(storage), VK_IMAGE_LAYOUT_GENERAL);
+    set.write_buffer(10, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
+    device.collect_garbage();
+}
+
+void expect_every_value(const vkrc::Buffer& out, std::uint32_t count) {
+    std::uint32_t data[10] = {};
+    out.allocation().read(0, data, count);
+    const std::uint32_t expected[10] = {100, 101, 102, 103, 104, 105, 107, 108, 109, 110};
+    for (std::uint32_t i = 0; i < count; ++i) EXPECT_EQ(data[i], expected[i]) << "binding " << i;
+}
+
+// Every descriptor type a compute shader reads, each object dropped after
+// its write and before any command buffer records the set.
 TEST_F(VulkanTest, EveryDescriptorTypeDroppedAfterTheWriteIsStillRead) {
     auto set_layout = every_type_layout(device);
     auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
@@ -98,53 +160,7 @@ TEST_F(VulkanTest, EveryDescriptorTypeDroppedAfterTheWriteIsStillRead) {
     auto pool = every_type_pool(device, 1);
     auto set = pool.allocate(set_layout);
     auto out = readback_buffer(device, 9 * sizeof(std::uint32_t));
-    {
-        vkrc_test::OneShotCommands prepare(queue);
-        auto sampled = uint_image(device, prepare.cmd, 107, VK_IMAGE_USAGE_SAMPLED_BIT,
-                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-        auto combined = uint_image(device, prepare.cmd, 108, VK_IMAGE_USAGE_SAMPLED_BIT,
-                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-        auto storage = uint_image(device, prepare.cmd, 109, VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_LAYOUT_GENERAL);
-        prepare.run(queue);
-        set.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                         value_buffer(device, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 100));
-        set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                         value_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 101));
-        // The raw-handle forms, of objects vkrc made: found by handle, counted the same.
-        {
-            auto dynamic_uniform = value_buffer(device, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 102);
-            set.write_buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, dynamic_uniform.vk(), 0, 16);
-            auto dynamic_storage = value_buffer(device, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 103);
-            const VkDescriptorBufferInfo info{dynamic_storage.vk(), 0, 16};
-            set.write_buffers(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER_DYNAMIC, std::span(&info, 1));
-        }
-        set.write_buffer_view(4, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
-                              vkrc::BufferView::create(
-                                  value_buffer(device, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, 104),
-                                  {.format = VK_FORMAT_R32_UINT}));
-        {
-            auto view = vkrc::BufferView::create(value_buffer(device, VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT, 105),
-                                                 {.format = VK_FORMAT_R32_UINT});
-            const VkBufferView raw = view.vk();
-            set.write_buffer_views(5, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, std::span(&raw, 1));
-        }
-        set.write_image(6, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED,
-                        nearest_sampler(device));
-        set.write_image(7, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, vkrc::ImageView::create(sampled),
-                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-        {
-            auto view = vkrc::ImageView::create(combined);
-            auto sampler = nearest_sampler(device);
-            const VkDescriptorImageInfo info{sampler.vk(), view.vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-            set.write_images(8, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, std::span(&info, 1));
-            EXPECT_EQ(view.use_count(), 2u) << "the set keeps the view written by raw handle";
-            EXPECT_EQ(sampler.use_count(), 2u) << "and its sampler";
-        }
-        set.write_image(9, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, vkrc::ImageView::create(storage),
-                        VK_IMAGE_LAYOUT_GENERAL);
-        set.write_buffer(10, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
-    }
-    device.collect_garbage();
+    write_every_type_and_drop(device, queue, set, out);
     vkrc_test::OneShotCommands use(queue);
     use.cmd.bind_pipeline(pipeline);
     const std::uint32_t offsets[] = {0, 0};
@@ -153,10 +169,66 @@ TEST_F(VulkanTest, EveryDescriptorTypeDroppedAfterTheWriteIsStillRead) {
     const auto to_host = vkrc_test::compute_to_host();
     use.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
     use.run(queue);
-    std::uint32_t data[9] = {};
-    out.allocation().read(0, data, 9);
-    const std::uint32_t expected[9] = {100, 101, 102, 103, 104, 105, 107, 108, 109};  // the sampler reads the sampled image
-    for (std::uint32_t i = 0; i < 9; ++i) EXPECT_EQ(data[i], expected[i]) << "binding " << i;
+    expect_every_value(out, 9);
+}
+
+// The same from a fragment shader, plus an input attachment (which the
+// framebuffer holds too): one fragment reads them all.
+TEST_F(VulkanTest, EveryDescriptorTypeDroppedAfterTheWriteIsStillReadByAFragmentShader) {
+    if (!vkrc_test::supported_features(physical_device).core.features.fragmentStoresAndAtomics)
+        GTEST_SKIP() << "the device lacks fragmentStoresAndAtomics";
+    vkrc::DeviceCreateInfo info;
+    info.enabled_features.fragmentStoresAndAtomics = VK_TRUE;
+    device = vkrc::Device::create(physical_device, info);
+    queue = device.default_queue();
+    auto set_layout = every_type_layout(device, VK_SHADER_STAGE_FRAGMENT_BIT, true);
+    auto pool = every_type_pool(device, 1);
+    auto set = pool.allocate(set_layout);
+    auto out = readback_buffer(device, 10 * sizeof(std::uint32_t));
+    write_every_type_and_drop(device, queue, set, out);
+    VkAttachmentDescription input{0,
+                                  VK_FORMAT_R32_UINT,
+                                  VK_SAMPLE_COUNT_1_BIT,
+                                  VK_ATTACHMENT_LOAD_OP_LOAD,
+                                  VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                  VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                  VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    auto render_pass = vkrc::RenderPass::create(
+        device, {.attachments = {input},
+                 .subpasses = {{.input_attachments = {{0, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}}}}});
+    vkrc::Framebuffer framebuffer;
+    {
+        vkrc_test::OneShotCommands prepare(queue);
+        auto image = uint_image(device, prepare.cmd, 110, VK_IMAGE_USAGE_INPUT_ATTACHMENT_BIT,
+                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        prepare.run(queue);
+        auto view = vkrc::ImageView::create(image);
+        set.write_image(11, VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        framebuffer = vkrc::Framebuffer::create(
+            device, {.render_pass = render_pass, .attachments = {view}, .width = 1, .height = 1});
+    }
+    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
+    auto pipeline =
+        vkrc::GraphicsPipelineBuilder(layout)
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::fullscreen_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::descriptor_types_frag))
+            .render_pass(render_pass)
+            .build();
+    vkrc_test::OneShotCommands use(queue);
+    use.cmd.begin_render_pass(render_pass, framebuffer, {{0, 0}, {1, 1}}, {});
+    use.cmd.bind_pipeline(pipeline);
+    use.cmd.set_viewport_and_scissor(framebuffer.extent());
+    const std::uint32_t offsets[] = {0, 0};
+    use.cmd.bind_descriptor_set(pipeline, 0, set, offsets);
+    use.cmd.draw(3);
+    use.cmd.end_render_pass();
+    const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                              VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    use.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    use.run(queue);
+    expect_every_value(out, 10);
 }
 
 // Overwriting a descriptor releases the old object as a drop does: while
