@@ -27,20 +27,26 @@ detail::BindlessTableState::Array& array_of(const detail::BindlessTableState& s,
     return const_cast<detail::BindlessTableState&>(s).arrays[static_cast<int>(kind)];
 }
 
-// Moves the removed slots the GPU is done with to their free lists and
-// drops their objects. Under the table's lock.
+// Moves the removed slots the GPU is done with to their free lists, then
+// drops their objects outside the box's lock (a drop may run deferred
+// actions, which take it). Under the table's lock.
 void collect(const detail::BindlessTableState& s) {
     auto& returns = *s.returns;
-    LockGuard lock(returns.mutex);
-    for (const std::uint64_t bits : returns.ready) {
-        const auto kind = static_cast<BindlessKind>(bits >> 32);
-        const auto slot = static_cast<std::uint32_t>(bits);
-        auto& a = array_of(s, kind);
-        a.free.push_back(slot);  // reserved for every slot: no allocation
-        --a.pending;
-        detail::release_descriptors(*s.set.state(), static_cast<std::uint32_t>(kind), Span(&slot, 1));
+    std::size_t before[2] = {s.arrays[0].free.size(), s.arrays[1].free.size()};
+    {
+        LockGuard lock(returns.mutex);
+        for (const std::uint64_t bits : returns.ready) {
+            auto& a = array_of(s, static_cast<BindlessKind>(bits >> 32));
+            a.free.push_back(static_cast<std::uint32_t>(bits));  // reserved for every slot: no allocation
+            --a.pending;
+        }
+        returns.ready.clear();
     }
-    returns.ready.clear();
+    for (std::uint32_t k = 0; k < 2; ++k) {
+        const auto& free = s.arrays[k].free;
+        detail::release_descriptors(*s.set.state(), k,
+                                    Span<const std::uint32_t>(free.data() + before[k], free.size() - before[k]));
+    }
 }
 
 // The DeferredAction of a removal: the slot is back.
@@ -62,8 +68,8 @@ std::uint32_t take_slot(const detail::BindlessTableState& s, BindlessKind kind, 
         a.free.resize(a.free.size() - 1);
         return slot;
     }
-    caller.require(a.capacity != 0, "the table holds no ", kind_name[static_cast<int>(kind)],
-                   " descriptors (its ", kind_name[static_cast<int>(kind)], "_capacity is 0)");
+    caller.require(a.capacity != 0, "the table holds no ", kind_name[static_cast<int>(kind)], " descriptors (its ",
+                   kind_name[static_cast<int>(kind)], "_capacity is 0)");
     if (a.fresh < a.capacity) {
         if (a.slots.size() <= a.fresh) a.slots.resize(std::min<std::size_t>(a.capacity, a.slots.size() * 2 + 64));
         return a.fresh++;
@@ -116,8 +122,8 @@ BindlessTable BindlessTable::create(const Device& device, const BindlessTableCre
     }
     const auto resources = vulkan12_properties(device.physical_device()).maxPerStageUpdateAfterBindResources;
     caller.require(std::uint64_t(capacity[0]) + capacity[1] <= resources, "image_capacity ", capacity[0],
-                   " and buffer_capacity ", capacity[1], " together are more than maxPerStageUpdateAfterBindResources (",
-                   resources, ")");
+                   " and buffer_capacity ", capacity[1],
+                   " together are more than maxPerStageUpdateAfterBindResources (", resources, ")");
     caller.require(capacity[0] + capacity[1] != 0, "both capacities are 0");
     DescriptorSetLayoutCreateInfo layout_info{.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT};
     DescriptorPoolCreateInfo pool_info{.flags = VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT, .max_sets = 1};

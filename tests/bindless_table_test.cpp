@@ -59,21 +59,8 @@ protected:
 
     // A 1x1 R32_UINT texture holding value, cleared by cmd before a compute read.
     vkrc::ImageView texture(const vkrc::CommandBuffer& cmd, std::uint32_t value) const {
-        auto image = vkrc::Image::create(device, {.format = VK_FORMAT_R32_UINT,
-                                                  .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-        auto to_dst = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                          VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                                          VK_ACCESS_2_TRANSFER_WRITE_BIT);
-        cmd.pipeline_barrier({}, {}, std::span(&to_dst, 1));
-        VkClearColorValue color{};
-        color.uint32[0] = value;
-        const VkImageSubresourceRange whole{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&whole, 1));
-        auto to_read = vkrc::image_barrier(
-            image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-            VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-        cmd.pipeline_barrier({}, {}, std::span(&to_read, 1));
+        auto image = vkrc_test::uint_image(device, cmd, value, VK_IMAGE_USAGE_SAMPLED_BIT,
+                                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
         return vkrc::ImageView::create(image);
     }
     vkrc::Buffer readback(std::uint32_t words) const {
@@ -100,8 +87,8 @@ struct TablePipeline {
 
 TablePipeline table_pipeline(const vkrc::Device& device, const vkrc::BindlessTable& table) {
     auto layout = vkrc::PipelineLayout::create(
-        device, {.set_layouts = {table.layout()},
-                 .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Params)}}});
+        device,
+        {.set_layouts = {table.layout()}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Params)}}});
     auto pipeline =
         vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::bindless_table_comp));
     return {layout, pipeline};

@@ -110,8 +110,8 @@ void inject_into_every_call(const char* what, const Scenario& scenario, std::siz
 
 TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
     inject_into_every_call(
-        "teapot scene", [](const vkrc::InstanceCreateInfo& info) { return vkrc_test::run_teapot_scenario(info); },
-        100, 50);
+        "teapot scene", [](const vkrc::InstanceCreateInfo& info) { return vkrc_test::run_teapot_scenario(info); }, 100,
+        50);
 }
 
 // Descriptor references and the bindless table (issue 30): a table made,
@@ -132,7 +132,8 @@ std::size_t run_descriptor_scenario(const vkrc::InstanceCreateInfo& info) {
     const auto first = table.add(buffer);
     auto layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
-    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
     auto set = pool.allocate(layout);
     set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer);
     auto commands = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
@@ -148,7 +149,8 @@ std::size_t run_descriptor_scenario(const vkrc::InstanceCreateInfo& info) {
     buffer.reset();
     set.reset();
     pool.reset_sets();
-    const auto second = table.add(vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT}));
+    const auto second =
+        table.add(vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT}));
     if (fence.wait() != VK_SUCCESS) return 0;
     table.remove(second);
     device.wait_idle();
