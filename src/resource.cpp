@@ -64,9 +64,16 @@ SamplerState::~SamplerState() {
 
 // Makes state findable by its raw handle (descriptor writes of raw handles
 // keep it alive through it); its destructor above forgets it.
+// An adoption that fails here leaves the handle to its caller (as every
+// failed adopt does), so the state gives it up before it goes.
 template <class State>
-Ref<State> registered(Ref<State> state, const Device& device, DescribedKind kind) {
-    device.state()->objects.add(kind, handle_bits(state->handle), state.get());
+Ref<State> registered(Ref<State> state, const Device& device, DescribedKind kind, bool adopted = false) {
+    try {
+        device.state()->objects.add(kind, handle_bits(state->handle), state.get());
+    } catch (...) {
+        if (adopted) state->ownership = Ownership::borrowed;
+        throw;
+    }
     return state;
 }
 
@@ -217,7 +224,7 @@ Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, V
     state->handle = buffer;
     state->cleanup = std::move(cleanup);
     state->device_address = query_device_address(device, buffer, usage);
-    return Buffer(detail::registered(std::move(state), device, detail::DescribedKind::buffer));
+    return Buffer(detail::registered(std::move(state), device, detail::DescribedKind::buffer, true));
 }
 
 VkImageAspectFlags format_aspects(VkFormat format) noexcept {
@@ -407,14 +414,14 @@ ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format
         "vkrc::ImageView::adopt", image, "the Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
-    return ImageView(detail::registered(std::move(state), image.device(), detail::DescribedKind::image_view));
+    return ImageView(detail::registered(std::move(state), image.device(), detail::DescribedKind::image_view, true));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
     return BufferView(
         detail::registered(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
                                "vkrc::BufferView::adopt", buffer, "the Buffer", view, "VkBufferView", ownership),
-                           buffer.device(), detail::DescribedKind::buffer_view));
+                           buffer.device(), detail::DescribedKind::buffer_view, true));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {

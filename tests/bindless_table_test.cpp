@@ -342,7 +342,7 @@ TEST_F(BindlessTableTest, AddsAndRemovesFromSeveralThreads) {
     }
     for (auto& w : workers) w.join();
     EXPECT_FALSE(duplicate.load());
-    EXPECT_EQ(table.live_count(vkrc::BindlessKind::buffer), threads * 9);
+    EXPECT_EQ(table.live_count(vkrc::BindlessKind::buffer), threads * 8);  // each keeps its last 8
 }
 #endif
 

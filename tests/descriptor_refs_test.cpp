@@ -361,15 +361,29 @@ TEST_F(VulkanTest, EveryWriteFormCountsAndOverwritesRelease) {
     set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, b);
     EXPECT_EQ(b.use_count(), 2u) << "the same object again: still one reference";
 
-    // A raw handle vkrc did not make keeps its documented contract: not counted.
+    // A raw handle vkrc did not make keeps its documented contract: it is
+    // written, not counted (and what the descriptor held is released).
     VkBufferCreateInfo ci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
     ci.size = 256;
     ci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     VkBuffer raw = VK_NULL_HANDLE;
     ASSERT_EQ(device.fn().vkCreateBuffer(device.vk(), &ci, nullptr, &raw), VK_SUCCESS);
-    auto borrowed = vkrc::Buffer::adopt(device, raw, 256, ci.usage, vkrc::Ownership::borrowed);
-    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, a);
+    VkMemoryRequirements requirements;
+    device.fn().vkGetBufferMemoryRequirements(device.vk(), raw, &requirements);
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = requirements.size;
+    ai.memoryTypeIndex = static_cast<std::uint32_t>(__builtin_ctz(requirements.memoryTypeBits));
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    ASSERT_EQ(device.fn().vkAllocateMemory(device.vk(), &ai, nullptr, &memory), VK_SUCCESS);
+    ASSERT_EQ(device.fn().vkBindBufferMemory(device.vk(), raw, memory, 0), VK_SUCCESS);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, raw);
     EXPECT_EQ(b.use_count(), 1u);
+    // Adopted, the same handle is vkrc's: counted.
+    auto borrowed = vkrc::Buffer::adopt(device, raw, 256, ci.usage, vkrc::Ownership::borrowed);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, raw);
+    EXPECT_EQ(borrowed.use_count(), 2u);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, a);
+    EXPECT_EQ(borrowed.use_count(), 1u);
 
     // Update templates count from their entries.
     auto update_template = vkrc::DescriptorUpdateTemplate::create(
@@ -395,6 +409,7 @@ TEST_F(VulkanTest, EveryWriteFormCountsAndOverwritesRelease) {
     borrowed.reset();
     device.wait_idle();
     device.fn().vkDestroyBuffer(device.vk(), raw, nullptr);
+    device.fn().vkFreeMemory(device.vk(), memory, nullptr);
 }
 
 TEST_F(VulkanTest, DescriptorWriteMisuseIsAUsageError) {
