@@ -800,7 +800,34 @@ def contention_section(pattern, pending):
     return out[:-1]
 
 
+DESCRIPTOR_PAIRS = [("vkrc-write1", "raw-write1"), ("vkrc-update1000", "raw-update1000"),
+                    ("vkrc-table1000", "raw-update1000")]
+
+
+def descriptors_section(pending):
+    """bench/descriptors_run.sh runs: ns and instructions per operation, vkrc against raw."""
+    found = sorted((load(p) for p in glob.glob(os.path.join(ROOT, "docs/results/*-descriptors.csv"))),
+                   key=lambda r: r["path"])
+    if not found:
+        return [pending]
+    out = []
+    for r in found:
+        get = {x["case"]: x for x in r["rows"]}
+        out += [run_line(r), "", f"    {r['meta'].get('command', '?')}", "",
+                "| case | ns per operation (median) | instructions per operation | vs raw: time | vs raw: instructions |",
+                "|---|---:|---:|---:|---:|"]
+        ref = dict(DESCRIPTOR_PAIRS)
+        for x in r["rows"]:
+            raw = get.get(ref.get(x["case"], ""))
+            ratio = (lambda k: f"{float(x[k]) / float(raw[k]):.2f}x") if raw else (lambda k: "")
+            out.append(f"| {x['case']} | {thousands(x['ns_per_op_median'])} | {thousands(x['instructions_per_op'])} | "
+                       f"{ratio('ns_per_op_median')} | {ratio('instructions_per_op')} |")
+        out.append("")
+    return out[:-1]
+
+
 BLOCKS = {
+    "descriptors": lambda: descriptors_section("No descriptor-write results in docs/results/ yet."),
     "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
     "upload-h200": lambda: upload_section(
         "H200", "**Pending:** no H200 upload run is committed yet. `bench/upload_run.sh BUILD_DIR OUT NAME` on the "

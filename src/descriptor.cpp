@@ -2,10 +2,12 @@
 
 #include "vkrc/descriptor_template.hpp"
 
+#include "caller.hpp"
 #include "object_state.hpp"
 #include "enum_names.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -22,11 +24,43 @@ DescriptorPoolState::~DescriptorPoolState() {
     destroy_owned<&DeviceFunctions::vkDestroyDescriptorPool>(*this, device);
 }
 
+namespace {
+void unlink_refs(DescriptorPoolState& p, DescriptorSetState& s) noexcept {
+    if (s.previous_with_refs) s.previous_with_refs->next_with_refs = s.next_with_refs;
+    else if (p.sets_with_refs == &s) p.sets_with_refs = s.next_with_refs;
+    if (s.next_with_refs) s.next_with_refs->previous_with_refs = s.previous_with_refs;
+    s.previous_with_refs = s.next_with_refs = nullptr;
+}
+}  // namespace
+
+// The references (the refs member) are released after the body, as drops:
+// the objects' destruction waits for the GPU like the set's free.
 DescriptorSetState::~DescriptorSetState() {
     auto& p = *pool.state();
-    if (!p.can_free_sets || !owns_handle()) return;
+    const bool free_set = p.can_free_sets && owns_handle();
+    if (!free_set && refs.empty()) return;
     LockGuard lock(p.mutex);
-    if (p.generation == generation) p.pending.push(*p.device.state(), handle, serial());
+    if (!refs.empty()) unlink_refs(p, *this);
+    if (free_set && p.generation == generation) p.pending.push(*p.device.state(), handle, serial());
+}
+
+// Resets the pool's sets: each one's references are moved to released (the
+// caller drops them after the pool's lock). Under the pool's lock.
+void release_set_refs(DescriptorPoolState& p, List<DescriptorRefs>& released) noexcept {
+    while (DescriptorSetState* set = p.sets_with_refs) {
+        unlink_refs(p, *set);
+        List<DescriptorRefs> refs;
+        refs.swap(set->refs);
+        if (released.empty()) {
+            released.swap(refs);
+            continue;
+        }
+        // Out of host memory: released here, under the lock; a release never takes it.
+        try {
+            released.reserve(released.size() + refs.size());
+            for (auto& r : refs) released.push_back(std::move(r));
+        } catch (...) {}
+    }
 }
 
 }  // namespace detail
@@ -68,14 +102,26 @@ void check_bindings(const detail::Caller& caller, const Device& device, const De
     }
 }
 
-// The bindings a layout checks writes against, and its variable-count binding.
+// The bindings a layout checks writes against, its variable-count binding,
+// and where each binding's descriptors sit in a set's references (an inline
+// uniform block counts bytes and references nothing).
 void keep_bindings(detail::DescriptorSetLayoutState& s, const List<DescriptorSetLayoutBinding>& bindings) {
     s.bindings = bindings;
-    for (const auto& b : bindings) {
+    s.first_slot.resize(bindings.size());
+    std::uint32_t next = 0;
+    for (std::size_t i = 0; i < bindings.size(); ++i) {
+        const auto& b = bindings[i];
         if (b.binding_flags & VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT) {
             s.has_variable_binding = true;
             s.variable_binding = b.binding;
+            continue;
         }
+        s.first_slot[i] = next;
+        if (b.descriptor_type != VK_DESCRIPTOR_TYPE_INLINE_UNIFORM_BLOCK) next += b.descriptor_count;
+    }
+    s.fixed_slots = next;
+    for (std::size_t i = 0; i < bindings.size(); ++i) {
+        if (s.has_variable_binding && bindings[i].binding == s.variable_binding) s.first_slot[i] = next;
     }
 }
 
@@ -237,10 +283,12 @@ DescriptorSet DescriptorSet::adopt(const DescriptorPool& pool, const DescriptorS
 
 void DescriptorPool::reset_sets() const {
     auto& p = *state_;
+    List<detail::DescriptorRefs> released;  // dropped after the lock, as drops
     LockGuard lock(p.mutex);
     check(p.device.fn().vkResetDescriptorPool(p.device.vk(), p.handle, 0), "vkResetDescriptorPool");
     p.pending.clear();
     ++p.generation;
+    detail::release_set_refs(p, released);
 }
 
 std::size_t DescriptorPool::pending_free_count() const {
@@ -259,30 +307,165 @@ bool is_image_type(VkDescriptorType t) {
            t == VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE || t == VK_DESCRIPTOR_TYPE_STORAGE_IMAGE ||
            t == VK_DESCRIPTOR_TYPE_INPUT_ATTACHMENT;
 }
+bool is_texel_type(VkDescriptorType t) {
+    return t == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER || t == VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER;
+}
 
 // The layout binding a write targets must exist, have the write's type and
 // hold the count elements from array_element on (VUID-VkWriteDescriptorSet-dstBinding-00315,
 // -descriptorType-00319, -dstArrayElement-00321); vkrc does not let a write
 // run on into the next binding. The variable binding holds the set's count.
-void check_write(const detail::Caller& caller, const detail::DescriptorSetState& s, std::uint32_t binding,
-                 VkDescriptorType type, std::uint32_t array_element, std::size_t count) {
-    if (!s.layout) return;
+// Returns the binding's index in the layout.
+std::size_t check_write(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                        std::uint32_t array_element, std::size_t count, const detail::Caller& caller) {
     const auto& layout = *s.layout.state();
-    for (const auto& b : layout.bindings) {
+    for (std::size_t i = 0; i < layout.bindings.size(); ++i) {
+        const auto& b = layout.bindings[i];
         if (b.binding != binding) continue;
         caller.require(b.descriptor_type == type, "binding ", binding, " has descriptor type ", b.descriptor_type,
                        " in the set layout, the write has type ", type);
         const bool variable = layout.has_variable_binding && layout.variable_binding == binding;
         const std::uint32_t size = variable ? s.variable_count : b.descriptor_count;
         if (array_element >= size || count > size - array_element) {
-            const std::string elements = count == 1 ? "array element " + std::to_string(array_element) + " is"
-                                                    : "array elements " + std::to_string(array_element) + " to " +
-                                                          std::to_string(array_element + count - 1) + " are";
-            caller.refuse(elements, " past binding ", binding, "'s ", size, " descriptors");
+            if (count == 1)
+                caller.refuse("array element ", array_element, " is past binding ", binding, "'s ", size,
+                              " descriptors");
+            caller.refuse("array elements ", array_element, " to ", array_element + count - 1, " are past binding ",
+                          binding, "'s ", size, " descriptors");
         }
-        return;
+        return i;
     }
     caller.refuse("the set layout has no binding ", binding);
+}
+
+// One descriptor's new references and where they go in the set's refs.
+struct SlotWrite {
+    std::uint32_t slot = 0;
+    detail::DescriptorRefs refs;
+};
+
+// The references of one descriptor whose info (a VkDescriptorBufferInfo,
+// VkDescriptorImageInfo, VkBufferView or VkAccelerationStructureKHR, by
+// type) is at info: the states vkrc made for its raw handles on this device.
+detail::DescriptorRefs refs_of(const detail::DeviceState& d, VkDescriptorType type, const void* info,
+                               bool immutable_sampler) {
+    using detail::DescribedKind;
+    detail::DescriptorRefs r;
+    if (is_buffer_type(type)) {
+        VkDescriptorBufferInfo b;
+        std::memcpy(&b, info, sizeof b);
+        r.object = d.objects.find(DescribedKind::buffer, detail::handle_bits(b.buffer));
+    } else if (is_image_type(type)) {
+        VkDescriptorImageInfo image;
+        std::memcpy(&image, info, sizeof image);
+        if (type != VK_DESCRIPTOR_TYPE_SAMPLER)
+            r.object = d.objects.find(DescribedKind::image_view, detail::handle_bits(image.imageView));
+        const bool has_sampler =
+            type == VK_DESCRIPTOR_TYPE_SAMPLER || type == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        if (has_sampler && !immutable_sampler)
+            r.sampler = d.objects.find(DescribedKind::sampler, detail::handle_bits(image.sampler));
+    } else if (is_texel_type(type)) {
+        VkBufferView view;
+        std::memcpy(&view, info, sizeof view);
+        r.object = d.objects.find(DescribedKind::buffer_view, detail::handle_bits(view));
+    } else if (type == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) {
+        VkAccelerationStructureKHR as;
+        std::memcpy(&as, info, sizeof as);
+        r.object = d.objects.find(DescribedKind::acceleration_structure, detail::handle_bits(as));
+    }
+    return r;
+}
+
+std::size_t info_size(VkDescriptorType type) noexcept {
+    if (is_buffer_type(type)) return sizeof(VkDescriptorBufferInfo);
+    if (is_image_type(type)) return sizeof(VkDescriptorImageInfo);
+    return sizeof(VkBufferView);
+}
+
+// The set's references, made at its first write, which puts the set on its
+// pool's list (reset_sets releases them). Under the pool's lock.
+void ensure_refs(detail::DescriptorPoolState& p, detail::DescriptorSetState& s) {
+    if (!s.refs.empty()) return;
+    const auto& layout = *s.layout.state();
+    const std::size_t count = layout.fixed_slots + (layout.has_variable_binding ? s.variable_count : 0);
+    if (count == 0) return;
+    s.refs.resize(count);
+    s.next_with_refs = p.sets_with_refs;
+    if (p.sets_with_refs) p.sets_with_refs->previous_with_refs = &s;
+    p.sets_with_refs = &s;
+}
+
+// Runs update (the Vulkan call), then swaps the writes' references into the
+// set, all under the pool's lock (reset_sets and drops on other threads see
+// the set's references whole). The writes come back holding the references
+// they replaced, which their owner drops after the lock: a drop, so the old
+// objects' destruction waits for the GPU.
+template <class Update>
+void update_keeping(const detail::DescriptorSetState& s, SlotWrite* writes, std::size_t count, const Update& update,
+                    const detail::Caller& caller) {
+    auto& set = const_cast<detail::DescriptorSetState&>(s);
+    auto& p = *s.pool.state();
+    LockGuard lock(p.mutex);
+    caller.require(s.generation == p.generation, "the set was invalidated by its pool's reset_sets()");
+    if (count != 0) ensure_refs(p, set);
+    update();
+    for (std::size_t i = 0; i < count; ++i) {
+        auto& kept = set.refs[writes[i].slot];
+        kept.object.swap(writes[i].refs.object);
+        kept.sampler.swap(writes[i].refs.sampler);
+    }
+}
+
+// One vkUpdateDescriptorSets of count descriptors of binding whose infos
+// (of the type's kind) start at infos, keeping what they point to.
+void write_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                 std::uint32_t array_element, std::size_t count, const void* infos, const detail::Caller& caller) {
+    const std::size_t b = check_write(s, binding, type, array_element, count, caller);
+    if (count == 0) return;
+    const auto& layout = *s.layout.state();
+    const bool immutable = !layout.bindings[b].immutable_samplers.empty();
+    const std::uint32_t first = layout.first_slot[b] + array_element;
+    const auto& d = *s.pool.device().state();
+    SlotWrite one;
+    List<SlotWrite> many;
+    if (count > 1) many.resize(count);
+    SlotWrite* writes = count > 1 ? many.data() : &one;
+    const std::size_t stride = info_size(type);
+    for (std::size_t i = 0; i < count; ++i) {
+        writes[i].slot = first + static_cast<std::uint32_t>(i);
+        writes[i].refs = refs_of(d, type, static_cast<const char*>(infos) + i * stride, immutable);
+    }
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = s.handle;
+    w.dstBinding = binding;
+    w.dstArrayElement = array_element;
+    w.descriptorCount = static_cast<std::uint32_t>(count);
+    w.descriptorType = type;
+    if (is_buffer_type(type)) w.pBufferInfo = static_cast<const VkDescriptorBufferInfo*>(infos);
+    else if (is_image_type(type)) w.pImageInfo = static_cast<const VkDescriptorImageInfo*>(infos);
+    else w.pTexelBufferView = static_cast<const VkBufferView*>(infos);
+    update_keeping(
+        s, writes, count, [&] { d.fn.vkUpdateDescriptorSets(d.device, 1, &w, 0, nullptr); }, caller);
+}
+
+void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                        Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element,
+                        const detail::Caller& caller) {
+    caller.require(is_buffer_type(type), "descriptor type ", type, " is not a buffer type");
+    write_infos(s, binding, type, array_element, infos.size(), infos.data(), caller);
+}
+
+void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                       Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element,
+                       const detail::Caller& caller) {
+    caller.require(is_image_type(type), "descriptor type ", type, " is not an image or sampler type");
+    write_infos(s, binding, type, array_element, infos.size(), infos.data(), caller);
+}
+
+void write_texel_views(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+                       Span<const VkBufferView> views, std::uint32_t array_element, const detail::Caller& caller) {
+    caller.require(is_texel_type(type), "descriptor type ", type, " is not a texel buffer type");
+    write_infos(s, binding, type, array_element, views.size(), views.data(), caller);
 }
 
 }  // namespace
@@ -311,50 +494,22 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, co
                 array_element);
 }
 
-namespace {
-// One vkUpdateDescriptorSets of count descriptors; exactly one of the infos is set.
-void update(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-            std::uint32_t array_element, std::size_t count, const VkDescriptorBufferInfo* buffer_info,
-            const VkDescriptorImageInfo* image_info) {
-    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    w.dstSet = s.handle;
-    w.dstBinding = binding;
-    w.dstArrayElement = array_element;
-    w.descriptorCount = static_cast<std::uint32_t>(count);
-    w.descriptorType = type;
-    w.pBufferInfo = buffer_info;
-    w.pImageInfo = image_info;
-    const auto& d = s.pool.device();
-    d.fn().vkUpdateDescriptorSets(d.vk(), 1, &w, 0, nullptr);
+void DescriptorSet::write_buffer_view(std::uint32_t binding, VkDescriptorType type, const BufferView& view,
+                                      std::uint32_t array_element) const {
+    const detail::Caller caller{"vkrc::DescriptorSet::write_buffer_view"};
+    caller.require_handle(view, "the BufferView");
+    caller.require(view.buffer().device() == pool().device(), "the buffer view belongs to another device");
+    const VkBufferView raw = view.vk();
+    write_texel_views(*state_, binding, type, Span(&raw, 1), array_element, caller);
 }
-}  // namespace
-
-namespace {
-
-void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                        Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element,
-                        const detail::Caller& caller) {
-    caller.require(is_buffer_type(type), "descriptor type ", type, " is not a buffer type");
-    check_write(caller, s, binding, type, array_element, infos.size());
-    if (!infos.empty()) update(s, binding, type, array_element, infos.size(), infos.data(), nullptr);
-}
-
-void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
-                       Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element,
-                       const detail::Caller& caller) {
-    caller.require(is_image_type(type), "descriptor type ", type, " is not an image or sampler type");
-    check_write(caller, s, binding, type, array_element, infos.size());
-    if (!infos.empty()) update(s, binding, type, array_element, infos.size(), nullptr, infos.data());
-}
-
-}  // namespace
 
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
     const detail::Caller caller{"vkrc::DescriptorSet::write_buffer"};
     VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
+    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element,
+                       detail::Caller{"vkrc::DescriptorSet::write_buffer"});
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
@@ -362,35 +517,90 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, Vk
     const detail::Caller caller{"vkrc::DescriptorSet::write_image"};
     VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorImageInfo info{sampler, view, layout};
-    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
+    write_image_infos(*state_, binding, type, Span(&info, 1), array_element,
+                      detail::Caller{"vkrc::DescriptorSet::write_image"});
 }
 
 void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,
                                   Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
-    const detail::Caller caller{"vkrc::DescriptorSet::write_buffers"};
-    VKRC_REQUIRE_STATE(caller.name());
-    write_buffer_infos(*state_, binding, type, infos, array_element, caller);
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffers");
+    write_buffer_infos(*state_, binding, type, infos, array_element,
+                       detail::Caller{"vkrc::DescriptorSet::write_buffers"});
 }
 
 void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
                                  std::uint32_t array_element) const {
-    const detail::Caller caller{"vkrc::DescriptorSet::write_images"};
-    VKRC_REQUIRE_STATE(caller.name());
-    write_image_infos(*state_, binding, type, infos, array_element, caller);
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_images");
+    write_image_infos(*state_, binding, type, infos, array_element,
+                      detail::Caller{"vkrc::DescriptorSet::write_images"});
 }
 
+void DescriptorSet::write_buffer_views(std::uint32_t binding, VkDescriptorType type, Span<const VkBufferView> views,
+                                       std::uint32_t array_element) const {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffer_views");
+    write_texel_views(*state_, binding, type, views, array_element,
+                      detail::Caller{"vkrc::DescriptorSet::write_buffer_views"});
+}
+
+namespace {
+
+// The references an update with template t writes into s from data: each
+// entry's descriptors, which must lie in its binding.
+List<SlotWrite> template_writes(const detail::DescriptorSetState& s, const detail::DescriptorUpdateTemplateState& t,
+                                const void* data, const detail::Caller& caller) {
+    const auto& layout = *s.layout.state();
+    const auto& d = *s.pool.device().state();
+    std::size_t count = 0;
+    for (const auto& e : t.entries) {
+        if (e.descriptorType != VK_DESCRIPTOR_TYPE_INLINE_UNIFORM_BLOCK) count += e.descriptorCount;
+    }
+    List<SlotWrite> writes;
+    writes.reserve(count);
+    for (const auto& e : t.entries) {
+        const std::size_t b =
+            check_write(s, e.dstBinding, e.descriptorType, e.dstArrayElement, e.descriptorCount, caller);
+        if (e.descriptorType == VK_DESCRIPTOR_TYPE_INLINE_UNIFORM_BLOCK) continue;
+        const bool immutable = !layout.bindings[b].immutable_samplers.empty();
+        for (std::uint32_t i = 0; i < e.descriptorCount; ++i) {
+            const void* info = static_cast<const char*>(data) + e.offset + i * e.stride;
+            writes.push_back(
+                {layout.first_slot[b] + e.dstArrayElement + i, refs_of(d, e.descriptorType, info, immutable)});
+        }
+    }
+    return writes;
+}
+
+}  // namespace
+
 void DescriptorSet::update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const {
+    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::update_with_template");
     const detail::Caller caller{"vkrc::DescriptorSet::update_with_template"};
-    VKRC_REQUIRE_STATE(caller.name());
     caller.require_handle(update_template, "the DescriptorUpdateTemplate");
     caller.require(update_template.template_type() == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_DESCRIPTOR_SET,
                    "the template is for push descriptors");
     // VUID-vkUpdateDescriptorSetWithTemplate-descriptorUpdateTemplate-00387 asks
     // for a compatible layout; vkrc asks for the same one.
-    caller.require(!state_->layout || update_template.descriptor_set_layout() == state_->layout,
+    caller.require(update_template.descriptor_set_layout() == state_->layout,
                    "the template was made for another descriptor set layout");
-    const auto& d = state_->pool.device();
-    d.fn().vkUpdateDescriptorSetWithTemplate(d.vk(), state_->handle, update_template.vk(), data);
+    caller.require(data != nullptr || update_template.state()->entries.empty(), "data is null");
+    auto writes = template_writes(*state_, *update_template.state(), data, caller);
+    const auto& d = *state_->pool.device().state();
+    update_keeping(
+        *state_, writes.data(), writes.size(),
+        [&] { d.fn.vkUpdateDescriptorSetWithTemplate(d.device, state_->handle, update_template.vk(), data); }, caller);
+}
+
+void detail::release_descriptors(const DescriptorSetState& s, std::uint32_t binding,
+                                 Span<const std::uint32_t> elements) noexcept {
+    auto& set = const_cast<DescriptorSetState&>(s);
+    const auto& layout = *s.layout.state();
+    LockGuard lock(s.pool.state()->mutex);
+    if (set.refs.empty()) return;
+    for (std::size_t b = 0; b < layout.bindings.size(); ++b) {
+        if (layout.bindings[b].binding != binding) continue;
+        // Released under the lock: a release never takes a descriptor pool's lock.
+        for (const std::uint32_t e : elements) set.refs[layout.first_slot[b] + e] = DescriptorRefs{};
+    }
 }
 
 VKRC_END_NAMESPACE

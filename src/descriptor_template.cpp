@@ -32,10 +32,11 @@ void check_template_info(const detail::Caller& caller, const Device& device,
 }
 
 // What the template was made for: its type, its set layout and, for a push
-// template, the pipeline layout and set (handle copies: nothing here throws).
+// template, the pipeline layout and set; the entries (the only copy that may throw).
 void keep_template_info(detail::DescriptorUpdateTemplateState& s, const DescriptorUpdateTemplateCreateInfo& info) {
     s.type = info.template_type;
     s.set_layout = info.descriptor_set_layout;
+    s.entries = info.entries;
     if (info.template_type == VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR) {
         s.pipeline_layout = info.pipeline_layout;
         s.set = info.set;

@@ -17,6 +17,7 @@ namespace detail {
 // members (the allocation, then the parents) are released after, so FIFO
 // order destroys the handle before its memory returns and before its parent.
 BufferState::~BufferState() {
+    if (device) device.state()->objects.remove(DescribedKind::buffer, handle_bits(handle), this);
     destroy_owned<&DeviceFunctions::vkDestroyBuffer>(*this, device);
     if (device && cleanup) defer_cleanup(*device.state(), cleanup, serial());
 }
@@ -49,12 +50,34 @@ void defer_cleanup(DeviceState& device, Function<void()>& cleanup, std::uint64_t
     device.destroy_after_gpu({run, 0, held}, serial);
 }
 ImageViewState::~ImageViewState() {
-    if (image) destroy_owned<&DeviceFunctions::vkDestroyImageView>(*this, image.device());
+    if (!image) return;
+    image.device().state()->objects.remove(DescribedKind::image_view, handle_bits(handle), this);
+    destroy_owned<&DeviceFunctions::vkDestroyImageView>(*this, image.device());
 }
 BufferViewState::~BufferViewState() {
-    if (buffer) destroy_owned<&DeviceFunctions::vkDestroyBufferView>(*this, buffer.device());
+    if (!buffer) return;
+    buffer.device().state()->objects.remove(DescribedKind::buffer_view, handle_bits(handle), this);
+    destroy_owned<&DeviceFunctions::vkDestroyBufferView>(*this, buffer.device());
 }
-SamplerState::~SamplerState() { destroy_owned<&DeviceFunctions::vkDestroySampler>(*this, device); }
+SamplerState::~SamplerState() {
+    if (device) device.state()->objects.remove(DescribedKind::sampler, handle_bits(handle), this);
+    destroy_owned<&DeviceFunctions::vkDestroySampler>(*this, device);
+}
+
+// Makes state findable by its raw handle (descriptor writes of raw handles
+// keep it alive through it); its destructor above forgets it.
+// An adoption that fails here leaves the handle to its caller (as every
+// failed adopt does), so the state gives it up before it goes.
+template <class State>
+Ref<State> registered(Ref<State> state, const Device& device, DescribedKind kind, bool adopted = false) {
+    try {
+        device.state()->objects.add(kind, handle_bits(state->handle), state.get());
+    } catch (...) {
+        if (adopted) state->ownership = Ownership::borrowed;
+        throw;
+    }
+    return state;
+}
 
 }  // namespace detail
 
@@ -435,7 +458,7 @@ Buffer Buffer::create(const Device& device, const BufferCreateInfo& info) {
     auto state = buffer_state(device, info.size, info.usage, Ownership::owned);
     create_bound(device, ci, *state, request, info.allocator);
     state->device_address = query_device_address(device, state->handle, info.usage);
-    return Buffer(std::move(state));
+    return Buffer(detail::registered(std::move(state), device, detail::DescribedKind::buffer));
 }
 
 Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, VkBufferUsageFlags usage,
@@ -447,7 +470,7 @@ Buffer Buffer::adopt(const Device& device, VkBuffer buffer, VkDeviceSize size, V
     state->handle = buffer;
     state->cleanup = std::move(cleanup);
     state->device_address = query_device_address(device, buffer, usage);
-    return Buffer(std::move(state));
+    return Buffer(detail::registered(std::move(state), device, detail::DescribedKind::buffer, true));
 }
 
 VkImageAspectFlags format_aspects(VkFormat format) noexcept {
@@ -583,7 +606,7 @@ ImageView ImageView::create(const Image& image, const ImageViewCreateInfo& info)
     state->format = ci.format;
     state->range = ci.subresourceRange;
     state->ycbcr_conversion = info.ycbcr_conversion;
-    return ImageView(std::move(state));
+    return ImageView(detail::registered(std::move(state), device, detail::DescribedKind::image_view));
 }
 
 BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& info) {
@@ -600,7 +623,7 @@ BufferView BufferView::create(const Buffer& buffer, const BufferViewCreateInfo& 
     const auto& device = buffer.device();
     check(device.fn().vkCreateBufferView(device.vk(), &ci, nullptr, &state->handle), "vkCreateBufferView");
     state->buffer = buffer;
-    return BufferView(std::move(state));
+    return BufferView(detail::registered(std::move(state), device, detail::DescribedKind::buffer_view));
 }
 
 ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format,
@@ -609,17 +632,21 @@ ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format
         detail::Caller{"vkrc::ImageView::adopt"}, image, "the Image", view, "VkImageView", ownership);
     state->format = format;
     state->range = subresource_range;
-    return ImageView(std::move(state));
+    return ImageView(detail::registered(std::move(state), image.device(), detail::DescribedKind::image_view, true));
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    return BufferView(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
-        detail::Caller{"vkrc::BufferView::adopt"}, buffer, "the Buffer", view, "VkBufferView", ownership));
+    return BufferView(
+        detail::registered(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
+                               detail::Caller{"vkrc::BufferView::adopt"}, buffer, "the Buffer", view, "VkBufferView", ownership),
+                           buffer.device(), detail::DescribedKind::buffer_view, true));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
-    return Sampler(detail::adopted_state<detail::SamplerState>(detail::Caller{"vkrc::Sampler::adopt"}, device,
-                                                               "the Device", sampler, "VkSampler", ownership));
+    return Sampler(
+        detail::registered(detail::adopted_state<detail::SamplerState>(detail::Caller{"vkrc::Sampler::adopt"}, device, "the Device",
+                                                                       sampler, "VkSampler", ownership),
+                           device, detail::DescribedKind::sampler));
 }
 
 Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
@@ -647,7 +674,7 @@ Sampler Sampler::create(const Device& device, const SamplerCreateInfo& info) {
     auto state =
         detail::created_state<detail::SamplerState, &DeviceFunctions::vkCreateSampler>(device, ci, "vkCreateSampler");
     state->ycbcr_conversion = info.ycbcr_conversion;
-    return Sampler(std::move(state));
+    return Sampler(detail::registered(std::move(state), device, detail::DescribedKind::sampler));
 }
 
 VKRC_END_NAMESPACE

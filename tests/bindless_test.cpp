@@ -69,22 +69,8 @@ vkrc::DescriptorPool bindless_pool(const vkrc::Device& device) {
 
 // A 1x1 R32_UINT texture holding value, cleared and made shader-readable by cmd.
 vkrc::Image uint_texture(const vkrc::Device& device, const vkrc::CommandBuffer& cmd, std::uint32_t value) {
-    auto image = vkrc::Image::create(
-        device, {.format = VK_FORMAT_R32_UINT, .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-    auto to_dst = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                      VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                                      VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    cmd.pipeline_barrier({}, {}, std::span(&to_dst, 1));
-    VkClearColorValue color{};
-    color.uint32[0] = value;
-    const VkImageSubresourceRange whole{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&whole, 1));
-    auto to_read =
-        vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                            VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-    cmd.pipeline_barrier({}, {}, std::span(&to_read, 1));
-    return image;
+    return vkrc_test::uint_image(device, cmd, value, VK_IMAGE_USAGE_SAMPLED_BIT,
+                                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
 // A variable-count set of 64 textures, 8 of them written in one call at

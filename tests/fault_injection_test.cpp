@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <memory>
 #include <new>
@@ -46,15 +47,19 @@ bool all_errors() {
 #endif
 }
 
-TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
+// Runs scenario once to count its failable calls, then once per call and
+// error with that call failing (see the file comment); returns how many runs ended in vkrc::Error.
+using Scenario = std::function<std::size_t(const vkrc::InstanceCreateInfo&)>;
+void inject_into_every_call(const char* what, const Scenario& scenario, std::size_t min_result,
+                            std::uint64_t min_points) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     const auto info = injected_instance_info(log);
     faults::arm(0, VK_SUCCESS);
     const auto start = std::chrono::steady_clock::now();
-    EXPECT_GT(vkrc_test::run_teapot_scenario(info), 100u) << "the teapots were not drawn";
+    EXPECT_GT(scenario(info), min_result) << what << ": the scenario did not run";
     const std::uint64_t points = faults::failable_calls();
     vkrc_test::expect_no_validation_messages(*log);
-    ASSERT_GT(points, 50u) << "the wrapper does not see vkrc's calls";
+    ASSERT_GT(points, min_points) << "the wrapper does not see vkrc's calls";
 
     std::uint64_t runs = 0, thrown = 0, not_reached = 0;
     std::map<std::string, int> absorbed;  // calls whose failure vkrc handled without throwing
@@ -69,7 +74,7 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
                 std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
             faults::arm(k, error);
             try {
-                vkrc_test::run_teapot_scenario(info);
+                scenario(info);
                 absorbed[faults::fired_in() ? faults::fired_in() : "-"]++;
             } catch (const vkrc::Error& ex) {
                 ++thrown;
@@ -95,12 +100,65 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
     faults::arm(0, VK_SUCCESS);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf(
-        "fault injection: %llu injection points exercised in %llu runs (%.1f s), %llu ended in vkrc::Error, "
+        "fault injection (%s): %llu injection points exercised in %llu runs (%.1f s), %llu ended in vkrc::Error, "
         "%llu not reached (fewer timeline polls)\n",
-        static_cast<unsigned long long>(points), static_cast<unsigned long long>(runs), seconds,
+        what, static_cast<unsigned long long>(points), static_cast<unsigned long long>(runs), seconds,
         static_cast<unsigned long long>(thrown), static_cast<unsigned long long>(not_reached));
     for (const auto& [name, count] : absorbed) std::printf("  absorbed by vkrc: %s x%d\n", name.c_str(), count);
     EXPECT_GT(thrown, runs / 2);
+}
+
+TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
+    inject_into_every_call(
+        "teapot scene", [](const vkrc::InstanceCreateInfo& info) { return vkrc_test::run_teapot_scenario(info); }, 100,
+        50);
+}
+
+// Descriptor references and the bindless table (issue 30): a table made,
+// filled and bound, a set written and dropped and its pool reset, with work
+// in flight; every failable call on the way fails cleanly.
+std::size_t run_descriptor_scenario(const vkrc::InstanceCreateInfo& info) {
+    auto instance = vkrc::Instance::create(info);
+    auto physical_device = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
+    vkrc::DeviceCreateInfo device_info;
+    device_info.vulkan12_features.descriptorBindingPartiallyBound = VK_TRUE;
+    device_info.vulkan12_features.descriptorBindingSampledImageUpdateAfterBind = VK_TRUE;
+    device_info.vulkan12_features.descriptorBindingStorageBufferUpdateAfterBind = VK_TRUE;
+    device_info.vulkan12_features.descriptorBindingUpdateUnusedWhilePending = VK_TRUE;
+    auto device = vkrc::Device::create(physical_device, device_info);
+    auto queue = device.default_queue();
+    auto table = vkrc::BindlessTable::create(device, {.image_capacity = 4, .buffer_capacity = 4});
+    auto buffer = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+    const auto first = table.add(buffer);
+    auto layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto set = pool.allocate(layout);
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer);
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = commands.allocate();
+    auto pipeline_layout = vkrc::PipelineLayout::create(device, {.set_layouts = {table.layout()}});
+    cmd.begin();
+    const VkDescriptorSet raw = table.set().vk();
+    cmd.bind_descriptor_sets(VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout.vk(), 0, vkrc::Span(&raw, 1));
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = vkrc::Span(&cmd, 1)}, fence);
+    table.remove(first);
+    buffer.reset();
+    set.reset();
+    pool.reset_sets();
+    const auto second =
+        table.add(vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT}));
+    if (fence.wait() != VK_SUCCESS) return 0;
+    table.remove(second);
+    device.wait_idle();
+    return table.live_count(vkrc::BindlessKind::buffer) + 1;
+}
+
+TEST(FaultInjection, EveryFailableCallOfDescriptorReferencesAndTheBindlessTableFailsCleanly) {
+    inject_into_every_call("descriptors and bindless table", run_descriptor_scenario, 0, 10);
 }
 
 // A user allocator that fails its k-th allocation in one of three ways.

@@ -114,8 +114,15 @@ public:
                                Ownership ownership, std::uint32_t variable_descriptor_count = 0);
     const DescriptorPool& pool() const VKRC_UNCHECKED_NOEXCEPT;
 
-    // vkUpdateDescriptorSets with one buffer descriptor. The set does not keep
-    // what it points to alive: drop it only after the work that uses it is submitted.
+    // Every write keeps what it writes alive (the buffer, view or sampler,
+    // found by raw handle when vkrc made it for this device; a raw handle vkrc
+    // does not know is the caller's to keep alive until the work using it is
+    // done). Overwriting a descriptor, and resetting, freeing or dropping the
+    // set, releases the old object as a drop does: its destruction waits for
+    // the GPU (docs/design.md, "Descriptor references"). A write to a set
+    // invalidated by its pool's reset_sets() is a UsageError.
+    //
+    // vkUpdateDescriptorSets with one buffer descriptor.
     // Throws UsageError when the binding does not exist, has another
     // descriptor type, or the buffer belongs to another device or lacks the
     // usage the type needs.
@@ -138,9 +145,17 @@ public:
                        std::uint32_t array_element = 0) const;
     void write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
                       std::uint32_t array_element = 0) const;
+    // Texel buffer descriptors (UNIFORM_TEXEL_BUFFER, STORAGE_TEXEL_BUFFER),
+    // checked as write_buffer / write_buffers are.
+    void write_buffer_view(std::uint32_t binding, VkDescriptorType type, const BufferView& view,
+                           std::uint32_t array_element = 0) const;
+    void write_buffer_views(std::uint32_t binding, VkDescriptorType type, Span<const VkBufferView> views,
+                            std::uint32_t array_element = 0) const;
     // vkUpdateDescriptorSetWithTemplate: data is laid out as the template's
     // entries say (read during the call). The template's type must be
-    // DESCRIPTOR_SET and its layout this set's (UsageError otherwise).
+    // DESCRIPTOR_SET and its layout this set's, and each entry must lie in
+    // its binding (UsageError otherwise). The objects are counted from the
+    // template's entries (an adopted template made without entries counts nothing).
     void update_with_template(const DescriptorUpdateTemplate& update_template, const void* data) const;
 
 private:
@@ -159,7 +174,19 @@ public:
     // The binding with VARIABLE_DESCRIPTOR_COUNT, if any.
     bool has_variable_binding = false;
     std::uint32_t variable_binding = 0;
+    // Where each binding's descriptors start in a set's references
+    // (parallel to bindings); the variable binding's come last, after fixed_slots.
+    List<std::uint32_t> first_slot;
+    std::uint32_t fixed_slots = 0;
 };
+
+// What one descriptor keeps alive: the object written into it and, for a
+// combined image sampler, its sampler.
+struct DescriptorRefs {
+    Ref<const RefCounted> object;
+    Ref<const RefCounted> sampler;
+};
+class DescriptorSetState;
 
 class DescriptorPoolState final : public DeviceChildState<VkDescriptorPool> {
 public:
@@ -171,6 +198,8 @@ public:
     // (a set from before a reset is already gone).
     PoolFreeList<VkDescriptorSet> pending;
     std::uint64_t generation = 0;
+    // Under mutex: the sets that hold references, released by reset_sets().
+    DescriptorSetState* sets_with_refs = nullptr;
 };
 
 class DescriptorSetState final : public VulkanObjectState<VkDescriptorSet> {
@@ -181,7 +210,19 @@ public:
     DescriptorSetLayout layout;  // checks writes (the raw layout may go once the set exists)
     std::uint64_t generation = 0;
     std::uint32_t variable_count = 0;  // of the layout's variable binding, if it has one
+    // Under the pool's mutex: one entry per descriptor (made at the first
+    // write), and the set's links in the pool's sets_with_refs.
+    List<DescriptorRefs> refs;
+    DescriptorSetState* previous_with_refs = nullptr;
+    DescriptorSetState* next_with_refs = nullptr;
 };
+
+// Drops the references of the given array elements of binding (their
+// objects' destruction then waits for the GPU like any drop's); the
+// descriptors stay as written. For bindless tables, whose PARTIALLY_BOUND
+// slots nothing reads once given back.
+void release_descriptors(const DescriptorSetState& set, std::uint32_t binding,
+                         Span<const std::uint32_t> elements) noexcept;
 
 }  // namespace detail
 

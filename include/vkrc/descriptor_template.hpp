@@ -43,8 +43,10 @@ public:
     // layouts of another device.
     static DescriptorUpdateTemplate create(const Device& device, const DescriptorUpdateTemplateCreateInfo& info);
     // A template made by other code; info describes it as its creation did
-    // (its type, layouts and set are kept, and checked as create() checks
-    // them; entries, flags and next are ignored). Owned: vkrc destroys it
+    // (its type, layouts, set and entries are kept, and checked as create()
+    // checks them; flags and next are ignored; the entries count the
+    // references of DescriptorSet::update_with_template, so without them
+    // its writes keep nothing alive). Owned: vkrc destroys it
     // after the GPU is done; borrowed: its maker does, after every vkrc
     // handle to it has gone.
     static DescriptorUpdateTemplate adopt(const Device& device, VkDescriptorUpdateTemplate update_template,
@@ -70,6 +72,8 @@ public:
     DescriptorSetLayout set_layout;
     PipelineLayout pipeline_layout;
     std::uint32_t set = 0;
+    // The entries, to find the objects an update writes (descriptor references).
+    List<VkDescriptorUpdateTemplateEntry> entries;
 };
 
 }  // namespace detail

@@ -31,6 +31,8 @@ struct SingleThreadPolicy {
     static void increment(Count& c) noexcept { ++c; }
     // True when the count reached zero.
     static bool decrement(Count& c) noexcept { return --c == 0; }
+    // Increments unless the count is zero (the object is being destroyed).
+    static bool increment_if_live(Count& c) noexcept { return c != 0 && ++c != 0; }
     static std::uint32_t load(const Count& c) noexcept { return c; }
 };
 
@@ -131,6 +133,11 @@ struct MultiThreadPolicy {
     static constexpr bool multi_thread = true;
     static void increment(Count& c) noexcept { c.fetch_add(1, __ATOMIC_RELAXED); }
     static bool decrement(Count& c) noexcept { return c.fetch_sub(1, __ATOMIC_ACQ_REL) == 1; }
+    static bool increment_if_live(Count& c) noexcept {
+        std::uint32_t seen = c.load(__ATOMIC_RELAXED);
+        while (seen != 0 && !c.compare_exchange_weak(seen, seen + 1, __ATOMIC_RELAXED)) {}
+        return seen != 0;
+    }
     static std::uint32_t load(const Count& c) noexcept { return c.load(__ATOMIC_RELAXED); }
 };
 
@@ -172,6 +179,9 @@ public:
     BasicRefCounted& operator=(const BasicRefCounted&) = delete;
 
     void add_ref() const noexcept { Policy::increment(refs_); }
+    // add_ref unless the last reference is already gone (a registry lookup
+    // racing the object's destruction, detail::ObjectRegistry).
+    bool try_add_ref() const noexcept { return Policy::increment_if_live(refs_); }
     // Drops one reference; on the last one hands the object to on_last_release().
     void release() const noexcept {
         if (Policy::decrement(refs_)) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "vkrc/barrier.hpp"
+#include "vkrc/bindless.hpp"
 #include "vkrc/command.hpp"
 #include "vkrc/command_pool.hpp"
 #include "vkrc/config.hpp"

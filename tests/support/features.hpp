@@ -66,4 +66,25 @@ inline VkMemoryBarrier2 compute_to_host() {
                                 VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
+// A 1x1 R32_UINT image holding value: cleared by cmd and left in layout for
+// any later read (usage gets TRANSFER_DST added).
+inline vkrc::Image uint_image(const vkrc::Device& device, const vkrc::CommandBuffer& cmd, std::uint32_t value,
+                              VkImageUsageFlags usage, VkImageLayout layout) {
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R32_UINT, .usage = usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    auto to_dst = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                      VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                                      VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_dst, 1));
+    VkClearColorValue color{};
+    color.uint32[0] = value;
+    const VkImageSubresourceRange whole{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    cmd.clear_color_image(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, color, std::span(&whole, 1));
+    auto to_read = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, layout,
+                                       VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_READ_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_read, 1));
+    return image;
+}
+
 }  // namespace vkrc_test

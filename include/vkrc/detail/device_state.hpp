@@ -7,6 +7,8 @@
 
 #include "vkrc/device.hpp"
 
+#include "vkrc/detail/object_registry.hpp"
+
 #include <cstdint>
 #include <type_traits>
 
@@ -321,6 +323,8 @@ public:
     List<QueueState> queues;                 // made once, never grows: Queue handles point into it
     std::size_t role_queues[3] = {0, 0, 0};  // by QueueRole: an index into queues
     Atomic<bool> lost{false};
+    // Raw handle -> state of what descriptors point to (descriptor writes of raw handles).
+    ObjectRegistry objects;
 
 private:
     friend class OpenCommandBuffers;  // moves released drops into deferred
