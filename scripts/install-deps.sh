@@ -11,7 +11,7 @@ packages=(
   build-essential cmake pkg-config
   libvulkan-dev libvulkan1 mesa-vulkan-drivers vulkan-validationlayers
   glslang-tools libglfw3-dev libglm-dev googletest libgtest-dev xvfb libstb-dev
-  clang clang-format valgrind python3
+  clang clang-format valgrind python3 gfxreconstruct
 )
 
 missing=()

@@ -9,6 +9,9 @@
 #include <new>
 #include <string>
 
+// The symbol code compiled for this library's policy references (vkrc/config.hpp).
+extern "C" const char VKRC_DETAIL_POLICY_SYMBOL = 0;
+
 VKRC_BEGIN_NAMESPACE
 
 const char* to_string(VkResult result) noexcept {

@@ -1,6 +1,8 @@
 #include "vkrc/pipeline.hpp"
 
+#include "caller.hpp"
 #include "object_state.hpp"
+#include "text.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -80,9 +82,62 @@ PipelineLayout PipelineLayout::create(const Device& device, const PipelineLayout
     ci.pSetLayouts = sets.data();
     ci.pushConstantRangeCount = static_cast<std::uint32_t>(info.push_constant_ranges.size());
     ci.pPushConstantRanges = info.push_constant_ranges.data();
-    return PipelineLayout(detail::created_state<detail::PipelineLayoutState, &DeviceFunctions::vkCreatePipelineLayout>(
-        device, ci, "vkCreatePipelineLayout"));
+    List<VkPushConstantRange> ranges(info.push_constant_ranges);  // before the layout: a failed copy must not leak it
+    auto s = detail::created_state<detail::PipelineLayoutState, &DeviceFunctions::vkCreatePipelineLayout>(
+        device, ci, "vkCreatePipelineLayout");
+    s->push_constant_ranges = std::move(ranges);
+    s->push_constant_ranges_known = true;
+    return PipelineLayout(std::move(s));
 }
+
+namespace detail {
+namespace {
+// "[offset, offset + size) of stage flags 0x..", as push_constants' messages write a range.
+std::string range_text(std::uint32_t offset, std::uint32_t size, VkShaderStageFlags stages) {
+    return "[" + std::to_string(offset) + ", " + std::to_string(std::uint64_t(offset) + size) + ") of stage flags 0x" +
+           hex(stages);
+}
+std::string ranges_text(Span<const VkPushConstantRange> ranges) {
+    if (ranges.empty()) return "none";
+    std::string out;
+    for (const auto& r : ranges) out += (out.empty() ? "" : ", ") + range_text(r.offset, r.size, r.stageFlags);
+    return out;
+}
+bool holds(const VkPushConstantRange& range, std::uint64_t byte) noexcept {
+    return byte >= range.offset && byte < std::uint64_t(range.offset) + range.size;
+}
+}  // namespace
+
+void check_push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
+                          std::uint32_t size) {
+    const Caller caller{"vkrc::CommandBuffer::push_constants"};
+    caller.require_handle(layout, "the PipelineLayout");
+    caller.require(stages != 0, "the stage flags are 0");
+    caller.require(size != 0 && size % 4 == 0 && offset % 4 == 0, "offset ", offset, " and size ", size,
+                   " must be multiples of 4 and size not 0");
+    const PipelineLayoutState& s = *layout.state();
+    if (!s.push_constant_ranges_known) return;
+    const Span<const VkPushConstantRange> ranges(s.push_constant_ranges);
+    const std::uint64_t end = std::uint64_t(offset) + size;
+    for (const auto& r : ranges) {  // VUID-vkCmdPushConstants-offset-01796
+        const bool overlaps = r.offset < end && offset < std::uint64_t(r.offset) + r.size;
+        if (overlaps && (r.stageFlags & ~stages) != 0) {
+            caller.refuse(range_text(offset, size, stages), " overlaps the layout's range ",
+                          range_text(r.offset, r.size, r.stageFlags),
+                          ", so the stage flags must include all of its stages");
+        }
+    }
+    for (std::uint64_t byte = offset; byte < end; byte += 4) {  // VUID-vkCmdPushConstants-offset-01795
+        VkShaderStageFlags covered = 0;
+        for (const auto& r : ranges) covered |= holds(r, byte) ? r.stageFlags : 0;
+        if ((stages & ~covered) != 0) {
+            caller.refuse(range_text(offset, size, stages), ": byte ", byte,
+                          " is in no push constant range of the layout for stage flags 0x", hex(stages & ~covered),
+                          " (the layout's ranges: ", ranges_text(ranges), ")");
+        }
+    }
+}
+}  // namespace detail
 
 RenderPass RenderPass::create(const Device& device, const RenderPassCreateInfo& info) {
     const detail::Caller caller{"vkrc::RenderPass::create"};

@@ -222,15 +222,35 @@ void carve(Pool& pool, NodeStore& nodes, Node& node, VkDeviceSize start, VkDevic
     node.block->allocations += 1;
 }
 
+// Which allocations of a host-visible memory type may share a block. The
+// host writes upload ranges and the GPU writes gpu_only and readback ones, so
+// they never share a (mapped) block: a capture layer such as gfxreconstruct
+// tracks host writes by page and copies each written page whole to the
+// device memory at submit, which overwrote GPU-written bytes in the same
+// page (issue 34: the teapot's frames under capture). custom, whose writer
+// vkrc cannot know, keeps to itself too. Memory types that are not
+// host-visible have one class (nothing maps them).
+enum class HostAccess : std::uint32_t { gpu_written, host_written, unknown };
+constexpr std::uint32_t host_access_count = 3;
+constexpr HostAccess host_access(MemoryUsage usage) noexcept {
+    switch (usage) {
+        case MemoryUsage::upload: return HostAccess::host_written;
+        case MemoryUsage::custom: return HostAccess::unknown;
+        case MemoryUsage::gpu_only:
+        case MemoryUsage::readback: break;
+    }
+    return HostAccess::gpu_written;
+}
+
 // An independent part of a PoolAllocator: its own lock, pools (so blocks and
 // spares) and nodes. Its statistics are summed by statistics().
 struct alignas(64) Shard {  // apart in cache: threads on different shards share no line
     Mutex mutex;
-    // Index: memory type * 4 + 2 * (device-address blocks) + (optimal-tiling
-    // pool when kept apart). Device-address blocks are kept apart so that
-    // only buffers that ask pay for the flag (drivers may place such memory
-    // differently).
-    std::unique_ptr<Pool> pools[VK_MAX_MEMORY_TYPES * 4];
+    // Index: ((memory type * host_access_count + host access class) * 2 +
+    // device-address blocks) * 2 + optimal-tiling pool when kept apart.
+    // Device-address blocks are kept apart so that only buffers that ask pay
+    // for the flag (drivers may place such memory differently).
+    std::unique_ptr<Pool> pools[VK_MAX_MEMORY_TYPES * host_access_count * 4];
     NodeStore nodes;
     AllocatorStatistics stats;
 };
@@ -285,6 +305,7 @@ struct PoolAllocator::Impl {
     VkDeviceSize atom = 1;
     VkDeviceSize units[VK_MAX_MEMORY_TYPES] = {};
     std::uint32_t heap_of[VK_MAX_MEMORY_TYPES] = {};
+    bool host_visible[VK_MAX_MEMORY_TYPES] = {};
     // bufferImageGranularity up to this is honoured by rounding every range
     // out to it; larger values put linear and optimal resources in separate blocks.
     static constexpr VkDeviceSize max_rounded_granularity = 4096;
@@ -321,6 +342,7 @@ void PoolAllocator::Impl::bind(DeviceView d, const detail::Caller& caller) {
         }
         units[t] = u;
         heap_of[t] = props.memoryTypes[t].heapIndex;
+        host_visible[t] = (flags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT) != 0;
     }
     device.store(&d.state(), __ATOMIC_RELEASE);
 }
@@ -466,7 +488,9 @@ void PoolAllocator::Impl::allocate_range(DeviceView d, const AllocationRequest& 
 // The shard's pool for the request's memory type and kind of block, made on first use.
 Pool& PoolAllocator::Impl::pool_for(Shard& shard, std::uint32_t type, const AllocationRequest& request) {
     const bool separate = granularity > max_rounded_granularity && !request.linear;
-    auto& slot = shard.pools[type * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
+    const auto access = host_visible[type] ? static_cast<std::uint32_t>(host_access(request.intent.usage)) : 0;
+    auto& slot =
+        shard.pools[(type * host_access_count + access) * 4 + (request.device_address ? 2 : 0) + (separate ? 1 : 0)];
     if (!slot) {
         slot = std::make_unique<Pool>();
         slot->shard = &shard;

@@ -1,5 +1,6 @@
 #include "vkrc/sync.hpp"
 
+#include "caller.hpp"
 #include "object_state.hpp"
 
 #include <bit>
@@ -198,18 +199,26 @@ QueryPool QueryPool::create(const Device& device, const QueryPoolCreateInfo& inf
     return QueryPool(std::move(s));
 }
 
-VkResult QueryPool::results(std::uint32_t first_query, Span<std::uint64_t> out, VkQueryResultFlags flags,
-                            std::uint32_t stride_words) const {
+VkResult QueryPool::results(std::uint32_t first_query, Span<std::uint64_t> out, VkQueryResultFlags flags) const {
     const detail::Caller caller{"vkrc::QueryPool::results"};
-    caller.require(stride_words != 0, "stride_words is 0");
-    const std::size_t count = out.size() / stride_words;
+    caller.require_handle(*this, "the QueryPool");
+    const std::uint32_t words = words_per_query(flags);
+    caller.require(!out.empty() && out.size() % words == 0, "out holds ", out.size(), " values, not a multiple of the ",
+                   words, " per query (values_per_query() ", state_->values_per_query,
+                   ", plus one for WITH_AVAILABILITY or WITH_STATUS_KHR)");
+    const std::size_t count = out.size() / words;
     caller.require(first_query <= state_->count && count <= state_->count - first_query, "queries ", first_query, "+",
                    count, " exceed the pool's ", state_->count);
     const auto& d = state_->device;
     VkResult r = d.fn().vkGetQueryPoolResults(d.vk(), state_->handle, first_query, static_cast<std::uint32_t>(count),
-                                              out.size_bytes(), out.data(), stride_words * sizeof(std::uint64_t),
+                                              out.size_bytes(), out.data(), words * sizeof(std::uint64_t),
                                               flags | VK_QUERY_RESULT_64_BIT);
     return d.state()->finish_call(r, "vkGetQueryPoolResults");
+}
+
+std::uint32_t QueryPool::words_per_query(VkQueryResultFlags flags) const VKRC_UNCHECKED_NOEXCEPT {
+    const bool extra = flags & (VK_QUERY_RESULT_WITH_AVAILABILITY_BIT | VK_QUERY_RESULT_WITH_STATUS_BIT_KHR);
+    return live("vkrc::QueryPool::words_per_query").values_per_query + (extra ? 1 : 0);
 }
 
 double QueryPool::timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT {

@@ -212,6 +212,42 @@ TEST_F(VulkanTest, MoreThanEightColourAttachmentsAreRejected) {
         {"vkrc::CommandBuffer::begin_rendering", "9 colour attachments", "at most 8"});
     cmd.end();
 }
+
+// Issue 34: the validation layer alone reported VUID-vkCmdPushConstants-offset-01795
+// here, then (under ASan) read past its buffer.
+TEST_F(VulkanTest, PushConstantsOutsideTheLayoutsRangesAreRejected) {
+    const auto layout = vkrc::PipelineLayout::create(
+        device, {.push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, 16}, {VK_SHADER_STAGE_FRAGMENT_BIT, 8, 8}}});
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    const std::array<std::uint32_t, 6> data{};
+    const auto push = [&](VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size) {
+        return [&cmd, &layout, &data, stages, offset, size] {
+            cmd.push_constants(layout, stages, offset, size, data.data());
+        };
+    };
+    const VkShaderStageFlags vertex = VK_SHADER_STAGE_VERTEX_BIT, both = vertex | VK_SHADER_STAGE_FRAGMENT_BIT;
+    // Past the end (the issue's case: 16 bytes where the range has 8).
+    expect_usage_error(push(both, 8, 16), {"vkrc::CommandBuffer::push_constants", "[8, 24) of stage flags 0x11",
+                                           "byte 16 is in no push constant range",
+                                           "[0, 16) of stage flags 0x1, [8, 16) of stage flags 0x10"});
+    // A stage no range at those bytes has.
+    expect_usage_error(push(both, 0, 8), {"[0, 8) of stage flags 0x11", "byte 0", "for stage flags 0x10"});
+    // Fewer stages than a range that holds the bytes (01796).
+    expect_usage_error(push(vertex, 8, 4),
+                       {"[8, 12) of stage flags 0x1 overlaps the layout's range [8, 16) of stage flags 0x10",
+                        "must include all of its stages"});
+    expect_usage_error(push(vertex, 2, 4), {"offset 2 and size 4 must be multiples of 4"});
+    expect_usage_error(push(vertex, 0, 0), {"size not 0"});
+    expect_usage_error(push(0, 0, 4), {"the stage flags are 0"});
+    // Within the ranges: recorded (the validation layer stays silent), both ways of calling.
+    push(vertex, 0, 8)();
+    push(both, 8, 8)();
+    cmd.push_constants(layout, vertex, data[0], 4);
+    cmd.push_constants(layout.vk(), vertex, 0, 4, data.data());
+    cmd.end();
+}
 #endif
 
 // What the device's limits, features and format properties rule out is

@@ -570,6 +570,39 @@ TEST_F(PoolTest, SubAllocatesAndMergesFreedNeighbours) {
     pool.release(view());
 }
 
+// Issue 34: gfxreconstruct's default (page-guard) capture copies each page
+// the host wrote to the device at submit, whole, which overwrote GPU-written
+// bytes sharing the page (the teapot's frames differed under capture). In
+// host-visible memory, upload ranges never share a block with gpu_only or
+// readback ones, nor custom ones with either.
+TEST_F(PoolTest, HostWrittenAndGpuWrittenRangesNeverShareABlock) {
+    const auto& props = physical_device.memory_properties();
+    std::uint32_t type = 0;
+    while (type < props.memoryTypeCount &&
+           !(props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)) {
+        ++type;
+    }
+    ASSERT_LT(type, props.memoryTypeCount);
+    vkrc::PoolAllocator pool(small_blocks());
+    const auto allocate = [&](vkrc::MemoryUsage usage) {
+        auto r = request(4096);
+        r.requirements.memoryTypeBits = 1u << type;  // every usage in the one host-visible type
+        r.intent.usage = usage;
+        return pool.allocate(view(), r);
+    };
+    const auto upload = allocate(vkrc::MemoryUsage::upload), upload2 = allocate(vkrc::MemoryUsage::upload);
+    const auto gpu = allocate(vkrc::MemoryUsage::gpu_only), readback = allocate(vkrc::MemoryUsage::readback);
+    const auto custom = allocate(vkrc::MemoryUsage::custom);
+    EXPECT_EQ(upload.memory, upload2.memory);
+    EXPECT_EQ(gpu.memory, readback.memory);  // neither is written by the host
+    EXPECT_NE(upload.memory, gpu.memory);
+    EXPECT_NE(custom.memory, upload.memory);
+    EXPECT_NE(custom.memory, gpu.memory);
+    EXPECT_EQ(pool.statistics(view()).total().block_count, 3u);
+    for (const auto& a : {upload, upload2, gpu, readback, custom}) pool.free(view(), a);
+    pool.release(view());
+}
+
 TEST_F(PoolTest, HonoursAlignmentAndGranularity) {
     vkrc::PoolAllocator pool(small_blocks());
     const VkDeviceSize granularity = physical_device.properties().limits.bufferImageGranularity;

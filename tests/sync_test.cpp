@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <span>
+#include <string>
 
 namespace {
 
@@ -125,6 +126,25 @@ TEST_F(VulkanTest, TimestampsAreWrittenInOrder) {
     EXPECT_GT(queries.timestamp_period_ns(), 0.0);
     std::uint64_t too_many[3];
     EXPECT_THROW((void)queries.results(0, too_many), vkrc::UsageError);
+    // With availability each query takes two words: the issue-34 trap (a
+    // count where the stride went left half the array unwritten) is refused.
+    std::uint64_t with_availability[4] = {};
+    ASSERT_EQ(queries.results(0, with_availability, VK_QUERY_RESULT_WAIT_BIT | VK_QUERY_RESULT_WITH_AVAILABILITY_BIT),
+              VK_SUCCESS);
+    EXPECT_EQ(with_availability[0], ticks[0]);
+    EXPECT_NE(with_availability[1], 0u);  // available
+    EXPECT_EQ(with_availability[2], ticks[1]);
+    EXPECT_EQ(queries.words_per_query(VK_QUERY_RESULT_WITH_AVAILABILITY_BIT), 2u);
+    try {
+        (void)queries.results(0, std::span(with_availability, 3), VK_QUERY_RESULT_WITH_AVAILABILITY_BIT);
+        ADD_FAILURE() << "no UsageError";
+    } catch (const vkrc::UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("vkrc::QueryPool::results: out holds 3 values, not a multiple of the 2 "
+                                             "per query"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW((void)queries.results(0, std::span<std::uint64_t>()), vkrc::UsageError);
 }
 
 }  // namespace

@@ -193,13 +193,24 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_descriptor_set_with_template");
         fn_->vkCmdPushDescriptorSetWithTemplateKHR(cmd_, update_template, layout, set, data);
     }
-    template <class T>
-    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, const T& value,
+    // value's bytes at offset; layout is a PipelineLayout or a raw VkPipelineLayout (as below).
+    template <class Layout, class T>
+    void push_constants(const Layout& layout, VkShaderStageFlags stages, const T& value,
                         std::uint32_t offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         push_constants(layout, stages, offset, sizeof(T), &value);
     }
-    void push_constants(Raw<VkPipelineLayout> layout, VkShaderStageFlags stages, std::uint32_t offset,
+    // With VKRC_RUNTIME_CHECKS, UsageError naming the layout's ranges when
+    // [offset, offset + size) and stages are outside them (see
+    // detail::check_push_constants); a raw or adopted layout is not checked.
+    void push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
                         std::uint32_t size, const void* data) const VKRC_UNCHECKED_NOEXCEPT {
+#if VKRC_RUNTIME_CHECKS
+        detail::check_push_constants(layout, stages, offset, size);
+#endif
+        push_constants(layout.vk(), stages, offset, size, data);
+    }
+    void push_constants(VkPipelineLayout layout, VkShaderStageFlags stages, std::uint32_t offset, std::uint32_t size,
+                        const void* data) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
         fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
     }

@@ -61,5 +61,27 @@
 #define VKRC_BEGIN_NAMESPACE namespace vkrc { inline namespace VKRC_POLICY_NAMESPACE {
 #define VKRC_END_NAMESPACE } }
 
+// A policy mismatch at link time names the missing define: every translation
+// unit that includes vkrc references a symbol that only the library of its
+// policy defines (src/error.cpp), so linking libvkrc_mt into code compiled
+// without -DVKRC_MULTI_THREAD=1 fails with, among vkrc::st:: symbols,
+//   undefined reference to `vkrc_st_library_missing__code_compiled_without_VKRC_MULTI_THREAD_1__link_libvkrc_st_or_define_VKRC_MULTI_THREAD_1'
+// (and the reverse for libvkrc_st under -DVKRC_MULTI_THREAD=1). The vkrc::st
+// and vkrc::mt CMake targets set the define; this is for builds without them.
+#define VKRC_DETAIL_CAT3(a, b, c) a##b##c
+#define VKRC_DETAIL_EXPAND_CAT3(a, b, c) VKRC_DETAIL_CAT3(a, b, c)
+#if VKRC_IS_MULTI_THREAD
+#  define VKRC_DETAIL_POLICY_SYMBOL VKRC_DETAIL_EXPAND_CAT3(vkrc_, VKRC_POLICY_NAMESPACE, \
+      _library_missing__code_compiled_with_VKRC_MULTI_THREAD_1__link_libvkrc_mt_or_remove_the_define)
+#else
+#  define VKRC_DETAIL_POLICY_SYMBOL VKRC_DETAIL_EXPAND_CAT3(vkrc_, VKRC_POLICY_NAMESPACE, \
+      _library_missing__code_compiled_without_VKRC_MULTI_THREAD_1__link_libvkrc_st_or_define_VKRC_MULTI_THREAD_1)
+#endif
+extern "C" const char VKRC_DETAIL_POLICY_SYMBOL;
+namespace vkrc::detail_policy_check {
+// One pointer per translation unit, kept (used) so the reference stays.
+[[gnu::used]] static const char* const policy_symbol = &VKRC_DETAIL_POLICY_SYMBOL;
+}
+
 #endif
 // clang-format on

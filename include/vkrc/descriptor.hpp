@@ -64,8 +64,11 @@ private:
 // a dropped set returns to the pool once the GPU is done with it; without it
 // sets are reclaimed only by reset_sets() or the pool's destruction.
 struct DescriptorPoolCreateInfo {
-    // Optional (default: sets freed one by one, see above). Add
-    // UPDATE_AFTER_BIND_BIT to allocate sets of UPDATE_AFTER_BIND_POOL layouts.
+    // Optional (default: sets freed one by one, see above). Flags you set
+    // replace the default, as Vulkan's field is replaced (a pool without
+    // FREE_DESCRIPTOR_SET, reclaimed only by reset_sets(), is a valid choice
+    // vkrc must not override): for UPDATE_AFTER_BIND_POOL layouts write
+    // FREE_DESCRIPTOR_SET_BIT | UPDATE_AFTER_BIND_BIT to keep freeing sets.
     VkDescriptorPoolCreateFlags flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;
     // Required, non-zero.
     std::uint32_t max_sets = 0;

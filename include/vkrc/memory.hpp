@@ -187,9 +187,12 @@ struct PoolAllocatorCreateInfo {
 inline constexpr std::uint32_t max_pool_shards = 64;
 
 // Sub-allocates from large blocks per memory type with TLSF (constant-time
-// good fit, freed neighbours merged); host-visible blocks stay mapped;
-// empty blocks are released keeping at most one spare per memory type and
-// shard; its own VkDeviceMemory count stays within maxMemoryAllocationCount.
+// good fit, freed neighbours merged); host-visible blocks stay mapped, and
+// hold either upload ranges (host-written) or gpu_only and readback ones
+// (GPU-written) or custom ones, never two of these, so that a capture tool
+// that copies host-written pages to the device never overwrites GPU writes;
+// empty blocks are released keeping at most one spare per kind of block
+// (memory type and the classes above) and shard; its own VkDeviceMemory count stays within maxMemoryAllocationCount.
 // The device's default allocator. Serves one device at a time; used directly
 // (not through Allocation), call release() before that device goes.
 //

@@ -21,7 +21,8 @@ class PipelineCacheState;
 struct PipelineLayoutCreateInfo {
     // Optional (empty: no sets). Read during create(); the PipelineLayout does not keep them.
     List<DescriptorSetLayout> set_layouts{};
-    // Optional (empty: no push constants). Read during create().
+    // Optional (empty: no push constants). Copied during create(): the
+    // PipelineLayout keeps them for the checks of CommandBuffer::push_constants.
     List<VkPushConstantRange> push_constant_ranges{};
     // Optional (default none).
     VkPipelineLayoutCreateFlags flags = 0;
@@ -35,6 +36,8 @@ public:
     static PipelineLayout create(const Device& device);  // no sets, no push constants
     // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
     // it once the GPU is done; borrowed, its maker does (after vkrc's last use).
+    // Its push constant ranges are not known, so push_constants into it is not
+    // checked against them.
     static PipelineLayout adopt(const Device& device, VkPipelineLayout layout, Ownership ownership);
 
 private:
@@ -391,7 +394,19 @@ class PipelineLayoutState final : public DeviceChildState<VkPipelineLayout> {
 public:
     static constexpr const char* type_name = "vkrc::PipelineLayout";
     ~PipelineLayoutState() override;
+    // As created; unknown (not checked) for an adopted layout.
+    List<VkPushConstantRange> push_constant_ranges;
+    bool push_constant_ranges_known = false;
 };
+
+// CommandBuffer::push_constants' check (VKRC_RUNTIME_CHECKS): UsageError
+// unless stages is not 0, offset and size are multiples of 4, size is not 0,
+// every byte of [offset, offset + size) lies, for each stage of stages, in a
+// range of layout with that stage (VUID-vkCmdPushConstants-offset-01795), and
+// every range of layout holding one of those bytes has only stages of stages
+// (VUID-vkCmdPushConstants-offset-01796).
+void check_push_constants(const PipelineLayout& layout, VkShaderStageFlags stages, std::uint32_t offset,
+                          std::uint32_t size);
 
 class RenderPassState final : public DeviceChildState<VkRenderPass> {
 public:

@@ -100,16 +100,22 @@ public:
 
     std::uint32_t query_count() const VKRC_UNCHECKED_NOEXCEPT;
     // Reset queries before use with CommandBuffer::reset_query_pool.
-    // vkGetQueryPoolResults as 64-bit values into out (one per query, or
-    // stride_words per query). VK_NOT_READY when flags lack WAIT and some are not ready.
+    // vkGetQueryPoolResults as 64-bit values into out, tightly packed: the
+    // queries read are out.size() / words_per_query(flags) from first_query.
+    // UsageError when out is empty or its size is not a multiple of that (so
+    // no value of out is left unwritten) or the queries exceed the pool.
+    // VK_NOT_READY when flags lack WAIT and some are not ready.
     VkResult results(std::uint32_t first_query, Span<std::uint64_t> out,
-                     VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT, std::uint32_t stride_words = 1) const;
-    // Nanoseconds per timestamp tick (VkPhysicalDeviceLimits::timestampPeriod).
+                     VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const;
+    // Nanoseconds per timestamp tick: the physical device's
+    // VkPhysicalDeviceLimits::timestampPeriod, offered here beside the ticks.
     double timestamp_period_ns() const VKRC_UNCHECKED_NOEXCEPT;
     VkQueryType query_type() const VKRC_UNCHECKED_NOEXCEPT;
-    // Values per query in results(): one per statistic for a pipeline
-    // statistics pool, otherwise 1 (pass it as stride_words).
+    // Values per query: one per statistic for a pipeline statistics pool, otherwise 1.
     std::uint32_t values_per_query() const VKRC_UNCHECKED_NOEXCEPT;
+    // The 64-bit words results() writes per query with flags: values_per_query(),
+    // plus one with WITH_AVAILABILITY or WITH_STATUS_KHR.
+    std::uint32_t words_per_query(VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT;
 
 private:
     using DeviceChild::DeviceChild;
