@@ -1,6 +1,7 @@
 // The whole of vkrc. Each object family also has its own header.
 #pragma once
 
+#include "vkrc/access.hpp"
 #include "vkrc/command.hpp"
 #include "vkrc/config.hpp"
 #include "vkrc/debug_utils.hpp"
