@@ -23,21 +23,21 @@ constexpr VkPipelineStageFlags2 fragment_tests =
 // access types" table (synchronization2), for the accesses the uses name.
 constexpr VkPipelineStageFlags2 stages_supporting(VkAccessFlags2 access) {
     switch (access) {
-    case VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT: return VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-    case VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT:
-    case VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT: return fragment_tests;
-    case VK_ACCESS_2_SHADER_SAMPLED_READ_BIT:
-    case VK_ACCESS_2_SHADER_STORAGE_READ_BIT:
-    case VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT:
-    case VK_ACCESS_2_UNIFORM_READ_BIT: return shader_stages;
-    case VK_ACCESS_2_TRANSFER_READ_BIT:
-    case VK_ACCESS_2_TRANSFER_WRITE_BIT: return transfer_stages;
-    case VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT: return VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT;
-    case VK_ACCESS_2_INDEX_READ_BIT: return VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT;
-    case VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT: return VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
-    case VK_ACCESS_2_HOST_READ_BIT:
-    case VK_ACCESS_2_HOST_WRITE_BIT: return VK_PIPELINE_STAGE_2_HOST_BIT;
-    default: return 0;
+        case VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT: return VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+        case VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT:
+        case VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT: return fragment_tests;
+        case VK_ACCESS_2_SHADER_SAMPLED_READ_BIT:
+        case VK_ACCESS_2_SHADER_STORAGE_READ_BIT:
+        case VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT:
+        case VK_ACCESS_2_UNIFORM_READ_BIT: return shader_stages;
+        case VK_ACCESS_2_TRANSFER_READ_BIT:
+        case VK_ACCESS_2_TRANSFER_WRITE_BIT: return transfer_stages;
+        case VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT: return VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT;
+        case VK_ACCESS_2_INDEX_READ_BIT: return VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT;
+        case VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT: return VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
+        case VK_ACCESS_2_HOST_READ_BIT:
+        case VK_ACCESS_2_HOST_WRITE_BIT: return VK_PIPELINE_STAGE_2_HOST_BIT;
+        default: return 0;
     }
 }
 
@@ -95,8 +95,8 @@ static_assert(use::colour_attachment_write.access == VK_ACCESS_2_COLOR_ATTACHMEN
 static_assert(use::depth_attachment.access ==
               (VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT));
 static_assert(use::depth_attachment.stage == fragment_tests);
-static_assert(use::discarded(use::transfer_src) ==
-              vkrc::Use{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED});
+static_assert(use::discarded(use::transfer_src) == vkrc::Use{VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                                                             VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED});
 
 // The helpers: the barrier's fields come from the two uses, nothing else.
 TEST(Access, MemoryBarrierTakesBothScopesFromTheUses) {

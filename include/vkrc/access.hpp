@@ -61,8 +61,8 @@ constexpr Use uniform_read(VkPipelineStageFlags2 stage) noexcept { return {stage
 // A storage image or buffer in a compute shader.
 inline constexpr Use compute_storage_read{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
                                           VK_IMAGE_LAYOUT_GENERAL};
-inline constexpr Use compute_storage_write{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL};
+inline constexpr Use compute_storage_write{VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                           VK_IMAGE_LAYOUT_GENERAL};
 inline constexpr Use compute_storage_read_write{
     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
     VK_IMAGE_LAYOUT_GENERAL};
@@ -110,8 +110,8 @@ inline VkImageMemoryBarrier2 image_barrier(const Image& image, Use previous, Use
 // The same over range (see mip_range and layer_range; their aspect is the caller's).
 inline VkImageMemoryBarrier2 image_barrier(const Image& image, const VkImageSubresourceRange& range, Use previous,
                                            Use next) {
-    return image_barrier(image.vk(), range, previous.layout, next.layout, previous.stage, previous.access,
-                         next.stage, next.access);
+    return image_barrier(image.vk(), range, previous.layout, next.layout, previous.stage, previous.access, next.stage,
+                         next.access);
 }
 // The buffer's size bytes from offset (VK_WHOLE_SIZE: to the end) between two uses.
 inline VkBufferMemoryBarrier2 buffer_barrier(const Buffer& buffer, Use previous, Use next, VkDeviceSize offset = 0,
