@@ -40,16 +40,17 @@ def main(out, seconds):
     print(f"\nwhat each variant costs per frame over raw-direct (raw C, device functions called directly)\n"
           f"{device}; {config}\n")
     print(f"{'variant':12} {'time per frame [95% CI]':>40} {'ratio [95% CI]':>24} {'instructions per frame':>24}"
-          f" {'outside the driver':>19}")
+          f" {'incl. the driver':>17}")
     for variant, ns, low, high, ratio, rlow, rhigh in costs:
         total, outside = counts.get(variant, (None, None))
         extra = f"{total - ref_total:+,.0f}" if total is not None else "-"
         extra_out = f"{outside - ref_outside:+,.0f}" if outside is not None else "-"
         time = f"{int(ns):+,} ns [{int(low):+,}, {int(high):+,}]"
-        print(f"{NAMES.get(variant, variant):12} {time:>40} {f'{ratio} [{rlow}, {rhigh}]':>24} {extra:>24}"
-              f" {extra_out:>19}")
-    print(f"(instructions by callgrind at 64x64, where raw-direct itself takes {ref_total:,.0f} per frame, "
-          f"{ref_outside:,.0f} outside the driver;\n the A/A control is raw-direct again: what the timer resolves)")
+        print(f"{NAMES.get(variant, variant):12} {time:>40} {f'{ratio} [{rlow}, {rhigh}]':>24} {extra_out:>24}"
+              f" {extra:>17}")
+    print(f"(instructions by callgrind at 64x64, outside the driver (lavapipe's own count varies a little from run"
+          f" to run);\n raw-direct itself: {ref_outside:,.0f} per frame outside the driver, {ref_total:,.0f} with it;"
+          " the A/A control is raw-direct again: what the timer resolves)")
     differing = [name for name, verdict, _, _ in images if verdict != "identical"]
     compared = sum(int(n) for _, _, _, n in images)
     print("image check: " + ("every variant's frames identical to raw-direct's" if not differing else
