@@ -11,8 +11,7 @@ int main() {
     auto cmd = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()}).allocate();
     cmd.begin();
     cmd.fill_buffer(buffer, 0, buffer.size(), 42);
-    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    auto to_host = vkrc::memory_barrier(vkrc::use::transfer_dst, vkrc::use::host_read);  // fill, then read
     cmd.pipeline_barrier(vkrc::Span(&to_host, 1), {}, {});
     cmd.end();
     auto done = vkrc::Fence::create(device);

@@ -17,6 +17,7 @@
 
 namespace {
 
+using vkrc_test::SyncValidatedTest;
 using vkrc_test::VulkanTest;
 
 constexpr std::uint32_t size = 64;
@@ -290,6 +291,56 @@ TEST_F(VulkanTest, DepthTestedQuadsWithDynamicRendering) {
     EXPECT_EQ(pixel(pixels, 44, 44), red);    // far quad only
     EXPECT_EQ(pixel(pixels, 2, 2), black);    // background
     EXPECT_EQ(pixel(pixels, 60, 4), black);
+}
+
+// Two passes into the same colour and depth images, each read back, with
+// every barrier from one named use (vkrc/access.hpp) to the next and the
+// aspect from the image's format, under synchronization validation: a
+// missing or too narrow barrier would be a reported hazard.
+void render_through_uses(const vkrc::CommandBuffer& cmd, const DepthTarget& target,
+                         const vkrc::GraphicsPipeline& pipeline, const RectPush& quad, const vkrc::Buffer& pixels,
+                         vkrc::Use colour_before, vkrc::Use depth_before) {
+    namespace use = vkrc::use;
+    cmd.pipeline_barrier({}, {},
+                         std::array{vkrc::image_barrier(target.color, colour_before, use::colour_attachment_write),
+                                    vkrc::image_barrier(target.depth, depth_before, use::depth_attachment)});
+    vkrc::RenderingAttachment color{.image_view = target.color_view.vk()};
+    color.clear_value.color = {{0.0f, 0.0f, 0.0f, 1.0f}};
+    vkrc::RenderingAttachment depth{.image_view = target.depth_view.vk(), .image_layout = use::depth_attachment.layout};
+    depth.clear_value.depthStencil = {1.0f, 0};
+    cmd.begin_rendering(
+        {.render_area = {{0, 0}, {size, size}}, .color_attachments = std::span(&color, 1), .depth_attachment = &depth});
+    draw_quads(cmd, pipeline, std::span(&quad, 1));
+    cmd.end_rendering();
+    const auto to_copy = vkrc::image_barrier(target.color, use::colour_attachment_write, use::transfer_src);
+    cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {size, size, 1};
+    cmd.copy_image_to_buffer(target.color, use::transfer_src.layout, pixels, std::span(&region, 1));
+    const auto to_host = vkrc::buffer_barrier(pixels, use::transfer_dst, use::host_read);
+    cmd.pipeline_barrier({}, std::span(&to_host, 1), {});
+}
+
+TEST_F(SyncValidatedTest, TwoPassesThroughNamedUseBarriers) {
+    DepthTarget target(device);
+    auto first = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto second = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto pipeline = rect_pipeline(device);
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    render_through_uses(cmd, target, pipeline, near_green, first, vkrc::use::none, vkrc::use::none);
+    // The second pass overwrites what the copy read, and the depth the first pass wrote.
+    render_through_uses(cmd, target, pipeline, far_red, second, vkrc::use::discarded(vkrc::use::transfer_src),
+                        vkrc::use::discarded(vkrc::use::depth_attachment));
+    cmd.end();
+    submit_and_wait(queue, cmd);
+
+    EXPECT_EQ(pixel(first, 19, 19), green);
+    EXPECT_EQ(pixel(first, 44, 44), black);
+    EXPECT_EQ(pixel(second, 19, 19), black);
+    EXPECT_EQ(pixel(second, 44, 44), red);
 }
 
 // Everything (buffers, images, views, pipelines, descriptor sets, the command

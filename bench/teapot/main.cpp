@@ -88,6 +88,7 @@ struct Options {
     // Hidden: set by the parent for each child process.
     std::string worker_out;
     int worker_index = 0;
+    int worker_runs = 1;  // the parent's --runs, for the progress line's time left
 };
 
 std::string default_out_dir() {
@@ -215,6 +216,7 @@ Options parse(int argc, char** argv) {
         else if (a == "--window") o.config.window = true;
         else if (a == "--worker-out") o.worker_out = value();
         else if (a == "--worker-index") o.worker_index = int(integer(a, value(), 0, 1000000));
+        else if (a == "--worker-runs") o.worker_runs = positive(a, value());
         else if (a == "--help" || a == "-h") usage("help");
         else usage("unknown option '" + a + "'");
     }
@@ -306,20 +308,44 @@ double pixels_per_unit(const Config& c) {
     return 0.5 * c.height * std::abs(cam.proj[1][1]) / std::max(nearest, 1e-3);
 }
 
+// When this process started: what the progress line's time left scales from.
+const std::chrono::steady_clock::time_point process_start = std::chrono::steady_clock::now();
+
+// The timed rounds' progress on stderr: run, configuration, variant, block
+// and time left. On a terminal one line redrawn after every block of every
+// variant; otherwise a plain line about every tenth of the blocks. Time left
+// extrapolates this process's time so far to its remaining configurations
+// and blocks, and to the runs (processes) after it.
 class Progress {
 public:
-    explicit Progress(std::string label) : label_(std::move(label)), tty_(isatty(2)) {}
-    void show(int done, int total) {
-        if (!tty_) return;
-        std::fprintf(stderr, "\r%s %3d%%", label_.c_str(), total ? 100 * done / total : 100);
+    Progress(const Options& options, int config_index, int configs, std::string tag)
+        : run_(options.worker_index),
+          runs_(options.worker_runs),
+          config_(config_index),
+          configs_(configs),
+          tag_(std::move(tag)),
+          tty_(isatty(2)) {}
+    // completed: blocks of every variant done; block_done: this call ends one.
+    void show(const std::string& variant, int completed, int blocks, bool block_done) {
+        const int step = std::max(1, blocks / 10);
+        if (!tty_ && !(block_done && (completed % step == 0 || completed == blocks))) return;
+        const double done = (config_ + double(completed) / blocks) / configs_;
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - process_start).count();
+        char left[48] = "time left: estimating";
+        if (done > 0)
+            std::snprintf(left, sizeof left, "about %.0f s left", elapsed / done * ((1 - done) + (runs_ - run_ - 1)));
+        std::fprintf(stderr, "%srun %d/%d, %s [%d/%d]: %-18s block %d/%d, %s%s", tty_ ? "\r" : "", run_ + 1, runs_,
+                     tag_.c_str(), config_ + 1, configs_, variant.c_str(), block_done ? completed : completed + 1,
+                     blocks, left, tty_ ? "\033[K" : "\n");
         std::fflush(stderr);
     }
     ~Progress() {
-        if (tty_) std::fprintf(stderr, "\r%*s\r", int(label_.size()) + 6, "");
+        if (tty_) std::fprintf(stderr, "\r\033[K");
     }
 
 private:
-    std::string label_;
+    int run_, runs_, config_, configs_;
+    std::string tag_;
     bool tty_;
 };
 
@@ -501,13 +527,15 @@ void time_rounds(Measurement& m, int frames, Progress& progress) {
     for (int b = 0; b < blocks; ++b) {
         const int in_block = std::min(block_frames, frames - b * block_frames);
         const int frames_run = m.config.frames_in_flight + in_block;
-        for (std::size_t v : shuffled_order(m.variants.size(), m.rng)) {
+        const std::vector<std::size_t> order = shuffled_order(m.variants.size(), m.rng);
+        for (std::size_t v : order) {
             bring_to_front(m, v);  // untimed, between blocks
+            progress.show(m.result.variants[v].name, b, blocks, false);
             time_block(m, v, t_round, frames_run);
         }
         check_last_frames(m, t_round + double(frames_run - 1) * frame_step);
         t_round += double(frames_run + 1) * frame_step;
-        progress.show(b + 1, blocks);
+        progress.show(m.result.variants[order.back()].name, b + 1, blocks, true);
     }
 }
 
@@ -537,7 +565,7 @@ ConfigRun measure_configuration(const Options& options, const PlannedConfig& pla
     for (const std::string& name : variants_for(options, config)) m.result.variants.push_back({.name = name});
 
     preinit(m, scene);
-    Progress progress("[" + std::to_string(index + 1) + "/" + std::to_string(total) + "] " + config_tag(config));
+    Progress progress(options, index, total, config_tag(config));
     warm_up(m);
     time_rounds(m, planned.frames, progress);
     check_reference_frames(m);
@@ -687,11 +715,13 @@ std::vector<RunData> run_processes(const Options& options, int argc, char** argv
             }
             args.push_back(arg);
         }
-        for (std::string extra : {"--runs", "1", "--seed", "", "--worker-out", "", "--worker-index", ""})
+        for (std::string extra :
+             {"--runs", "1", "--seed", "", "--worker-out", "", "--worker-index", "", "--worker-runs", ""})
             args.push_back(extra);
-        args[args.size() - 5] = std::to_string(seed + std::uint64_t(i));
-        args[args.size() - 3] = file;
-        args[args.size() - 1] = std::to_string(i);
+        args[args.size() - 7] = std::to_string(seed + std::uint64_t(i));
+        args[args.size() - 5] = file;
+        args[args.size() - 3] = std::to_string(i);
+        args[args.size() - 1] = std::to_string(options.runs);
         std::vector<char*> child_argv;
         for (std::string& arg : args) child_argv.push_back(arg.data());
         child_argv.push_back(nullptr);
@@ -723,6 +753,7 @@ struct StageRow {
     Ratio to_ref;
     std::optional<Ratio> to_raw;
     std::optional<Ratio> speedup;  // threads > 1: the 1-thread configuration's time over this one's
+    Ratio above_ref_ns;            // the block medians' difference to the reference, nanoseconds
     double floor_us = 0;
     std::optional<double> above_floor_ns;
     std::optional<double> target;
@@ -758,24 +789,41 @@ struct BlockSource {
     std::size_t config = 0, variant = 0;
 };
 
-// ratios[run][block]: the block medians of numerator over those of
-// denominator, block b with block b. Within one configuration these are neighbours (the
-// same round); across configurations (the speed-up) they are the same
-// round's blocks of configurations run one after the other in that run.
-std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, BlockSource numerator,
-                                              BlockSource denominator, int stage) {
-    std::vector<std::vector<double>> ratios;
+// per_block[run][block]: combine(numerator's block median, denominator's),
+// block b with block b, where combine gives a value. Within one
+// configuration these are neighbours (the same round); across configurations
+// (the speed-up) they are the same round's blocks of configurations run one
+// after the other in that run.
+template <class Combine>
+std::vector<std::vector<double>> block_pairs(const std::vector<RunData>& runs, BlockSource numerator,
+                                             BlockSource denominator, int stage, Combine combine) {
+    std::vector<std::vector<double>> values;
     for (const RunData& run : runs) {
         const auto& mine = run.configs.at(numerator.config).variants.at(numerator.variant).blocks[stage];
         const auto& theirs = run.configs.at(denominator.config).variants.at(denominator.variant).blocks[stage];
         std::vector<double> per_block;
-        for (std::size_t b = 0; b < std::min(mine.size(), theirs.size()); ++b) {
-            const double reference = median_of(theirs[b]);
-            if (reference > 0) per_block.push_back(median_of(mine[b]) / reference);
-        }
-        ratios.push_back(std::move(per_block));
+        for (std::size_t b = 0; b < std::min(mine.size(), theirs.size()); ++b)
+            if (std::optional<double> value = combine(median_of(mine[b]), median_of(theirs[b])))
+                per_block.push_back(*value);
+        values.push_back(std::move(per_block));
     }
-    return ratios;
+    return values;
+}
+
+// The block medians' ratios (blocks with a zero reference left out).
+std::vector<std::vector<double>> block_ratios(const std::vector<RunData>& runs, BlockSource numerator,
+                                              BlockSource denominator, int stage) {
+    return block_pairs(runs, numerator, denominator, stage, [](double mine, double reference) {
+        return reference > 0 ? std::optional<double>(mine / reference) : std::nullopt;
+    });
+}
+
+// The block medians' differences, in nanoseconds.
+std::vector<std::vector<double>> block_differences_ns(const std::vector<RunData>& runs, BlockSource numerator,
+                                                      BlockSource denominator, int stage) {
+    return block_pairs(runs, numerator, denominator, stage, [](double mine, double reference) {
+        return std::optional<double>((mine - reference) * 1000.0);
+    });
 }
 
 // The speed-up of every row of a threaded configuration whose 1-thread
@@ -851,6 +899,8 @@ void add_stage_rows(ConfigAnalysis& a, const std::vector<RunData>& runs, std::si
             auto ref_ratios = block_ratios(runs, {c, v}, {c, 0}, s);
             for (const auto& run : ref_ratios) row.blocks += run.size();
             row.to_ref = block_bootstrap_ratio(ref_ratios);
+            // The same two-level bootstrap, over differences instead of ratios.
+            row.above_ref_ns = block_bootstrap_ratio(block_differences_ns(runs, {c, v}, {c, 0}, s));
             if (raw) row.to_raw = block_bootstrap_ratio(block_ratios(runs, {c, v}, {c, *raw}, s));
             row.floor_us = floor_us;
             if (s >= 1 && s <= frame_stages) row.above_floor_ns = (row.summary.median - floor_us) * 1000.0;
@@ -1104,11 +1154,26 @@ void write_speedup_plots(const std::string& dir, const std::vector<ConfigAnalysi
     }
 }
 
+// Per configuration, what each variant's frame costs over the reference:
+// the newcomer's answer, above the tables' detail.
+void print_frame_costs(const ConfigAnalysis& a) {
+    std::printf(
+        "\nper-frame cost over %s, %s (frame stage: median of the block medians' differences and ratios, "
+        "95%% CI bootstrapped over the %d processes and their blocks)\n",
+        reference_name, config_tag(a.config).c_str(), a.runs);
+    for (const StageRow& row : a.rows)
+        if (row.stage == frame_stage && row.variant != reference_name)
+            std::printf("cost     %-18s %+8.0f ns [%+.0f, %+.0f]  ratio %s\n", row.variant.c_str(),
+                        row.above_ref_ns.ratio, row.above_ref_ns.low, row.above_ref_ns.high,
+                        format_ratio(row.to_ref).c_str());
+}
+
 void report(const std::vector<ConfigAnalysis>& results, const Options& options, const std::string& device,
             std::uint64_t seed) {
     std::printf("device: %s\nseed: %llu (--seed %llu repeats the shuffles)\n", device.c_str(), (unsigned long long)seed,
                 (unsigned long long)seed);
     for (const ConfigAnalysis& r : results) print_table(r);
+    for (const ConfigAnalysis& r : results) print_frame_costs(r);
     if (std::any_of(results.begin(), results.end(), [](const ConfigAnalysis& a) { return a.config.threads > 1; }))
         print_threads(results);
     if (options.sweep) print_sweep(results, options);

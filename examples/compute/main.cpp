@@ -75,8 +75,7 @@ int run(bool validation) {
     cmd.bind_descriptor_set(pipeline, 0, set);
     cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, count);
     cmd.dispatch((count + 63) / 64);
-    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
-                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    auto to_host = vkrc::memory_barrier(vkrc::use::compute_storage_write, vkrc::use::host_read);
     cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
     cmd.end();
 

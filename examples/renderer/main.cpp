@@ -110,38 +110,12 @@ Targets make_targets(const vkrc::Device& device, VkExtent2D e, VkSampleCountFlag
     return t;
 }
 
-// How an image is used at some point of the frame: its layout, and the stage and access that use
-// it there. A transition goes from one use to the next; without keep, the old contents are
-// discarded (layout UNDEFINED) and the barrier only orders the new use after the old one.
-struct Use {
-    VkImageLayout layout;
-    VkPipelineStageFlags2 stage;
-    VkAccessFlags2 access;
-};
-constexpr Use depth_write{
-    VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT};
-constexpr Use colour_write{VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                           VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT};
-constexpr Use fragment_read{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT};
-constexpr Use compute_read{VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT};
-constexpr Use storage_write{VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
-constexpr Use blit_read{VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_BLIT_BIT,
-                        VK_ACCESS_2_TRANSFER_READ_BIT};
-constexpr Use blit_write{VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_BLIT_BIT,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT};
-constexpr Use acquired{VK_IMAGE_LAYOUT_UNDEFINED, vkrc::Frame::acquire_stage, 0};  // a presenter's image
-
-void transition(const vkrc::CommandBuffer& cmd, const vkrc::Image& image, Use from, Use to, bool keep = true) {
-    const auto aspect = image.format() == depth_format ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
-    const auto b = vkrc::image_barrier(image.vk(), keep ? from.layout : VK_IMAGE_LAYOUT_UNDEFINED, to.layout,
-                                       from.stage, from.access, to.stage, to.access, aspect);
-    cmd.pipeline_barrier({}, {}, std::span(&b, 1));
-}
+// The images' uses through a frame are named (vkrc/access.hpp); a barrier goes from one to the next,
+// with the aspect taken from the image's format. A discarded previous use keeps the order but lets
+// the layout transition drop the old contents.
+namespace use = vkrc::use;
+constexpr vkrc::Use fragment_read = use::sampled(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT);
+constexpr vkrc::Use compute_read = use::sampled(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
 
 int run(const vkrc_examples::WindowOrHeadless& options) {
     // 1. Instance, device and presenter, as in examples/teapot. Headless, the tone-map writes the
@@ -468,8 +442,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.reset_query_pool(timestamps, q, 4);
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q);
         // Shadow pass: the teapots' depth from the light, once the last frame is done sampling the map.
-        transition(cmd, shadow_map, fragment_read, depth_write, false);
-        vkrc::RenderingAttachment shadow_target{shadow_view.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL};
+        cmd.pipeline_barrier(
+            {}, {}, std::array{vkrc::image_barrier(shadow_map, use::discarded(fragment_read), use::depth_attachment)});
+        vkrc::RenderingAttachment shadow_target{shadow_view.vk(), use::depth_attachment.layout};
         shadow_target.clear_value.depthStencil = {1.0f, 0};
         cmd.begin_rendering({.render_area = {{0, 0}, {shadow_size, shadow_size}}, .depth_attachment = &shadow_target});
         record_draws(cmd, shadow_pipeline, {shadow_size, shadow_size}, uniforms.dynamic_offset(),
@@ -479,20 +454,27 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
 
         // Main pass: the secondaries' draws into the multisampled HDR image, resolved into targets.hdr
         // once the last frame's tone-map has read it.
-        transition(cmd, shadow_map, depth_write, fragment_read);
-        transition(cmd, targets.hdr, compute_read, colour_write, false);
-        if (targets.msaa) transition(cmd, targets.msaa, colour_write, colour_write, false);
-        transition(cmd, targets.depth, depth_write, depth_write, false);
+        cmd.pipeline_barrier(
+            {}, {},
+            std::array{
+                vkrc::image_barrier(shadow_map, use::depth_attachment, fragment_read),
+                vkrc::image_barrier(targets.hdr, use::discarded(compute_read), use::colour_attachment_write),
+                vkrc::image_barrier(targets.depth, use::discarded(use::depth_attachment), use::depth_attachment)});
+        if (targets.msaa)
+            cmd.pipeline_barrier(
+                {}, {},
+                std::array{vkrc::image_barrier(targets.msaa, use::discarded(use::colour_attachment_write),
+                                               use::colour_attachment_write)});
         vkrc::RenderingAttachment colour_target{.image_view = targets.hdr_view.vk()};
         if (targets.msaa) {
-            colour_target = {targets.msaa_view.vk(), colour_write.layout, VK_ATTACHMENT_LOAD_OP_CLEAR,
+            colour_target = {targets.msaa_view.vk(), use::colour_attachment_write.layout, VK_ATTACHMENT_LOAD_OP_CLEAR,
                              VK_ATTACHMENT_STORE_OP_DONT_CARE};
             colour_target.resolve_mode = VK_RESOLVE_MODE_AVERAGE_BIT;
             colour_target.resolve_image_view = targets.hdr_view.vk();
         }
         colour_target.clear_value.color = {{0.45f, 0.6f, 0.9f, 1.0f}};  // the sky, in HDR
-        vkrc::RenderingAttachment depth_target{targets.depth_view.vk(), depth_write.layout, VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                               VK_ATTACHMENT_STORE_OP_DONT_CARE};
+        vkrc::RenderingAttachment depth_target{targets.depth_view.vk(), use::depth_attachment.layout,
+                                               VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
         depth_target.clear_value.depthStencil = {1.0f, 0};
         cmd.begin_rendering({.render_area = {{0, 0}, frame.extent},
                              .color_attachments = std::span(&colour_target, 1),
@@ -503,22 +485,28 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 2);
 
         // Post: tone-map targets.hdr into the 8-bit image: the presented one or an intermediate blitted into it.
-        const Use presented{frame.present_layout, VK_PIPELINE_STAGE_2_NONE, 0};
-        transition(cmd, targets.hdr, colour_write, compute_read);
-        transition(cmd, ldr, blit_output ? blit_read : acquired, storage_write, false);
+        cmd.pipeline_barrier(
+            {}, {},
+            std::array{vkrc::image_barrier(targets.hdr, use::colour_attachment_write, compute_read),
+                       vkrc::image_barrier(ldr, use::discarded(blit_output ? use::transfer_src : use::acquired),
+                                           use::compute_storage_write)});
         cmd.bind_pipeline(post_pipeline);
         cmd.bind_descriptor_set(post_pipeline, 0, f.post_set);
         cmd.dispatch((frame.extent.width + 7) / 8, (frame.extent.height + 7) / 8);
         if (blit_output) {
-            transition(cmd, ldr, storage_write, blit_read);
-            transition(cmd, frame.image(), acquired, blit_write, false);
+            cmd.pipeline_barrier({}, {},
+                                 std::array{vkrc::image_barrier(ldr, use::compute_storage_write, use::transfer_src),
+                                            vkrc::image_barrier(frame.image(), use::acquired, use::transfer_dst)});
             const VkOffset3D end{std::int32_t(frame.extent.width), std::int32_t(frame.extent.height), 1};
             const VkImageBlit region{
                 {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, {{}, end}, {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1}, {{}, end}};
-            cmd.blit_image(ldr, blit_read.layout, frame.image(), blit_write.layout, std::span(&region, 1),
-                           VK_FILTER_NEAREST);
+            cmd.blit_image(ldr, use::transfer_src.layout, frame.image(), use::transfer_dst.layout,
+                           std::span(&region, 1), VK_FILTER_NEAREST);
         }
-        transition(cmd, frame.image(), blit_output ? blit_write : storage_write, presented);
+        cmd.pipeline_barrier(
+            {}, {},
+            std::array{vkrc::image_barrier(frame.image(), blit_output ? use::transfer_dst : use::compute_storage_write,
+                                           use::presented(frame.present_layout))});
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 3);
         cmd.end();
         vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},

@@ -138,22 +138,15 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
 
         const auto& cmd = f.cmd;
         cmd.begin();
-        const VkPipelineStageFlags2 depth_stages =
-            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+        namespace use = vkrc::use;
         const VkImageMemoryBarrier2 to_attachments[2] = {
-            vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT),
-            vkrc::image_barrier(
-                depth.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depth_stages,
-                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,  // the previous frame's
-                depth_stages,
-                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                VK_IMAGE_ASPECT_DEPTH_BIT)};
+            vkrc::image_barrier(frame.image(), use::acquired, use::colour_attachment_write),
+            // After the previous frame's depth tests; its depth is not kept.
+            vkrc::image_barrier(depth, use::discarded(use::depth_attachment), use::depth_attachment)};
         cmd.pipeline_barrier({}, {}, to_attachments);
         vkrc::RenderingAttachment colour_target{.image_view = frame.view().vk()};
         colour_target.clear_value.color = {{0.08f, 0.09f, 0.11f, 1.0f}};
-        vkrc::RenderingAttachment depth_target{depth_view.vk(), VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        vkrc::RenderingAttachment depth_target{depth_view.vk(), use::depth_attachment.layout,
                                                VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_DONT_CARE};
         depth_target.clear_value.depthStencil = {1.0f, 0};
         cmd.begin_rendering({.render_area = {{0, 0}, frame.extent},
@@ -169,9 +162,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             cmd.draw_indexed(static_cast<std::uint32_t>(mesh.indices.size()));
         }
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                              frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+        auto to_present =
+            vkrc::image_barrier(frame.image(), use::colour_attachment_write, use::presented(frame.present_layout));
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
         cmd.end();
         vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},

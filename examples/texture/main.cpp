@@ -105,9 +105,7 @@ int run(bool validation) {
     auto cmd = pool.allocate();
     cmd.begin();
     uploaded.record_acquire(cmd);  // the ownership acquire when the families differ
-    auto to_attachment = vkrc::image_barrier(
-        target.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    auto to_attachment = vkrc::image_barrier(target, vkrc::use::none, vkrc::use::colour_attachment_write);
     cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
     vkrc::RenderingAttachment attachment{.image_view = target_view.vk()};
     cmd.begin_rendering({.render_area = {{0, 0}, {width, size}}, .color_attachments = std::span(&attachment, 1)});
@@ -121,10 +119,7 @@ int run(bool validation) {
         cmd.draw(3);
     }
     cmd.end_rendering();
-    auto to_copy =
-        vkrc::image_barrier(target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    auto to_copy = vkrc::image_barrier(target, vkrc::use::colour_attachment_write, vkrc::use::transfer_src);
     cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
     cmd.end();
     auto done = vkrc::Fence::create(device);

@@ -90,9 +90,7 @@ int run(bool validation) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto primary = pool.allocate();
     primary.begin();
-    auto to_attachment = vkrc::image_barrier(
-        target.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    auto to_attachment = vkrc::image_barrier(target, vkrc::use::none, vkrc::use::colour_attachment_write);
     primary.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
     vkrc::RenderingAttachment attachment{.image_view = target_view.vk()};
     primary.begin_rendering({.render_area = {{0, 0}, {size, size}},
@@ -100,10 +98,7 @@ int run(bool validation) {
                              .flags = VK_RENDERING_CONTENTS_SECONDARY_COMMAND_BUFFERS_BIT});
     primary.execute_commands(secondaries);
     primary.end_rendering();
-    auto to_copy =
-        vkrc::image_barrier(target.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    auto to_copy = vkrc::image_barrier(target, vkrc::use::colour_attachment_write, vkrc::use::transfer_src);
     primary.pipeline_barrier({}, {}, std::span(&to_copy, 1));
     primary.end();
 

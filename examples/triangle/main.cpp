@@ -84,10 +84,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         }
         done.unsignal();
         cmd.begin();
-        auto to_attachment = vkrc::image_barrier(  // after the presentation engine is done with it
-            frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-            vkrc::Frame::acquire_stage, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-            VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        // After the presentation engine is done with it (the acquire semaphore's stage).
+        auto to_attachment =
+            vkrc::image_barrier(frame.image(), vkrc::use::acquired, vkrc::use::colour_attachment_write);
         cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
         vkrc::RenderingAttachment target{.image_view = frame.view().vk()};
         target.clear_value.color = {{0.1f, 0.1f, 0.12f, 1.0f}};  // the plain background
@@ -97,9 +96,8 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.bind_vertex_buffer(0, vertex_buffer);
         cmd.draw(3);
         cmd.end_rendering();
-        auto to_present = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                              frame.present_layout, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+        auto to_present = vkrc::image_barrier(frame.image(), vkrc::use::colour_attachment_write,
+                                              vkrc::use::presented(frame.present_layout));
         cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
         cmd.end();
         vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},

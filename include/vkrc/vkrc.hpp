@@ -1,6 +1,7 @@
 // The whole of vkrc. Each object family also has its own header.
 #pragma once
 
+#include "vkrc/access.hpp"
 #include "vkrc/barrier.hpp"
 #include "vkrc/bindless.hpp"
 #include "vkrc/command.hpp"

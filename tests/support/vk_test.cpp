@@ -53,8 +53,21 @@ vkrc::DescriptorSetLayout sample_texels_set_layout(const vkrc::Device& device) {
                                .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
 }
 
-void VulkanTest::SetUp() {
-    instance = vkrc::Instance::create(validated_instance_info(log));
+void VulkanTest::SetUp() { create_all(validated_instance_info(log)); }
+
+void SyncValidatedTest::SetUp() {
+    const VkValidationFeatureEnableEXT enable = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features{};
+    features.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+    features.enabledValidationFeatureCount = 1;
+    features.pEnabledValidationFeatures = &enable;
+    auto info = validated_instance_info(log);
+    info.next = &features;
+    create_all(info);
+}
+
+void VulkanTest::create_all(const vkrc::InstanceCreateInfo& instance_info) {
+    instance = vkrc::Instance::create(instance_info);
     physical_device = vkrc::PhysicalDevice::select(instance, test_device_requirements());
     device = vkrc::Device::create(physical_device);
     queue = device.default_queue();

@@ -59,6 +59,8 @@ class VulkanTest : public ::testing::Test {
 protected:
     void SetUp() override;
     void TearDown() override;
+    // What SetUp does, from the given instance info.
+    void create_all(const vkrc::InstanceCreateInfo& instance_info);
     // Drops the fixture's handles (tests that check destruction order call it).
     void release_all();
 
@@ -67,6 +69,13 @@ protected:
     vkrc::PhysicalDevice physical_device;
     vkrc::Device device;
     vkrc::Queue queue;
+};
+
+// The same with the validation layer's synchronization validation on: a
+// missing or too narrow barrier is a reported hazard, and fails the test.
+class SyncValidatedTest : public VulkanTest {
+protected:
+    void SetUp() override;
 };
 
 // Asserts that log has no messages (prints them otherwise).
