@@ -37,6 +37,24 @@ vkrc::InstanceCreateInfo injected_instance_info(const std::shared_ptr<vkrc_test:
 // the 2-core CI machine); under ThreadSanitizer, slower still, call
 // k gets injected_errors[k % 4] so that every call is still covered once.
 // VKRC_FAULT_ALL_ERRORS=0/1 overrides.
+// The scene's frame: the teapots cover the centre and leave the corners to
+// the black background, and a plausible share of the pixels (on lavapipe
+// and NVIDIA about a quarter; a blank or a cleared-to-colour frame fails).
+::testing::AssertionResult frame_is_the_scene(const std::vector<std::array<std::uint8_t, 4>>& frame) {
+    constexpr std::size_t side = 64;
+    if (frame.size() != side * side) return ::testing::AssertionFailure() << frame.size() << " pixels";
+    const auto covered = vkrc_test::covered_pixels(frame);
+    if (covered < frame.size() / 10 || covered > frame.size() / 2) {
+        return ::testing::AssertionFailure() << covered << " of " << frame.size() << " pixels covered";
+    }
+    for (std::size_t corner : {std::size_t{0}, side - 1, side * (side - 1), side * side - 1}) {
+        if (vkrc_test::covered_pixels({frame[corner]}) != 0) {
+            return ::testing::AssertionFailure() << "corner pixel " << corner << " is not background";
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
 bool all_errors() {
     if (const char* v = std::getenv("VKRC_FAULT_ALL_ERRORS")) return *v && *v != '0';
 #if defined(__SANITIZE_THREAD__)
@@ -51,8 +69,10 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
     const auto info = injected_instance_info(log);
     faults::arm(0, VK_SUCCESS);
     const auto start = std::chrono::steady_clock::now();
-    EXPECT_GT(vkrc_test::run_teapot_scenario(info), 100u) << "the teapots were not drawn";
+    // The reference frame: a run vkrc absorbed a failure in must draw it again.
+    const auto reference = vkrc_test::run_teapot_scenario(info);
     const std::uint64_t points = faults::failable_calls();
+    EXPECT_TRUE(frame_is_the_scene(reference));
     vkrc_test::expect_no_validation_messages(*log);
     ASSERT_GT(points, 50u) << "the wrapper does not see vkrc's calls";
 
@@ -69,8 +89,10 @@ TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
                 std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
             faults::arm(k, error);
             try {
-                vkrc_test::run_teapot_scenario(info);
+                const auto frame = vkrc_test::run_teapot_scenario(info);
                 absorbed[faults::fired_in() ? faults::fired_in() : "-"]++;
+                EXPECT_TRUE(frame == reference) << "injecting " << vkrc::to_string(error) << " into call " << k << " ("
+                                                << faults::fired_in() << ") was absorbed, but the frame differs";
             } catch (const vkrc::Error& ex) {
                 ++thrown;
                 EXPECT_EQ(ex.result(), error) << "call " << k << " (" << faults::fired_in() << "): " << ex.what();
