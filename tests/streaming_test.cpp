@@ -484,15 +484,16 @@ TEST_F(StreamingTest, RingWrapsWhileOlderFramesAreStillOnTheGpu) {
     // Khronos layer 1.3.239 may miss the gate's value signalled from the host
     // on the opener thread while this one waits in begin_frame; it then gives
     // up after its timeout and reports "Timeout waiting for timeline
-    // semaphore state to update. This is most likely a validation bug." It
-    // depends on timing: on lavapipe either none or 4 (the two semaphores
-    // waited on twice each). The values above show the frames ran after the
+    // semaphore state to update. This is most likely a validation bug." How
+    // often depends on timing (on lavapipe 0, 3 or 4 times: the two
+    // semaphores waited on, each at most twice), so at most 4 of exactly
+    // that id are allowed. The values above show the frames ran after the
     // gate and in order; any other message still fails the test.
     const auto messages = log->take();
     const auto timeouts = std::count_if(messages.begin(), messages.end(), [](const std::string& m) {
         return m.starts_with("UNASSIGNED-VkSemaphore-state-timeout: ");
     });
-    EXPECT_TRUE(timeouts == 0 || timeouts == 4) << timeouts << " layer timeouts";
+    EXPECT_LE(timeouts, 4) << "layer timeouts";
     EXPECT_EQ(messages.size(), std::size_t(timeouts)) << messages.front();
     EXPECT_THROW(ring.end_frame(), vkrc::UsageError);
     EXPECT_THROW(ring.allocate(4), vkrc::UsageError);
