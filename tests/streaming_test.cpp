@@ -369,13 +369,19 @@ TEST_F(StreamingTest, UploaderRejectsBadInput) {
 TEST_F(StreamingTest, UploaderDropEverythingWhileUploadsInFlight) {
     vkrc_test::Watchdog watchdog("dropping uploads in flight");
     auto gate = vkrc::Semaphore::create_timeline(device);
+    // The destinations stay; the Uploader (with its staging ring), the
+    // batches and a download go while the gate holds them back.
+    std::vector<vkrc::Buffer> buffers;
+    std::vector<std::vector<std::byte>> uploaded;
     {
         std::mt19937 rng(vkrc_test::test_seed());
-        auto uploader = vkrc::Uploader::create({.queue = transfer, .staging_size = 1 << 20});
+        auto uploader = vkrc::Uploader::create(
+            {.queue = transfer, .consumer_family = transfer.family_index(), .staging_size = 1 << 20});
         const vkrc::SemaphoreSubmit wait{gate, 1};
         for (int i = 0; i < 20; ++i) {
-            auto buffer = device_buffer(16 << 10);
-            uploader.upload_buffer(buffer, 0, random_bytes(rng, 16 << 10));
+            buffers.push_back(device_buffer(16 << 10));
+            uploaded.push_back(random_bytes(rng, 16 << 10));
+            uploader.upload_buffer(buffers.back(), 0, uploaded.back());
             if (i % 4 == 3) uploader.submit({&wait, 1});
         }
         uploader.download_buffer(device_buffer(64), 0, 64);
@@ -385,6 +391,11 @@ TEST_F(StreamingTest, UploaderDropEverythingWhileUploadsInFlight) {
     gate.signal(1);
     device.wait_idle();
     EXPECT_EQ(device.deferred_count(), 0u);
+    // What the dropped staging ring carried arrived.
+    for (std::size_t i = 0; i < buffers.size(); ++i) {
+        const auto got = vkrc::download_buffer(transfer, buffers[i], 0, 16 << 10);
+        EXPECT_TRUE(std::equal(got.begin(), got.end(), uploaded[i].begin(), uploaded[i].end())) << "upload " << i;
+    }
 }
 
 // Device lost while batches are in flight: the next submit reports it, the
