@@ -359,11 +359,17 @@ TEST_F(VulkanTest, RawInteropQueriesAndEventsByRawHandle) {
     EXPECT_EQ(fn.vkGetEventStatus(device.vk(), raw_event), VK_EVENT_RESET);
 }
 
+// The pass clears its attachment; the texels read back show it ran with the
+// raw pass and framebuffer (final layout TRANSFER_SRC, so no extra barrier).
 TEST_F(VulkanTest, RawInteropRenderPassByRawHandle) {
-    auto image = vkrc::Image::create(
-        device,
-        {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT});
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                     .extent = {4, 4, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
     auto view = vkrc::ImageView::create(image);
+    auto readback = vkrc::Buffer::create(
+        device,
+        {.size = 64, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
     VkAttachmentDescription attachment{0,
                                        VK_FORMAT_R8G8B8A8_UNORM,
                                        VK_SAMPLE_COUNT_1_BIT,
@@ -372,19 +378,39 @@ TEST_F(VulkanTest, RawInteropRenderPassByRawHandle) {
                                        VK_ATTACHMENT_LOAD_OP_DONT_CARE,
                                        VK_ATTACHMENT_STORE_OP_DONT_CARE,
                                        VK_IMAGE_LAYOUT_UNDEFINED,
-                                       VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+                                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    // The store and the layout transition are done before the copy reads.
+    VkSubpassDependency to_copy{0,
+                                VK_SUBPASS_EXTERNAL,
+                                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                                VK_ACCESS_TRANSFER_READ_BIT,
+                                0};
     auto pass = vkrc::RenderPass::create(
         device, {.attachments = {attachment},
-                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}}});
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
+                 .dependencies = {to_copy}});
     auto framebuffer =
         vkrc::Framebuffer::create(device, {.render_pass = pass, .attachments = {view}, .width = 4, .height = 4});
     const VkRenderPass raw_pass = pass.vk();
     const VkFramebuffer raw_framebuffer = framebuffer.vk();
     run(queue, [&](const vkrc::CommandBuffer& cmd) {
         VkClearValue clear{};
+        clear.color = {{1.0f, 0.0f, 1.0f, 1.0f}};
         cmd.begin_render_pass(raw_pass, raw_framebuffer, {{0, 0}, {4, 4}}, std::span(&clear, 1));
         cmd.end_render_pass();
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {4, 4, 1};
+        cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, std::span(&region, 1));
+        auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
     });
+    for (VkDeviceSize texel = 0; texel < 16; ++texel) {
+        EXPECT_EQ(readback.allocation().read_value<std::uint32_t>(texel * 4), 0xffff00ffu) << "texel " << texel;
+    }
 }
 
 // Descriptor objects made with the raw API: vkrc checks writes against the

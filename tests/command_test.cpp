@@ -30,12 +30,18 @@ TEST_F(VulkanTest, CommandBufferKeepsItsPoolAlive) {
     EXPECT_THROW(next.begin(), vkrc::UsageError);
 }
 
-// Everything is dropped while the GPU is held back by a timeline wait that
-// only the host can release: nothing may be destroyed before it completes.
+// Everything the work uses (pipeline and its layouts, shader module,
+// descriptor pool and set, the storage buffer it fills) is dropped while the
+// GPU is held back by a gate only the host opens; the pattern then read back
+// shows the work ran with every object intact.
 TEST_F(VulkanTest, DroppingEverythingAfterSubmitDefersDestruction) {
-    auto gate = vkrc::Semaphore::create_timeline(device, 0);
+    constexpr std::uint32_t count = 256, seed = 0x5eed;
+    vkrc_test::GpuGate gate(device);
     auto fence = vkrc::Fence::create(device);
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = vkrc::Buffer::create(device, {.size = count * 4,
+                                                  .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                  .memory = {.usage = vkrc::MemoryUsage::readback}});
     {
         auto set_layout = vkrc::DescriptorSetLayout::create(
             device, {.bindings = {{.binding = 0,
@@ -46,27 +52,43 @@ TEST_F(VulkanTest, DroppingEverythingAfterSubmitDefersDestruction) {
         auto descriptors = vkrc::DescriptorPool::create(
             device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
         auto set = descriptors.allocate(set_layout);
+        auto storage = vkrc::Buffer::create(
+            device,
+            {.size = count * 4, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, storage);
         auto pipeline =
             vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp));
         auto cmd = pool.allocate();
         cmd.begin();
         cmd.bind_pipeline(pipeline);
         cmd.bind_descriptor_set(pipeline, 0, set);
-        cmd.end();  // nothing dispatched: the set needs no buffer written
-        vkrc::SemaphoreSubmit wait{gate, 1};
-        vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, fence);
+        const std::uint32_t params[] = {count, seed};
+        cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(params), params);
+        cmd.dispatch(count / 64, 1);
+        auto to_copy = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_WRITE_BIT,
+                                            VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        cmd.pipeline_barrier(std::span(&to_copy, 1), {}, {});
+        const VkBufferCopy region{0, 0, count * 4};
+        cmd.copy_buffer(storage, readback, std::span(&region, 1));
+        auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                            VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        cmd.end();
+        gate.submit(queue, cmd, fence);
         // Every handle goes out of scope here, right after the submit.
     }
     EXPECT_EQ(pool.pending_free_count(), 1u);
-    // Set layout, pipeline layout, descriptor pool, pipeline (the shader module
-    // went before the submit, when nothing was pending).
-    EXPECT_EQ(device.deferred_count(), 4u);
+    // Set layout, pipeline layout, descriptor pool, pipeline, storage buffer
+    // and its memory (the shader module went before the submit, when nothing
+    // was pending; the set goes with its pool).
+    EXPECT_EQ(device.deferred_count(), 6u);
     EXPECT_EQ(fence.status(), VK_NOT_READY);
-    gate.signal(1);
-    // The submit carried no timeline signal (nothing was dropped before it);
-    // its fence shows the work complete.
+    gate.open();
     EXPECT_EQ(fence.wait(), VK_SUCCESS);  // a wait collects what completed
     EXPECT_EQ(device.deferred_count(), 0u);
+    for (std::uint32_t i = 0; i < count; ++i) {
+        ASSERT_EQ(readback.allocation().read_value<std::uint32_t>(i * 4), (i * 2654435761u) ^ seed) << "word " << i;
+    }
     auto cmd = pool.allocate();  // frees the dropped command buffer
     EXPECT_EQ(pool.pending_free_count(), 0u);
 }

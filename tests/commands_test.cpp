@@ -8,9 +8,11 @@
 #include "shaders/push_color.frag.h"
 #include "shaders/rect.vert.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace {
@@ -680,6 +682,43 @@ TEST_F(VulkanTest, QueryPoolRejectsStatisticsWithoutFlags) {
 
 // DebugUtils
 
+// The command-buffer labels the layer gives a message (DebugMessage has no
+// labels: a raw messenger hears them).
+VKAPI_ATTR VkBool32 VKAPI_CALL hear_labels(VkDebugUtilsMessageSeverityFlagBitsEXT, VkDebugUtilsMessageTypeFlagsEXT,
+                                           const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    auto& heard = *static_cast<std::vector<std::string>*>(user);
+    for (std::uint32_t i = 0; i < data->cmdBufLabelCount; ++i) heard.emplace_back(data->pCmdBufLabels[i].pLabelName);
+    return VK_FALSE;
+}
+
+// A label open on a command buffer reaches the validation layer: a message
+// about a command recorded inside it carries the label.
+TEST_F(VulkanTest, DebugUtilsLabelsReachMessagesAboutTheCommandBuffer) {
+    std::vector<std::string> heard;
+    VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    info.pfnUserCallback = hear_labels;
+    info.pUserData = &heard;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    ASSERT_EQ(instance.fn().vkCreateDebugUtilsMessengerEXT(instance.vk(), &info, nullptr, &messenger), VK_SUCCESS);
+    auto buffer = vkrc::Buffer::create(device, {.size = 64, .usage = VK_BUFFER_USAGE_VERTEX_BUFFER_BIT});
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();  // never submitted
+    cmd.begin();
+    cmd.begin_label("outer pass");
+    cmd.begin_label("inner pass");
+    device.fn().vkCmdFillBuffer(cmd.vk(), buffer.vk(), 0, 4, 0);  // no TRANSFER_DST usage: reported
+    cmd.end_label();
+    cmd.end_label();
+    cmd.end();
+    instance.fn().vkDestroyDebugUtilsMessengerEXT(instance.vk(), messenger, nullptr);
+    EXPECT_TRUE(log->take_expected("VUID-vkCmdFillBuffer-dstBuffer-00029", 1));
+    EXPECT_NE(std::find(heard.begin(), heard.end(), "outer pass"), heard.end());
+    EXPECT_NE(std::find(heard.begin(), heard.end(), "inner pass"), heard.end());
+}
+
+// Balanced labels on a submitted command buffer and on its queue.
 TEST_F(VulkanTest, DebugUtilsLabelsOnCommandBuffersAndQueues) {
     ASSERT_NE(device.fn().vkCmdBeginDebugUtilsLabelEXT, nullptr);  // validation enables debug utils
     queue.begin_label("frame", {0.2f, 0.4f, 0.6f, 1.0f});

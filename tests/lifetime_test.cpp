@@ -74,6 +74,21 @@ void submit_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd) {
     ASSERT_EQ(fence.wait(), VK_SUCCESS);
 }
 
+// Submits cmd behind a gate only the host opens and runs while_held with the
+// GPU held back (what was dropped is then certainly still in use: destroying
+// it would be reported by the validation layer and spoil what it produces);
+// then opens the gate and waits for the work.
+void submit_gated_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd,
+                           const std::function<void()>& while_held) {
+    const vkrc_test::GpuGate gate(queue.device());
+    auto fence = vkrc::Fence::create(queue.device());
+    gate.submit(queue, cmd, fence);
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    while_held();
+    gate.open();
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+}
+
 // Images are side x side RGBA8; each recorded operation of a test copies
 // its result (texels words, one per texel) into its own slot of readback.
 constexpr std::uint32_t side = 8;
@@ -213,7 +228,7 @@ TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
         cmd.end();
     }                                        // buffer dropped here
     EXPECT_GE(device.deferred_count(), 1u);  // held, not destroyed
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_GE(device.deferred_count(), 1u); });
     EXPECT_TRUE(all_equal(readback, 7));
     EXPECT_EQ(device.deferred_count(), 0u);
 }
@@ -229,8 +244,9 @@ TEST_F(VulkanTest, BufferDroppedWhileRecording) {
         record_fill_copy(cmd, buffer, readback, 7);
     }
     cmd.end();
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_GE(device.deferred_count(), 1u); });
     EXPECT_TRUE(all_equal(readback, 7));
+    EXPECT_EQ(device.deferred_count(), 0u);
 }
 
 // Every kind the recorded work uses: an image cleared and then sampled
@@ -254,7 +270,7 @@ TEST_F(VulkanTest, EveryKindDroppedBetweenRecordAndSubmit) {
         o = Objects{};
         EXPECT_GE(device.deferred_count(), before + 9);  // held, not destroyed
     }
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_GE(device.deferred_count(), 9u); });
     EXPECT_TRUE(slot_holds(readback, 0, color.packed));
     EXPECT_EQ(device.deferred_count(), 0u);
 }
@@ -273,7 +289,7 @@ TEST_F(VulkanTest, DroppedBetweenSubmissionsOfAReusableCommandBuffer) {
     EXPECT_TRUE(all_equal(readback, 7));
     clear_readback(readback);
     buffer.reset();
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_GE(device.deferred_count(), 1u); });
     EXPECT_TRUE(all_equal(readback, 7));
     EXPECT_GE(device.deferred_count(), 1u);  // still held by cmd
     cmd.reset_commands();
@@ -298,7 +314,10 @@ TEST_F(VulkanTest, DroppedInsideASecondary) {
         cmd.end();
     }
     EXPECT_EQ(pool.pending_free_count(), 1u);  // the secondary, held by cmd
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] {
+        EXPECT_EQ(pool.pending_free_count(), 1u);
+        EXPECT_GE(device.deferred_count(), 1u);  // the buffer
+    });
     EXPECT_TRUE(all_equal(readback, 7));
     auto next = pool.allocate();  // frees the secondary
     EXPECT_EQ(pool.pending_free_count(), 0u);
@@ -372,7 +391,7 @@ TEST_F(VulkanTest, AdoptedBufferCleanupRunsAfterTheGpu) {
         cmd.end();
     }
     EXPECT_FALSE(cleaned);
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_FALSE(cleaned); });
     EXPECT_TRUE(cleaned);
     EXPECT_TRUE(all_equal(readback, 7));
 }
@@ -438,7 +457,7 @@ TEST_F(VulkanTest, AdoptedImageCleanupRunsAfterTheGpu) {
         cmd.end();
     }
     EXPECT_FALSE(cleaned);
-    submit_and_wait(queue, cmd);
+    submit_gated_and_wait(queue, cmd, [&] { EXPECT_FALSE(cleaned); });
     EXPECT_TRUE(cleaned);
     EXPECT_TRUE(slot_holds(readback, 0, color.packed));
 }
@@ -608,11 +627,22 @@ struct Coverage {
 };
 
 // One round: random objects, one command buffer (its work possibly in a
-// secondary) recording random operations on those still alive, and every
-// handle, the round's instance, device and queue included, dropped at a
-// random point in a random order. A round that waits checks each
-// operation's result in its slot of readback; one that does not drops
-// everything with the work in flight.
+// secondary) recording random operations on those still alive, submitted
+// behind a gate only the host opens, and every handle, the round's instance,
+// device and queue included, dropped at a random point in a random order:
+// those dropped after the submit go while the GPU is certainly held. Then
+// the gate opens and every round checks each operation's result in its slot
+// of readback, which (with the gate and the completion semaphore) is the one
+// thing kept. A round that waits waits on its fence; one that does not may
+// drop the fence with the work in flight and waits on the completion value.
+// A round's completion semaphore and gate; the gate goes first, waiting for
+// the device to be idle before either is destroyed (see GpuGate).
+struct RoundSync {
+    vkrc::Semaphore done;
+    vkrc_test::GpuGate gate;
+    explicit RoundSync(const vkrc::Device& device) : done(vkrc::Semaphore::create_timeline(device)), gate(device) {}
+};
+
 struct Round {
     std::mt19937& rng;
     Coverage& coverage;
@@ -626,6 +656,8 @@ struct Round {
 
     void run(bool wait) {
         auto& device = o.device;
+        const RoundSync sync(device);
+        const auto& [done, gate] = sync;
         o.pool = vkrc::CommandPool::create(device, {.queue_family_index = o.queue.family_index()});
         o.cmd = o.pool.allocate();
         o.fence = vkrc::Fence::create(device);
@@ -662,8 +694,7 @@ struct Round {
         add(o.pool, any_first, any_last);
         add(o.cmd, DropPoint::after_submit, any_last);  // needed to submit
         add(o.fence, wait ? DropPoint::after_wait : DropPoint::after_submit, any_last);
-        // Every operation copies into readback; a round that waits reads it at the end.
-        if (!wait) add(o.readback, DropPoint::after_end, any_last);
+        // Every operation copies into readback, which every round reads after the work.
         add(o.source, any_first, any_last);
         add(o.storage, any_first, any_last);
         add(o.image, any_first, any_last);
@@ -709,17 +740,25 @@ struct Round {
         o.cmd.end();
         drop_at(DropPoint::after_end);
         const auto queue = o.queue ? o.queue : o.cmd.pool().device().default_queue();
-        vkrc::submit(queue, {.command_buffers = std::span(&o.cmd, 1)}, o.fence);
+        const auto held = gate.wait();
+        const vkrc::SemaphoreSubmit finished{done, 1};
+        vkrc::submit(
+            queue,
+            {.waits = std::span(&held, 1), .command_buffers = std::span(&o.cmd, 1), .signals = std::span(&finished, 1)},
+            o.fence);
         drop_at(DropPoint::after_submit);
+        ASSERT_EQ(done.value(), 0u) << "the work ran before the gate opened";
+        gate.open();
         if (wait) {
             ASSERT_EQ(o.fence.wait(), VK_SUCCESS);
-            for (int slot = 0; slot < slots; ++slot) {
-                if (expected[slot]) {
-                    ASSERT_TRUE(slot_holds(o.readback, slot, *expected[slot])) << "slot " << slot;
-                }
-            }
         } else {
+            ASSERT_EQ(done.wait(1), VK_SUCCESS);
             ++coverage.unwaited;
+        }
+        for (int slot = 0; slot < slots; ++slot) {
+            if (expected[slot]) {
+                ASSERT_TRUE(slot_holds(o.readback, slot, *expected[slot])) << "slot " << slot;
+            }
         }
         drop_at(DropPoint::after_wait);
     }
@@ -763,13 +802,14 @@ struct Round {
     }
 };
 
-// Every 20th round makes its own instance and device, so that their last
-// handles (and with them the Vulkan objects) may go at any point; the other
+// Every 20th round makes its own instance and device, so that the round's
+// handles to them may go at any point (its gate, completion semaphore and
+// readback keep the Vulkan objects until the round's end); the other
 // rounds drop their copies of the fixture's. One round in eight (one in
-// two of those with a fresh device) never waits.
+// two of those with a fresh device) does not wait on its fence. The seed
+// comes from VKRC_TEST_SEED when set (test_seed), to replay a failing run.
 TEST_F(VulkanTest, RandomDropPointsAndOrders) {
-    const unsigned seed = std::random_device{}();
-    std::printf("RandomDropPointsAndOrders seed: %u\n", seed);
+    const auto seed = vkrc_test::test_seed();
     SCOPED_TRACE("seed " + std::to_string(seed));
     std::mt19937 rng(seed);
     Coverage coverage;
@@ -814,8 +854,7 @@ TEST_F(VulkanTest, RandomDropPointsAndOrders) {
 // Eight threads record into their own pools and drop what they recorded at
 // random points, on a shared device and queue.
 TEST_F(VulkanTest, EightThreadsRecordAndDrop) {
-    const unsigned seed = std::random_device{}();
-    std::printf("EightThreadsRecordAndDrop seed: %u\n", seed);
+    const auto seed = vkrc_test::test_seed();
     std::vector<std::thread> threads;
     std::atomic<int> failures{0};
     for (unsigned t = 0; t < 8; ++t) {

@@ -315,36 +315,45 @@ TEST_P(AllocatorTest, BufferViewsAndSamplers) {
     EXPECT_NE(sampler.vk(), VK_NULL_HANDLE);
 }
 
-// Memory is returned only after the GPU work submitted before the drop completes.
+// Memory is returned only after the GPU work submitted before the drop
+// completes: the work, held behind a host-opened gate, copies the dropped
+// buffer, and the copy read back afterwards holds what was written into it.
 TEST_P(AllocatorTest, MemoryOutlivesPendingGpuWork) {
-    VkSemaphoreTypeCreateInfo type{VK_STRUCTURE_TYPE_SEMAPHORE_TYPE_CREATE_INFO, nullptr, VK_SEMAPHORE_TYPE_TIMELINE,
-                                   0};
-    VkSemaphoreCreateInfo sem_info{VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO, &type};
-    VkSemaphore gate = VK_NULL_HANDLE;
-    ASSERT_EQ(device.fn().vkCreateSemaphore(device.vk(), &sem_info, nullptr, &gate), VK_SUCCESS);
-    VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO, nullptr, gate, 1,
-                               VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT};
-    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    submit.waitSemaphoreInfoCount = 1;
-    submit.pWaitSemaphoreInfos = &wait;
-
+    vkrc_test::GpuGate gate(device);
     auto buffer = make_buffer(4096, vkrc::MemoryUsage::upload);
-    queue.submit({&submit, 1});  // pending until the host signals the gate
+    const std::vector<std::uint32_t> words(1024, 0xa110c8edu);
+    buffer.allocation().write(0, std::span(words));
+    auto readback = vkrc::Buffer::create(
+        device,
+        {.size = 4096, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    cmd.begin();
+    const VkBufferCopy region{0, 0, 4096};
+    cmd.copy_buffer(buffer, readback, std::span(&region, 1));
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    gate.submit(queue, cmd, fence);  // pending until the host opens the gate
     buffer.reset();
     EXPECT_EQ(device.deferred_count(), 2u);  // the VkBuffer, then its memory
     if (GetParam() != Kind::user) {
         EXPECT_EQ(allocator->statistics(view()).total().allocation_count, 1u);
     }
-    VkSemaphoreSignalInfo signal{VK_STRUCTURE_TYPE_SEMAPHORE_SIGNAL_INFO, nullptr, gate, 1};
-    ASSERT_EQ(device.fn().vkSignalSemaphore(device.vk(), &signal), VK_SUCCESS);
-    queue.wait_idle();
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    gate.open();
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
     EXPECT_EQ(device.deferred_count(), 0u);
     if (GetParam() != Kind::user) {
         EXPECT_EQ(allocator->statistics(view()).total().allocation_count, 0u);
     } else {
         EXPECT_EQ(static_cast<ArenaAllocator&>(*allocator).frees, 1u);
     }
-    device.fn().vkDestroySemaphore(device.vk(), gate, nullptr);
+    std::vector<std::uint32_t> copied(1024);
+    readback.allocation().read(0, std::span(copied));
+    EXPECT_EQ(copied, words);
 }
 
 // The device keeps every allocator used with it, and calls release() at teardown.
@@ -782,8 +791,9 @@ TEST_F(PoolTest, ShardedConcurrentAllocateAndFree) {
     ASSERT_EQ(pool.shard_count(), 4u);
     constexpr int thread_count = 8;
     std::vector<std::vector<vkrc::AllocationInfo>> live(thread_count);
+    const auto seed = vkrc_test::test_seed();
     on_threads(thread_count, [&](int t) {
-        std::mt19937 rng(static_cast<unsigned>(t));
+        std::mt19937 rng(seed + static_cast<unsigned>(t));
         auto& mine = live[static_cast<std::size_t>(t)];
         for (int i = 0; i < 1000; ++i) {
             if (mine.size() < 24 && (rng() % 3 != 0 || mine.empty())) {
@@ -875,9 +885,10 @@ TEST_F(PoolTest, ConcurrentAllocateAndFree) {
     info.shards = 4;
     auto pool = vkrc::make_allocator<vkrc::PoolAllocator>(info);
     std::vector<std::thread> threads;
+    const auto seed = vkrc_test::test_seed();
     for (int t = 0; t < 8; ++t) {
         threads.emplace_back([&, t] {
-            std::mt19937 rng(t);
+            std::mt19937 rng(seed + static_cast<unsigned>(t));
             std::vector<vkrc::Allocation> live;
             for (int i = 0; i < 300; ++i) {
                 if (live.size() < 16 && (rng() % 3 != 0 || live.empty())) {

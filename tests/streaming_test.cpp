@@ -7,13 +7,16 @@
 #include "support/watchdog.hpp"
 
 #include "shaders/fill_pattern.comp.h"
+#include "shaders/read_uniform.comp.h"
 #include "shaders/sample_texels.comp.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <random>
 #include <span>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -118,7 +121,7 @@ TEST_F(VulkanTest, StreamingQueuesExplicitRequestsGetRoles) {
 // wraps and waits for its oldest batch many times.
 TEST_F(StreamingTest, UploaderThousandRandomUploadsInFlightWithRendering) {
     vkrc_test::Watchdog watchdog("1000 uploads");
-    std::mt19937 rng(15);
+    std::mt19937 rng(vkrc_test::test_seed());
     constexpr int uploads = 1000, per_batch = 10;
     std::vector<std::size_t> sizes(uploads);
     VkDeviceSize total = 0;
@@ -168,7 +171,7 @@ TEST_F(StreamingTest, OwnershipTransferToTheGraphicsFamily) {
     if (transfer.family_index() == queue.family_index()) {
         GTEST_SKIP() << "needs a transfer queue of another family than graphics (a dedicated transfer family)";
     }
-    std::mt19937 rng(3);
+    std::mt19937 rng(vkrc_test::test_seed());
     const auto data = random_bytes(rng, 1 << 16);
     auto dst = device_buffer(data.size());
     auto uploader = vkrc::Uploader::create({.queue = transfer});
@@ -268,7 +271,7 @@ TEST_F(StreamingTest, UploaderBlockCompressedImageByBlockSize) {
                                      .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
     // 4x2 + 2x1 + 1 + 1 + 1 blocks of 8 bytes.
     ASSERT_EQ(vkrc::image_data_size(image), (8u + 2 + 1 + 1 + 1) * 8);
-    std::mt19937 rng(1);
+    std::mt19937 rng(vkrc_test::test_seed());
     const auto data = random_bytes(rng, vkrc::image_data_size(image));
     auto uploader = vkrc::Uploader::create({.queue = transfer, .consumer_family = transfer.family_index()});
     uploader.upload_image(image, data, {.new_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
@@ -326,7 +329,7 @@ TEST_F(StreamingTest, UploaderBaseLevelThenGeneratedMips) {
 }
 
 TEST_F(StreamingTest, UploaderDownloadIsNonBlocking) {
-    std::mt19937 rng(4);
+    std::mt19937 rng(vkrc_test::test_seed());
     const auto data = random_bytes(rng, 4096);
     auto buffer = device_buffer(data.size());
     vkrc::upload_buffer(transfer, buffer, 0, data);
@@ -366,13 +369,19 @@ TEST_F(StreamingTest, UploaderRejectsBadInput) {
 TEST_F(StreamingTest, UploaderDropEverythingWhileUploadsInFlight) {
     vkrc_test::Watchdog watchdog("dropping uploads in flight");
     auto gate = vkrc::Semaphore::create_timeline(device);
+    // The destinations stay; the Uploader (with its staging ring), the
+    // batches and a download go while the gate holds them back.
+    std::vector<vkrc::Buffer> buffers;
+    std::vector<std::vector<std::byte>> uploaded;
     {
-        std::mt19937 rng(9);
-        auto uploader = vkrc::Uploader::create({.queue = transfer, .staging_size = 1 << 20});
+        std::mt19937 rng(vkrc_test::test_seed());
+        auto uploader = vkrc::Uploader::create(
+            {.queue = transfer, .consumer_family = transfer.family_index(), .staging_size = 1 << 20});
         const vkrc::SemaphoreSubmit wait{gate, 1};
         for (int i = 0; i < 20; ++i) {
-            auto buffer = device_buffer(16 << 10);
-            uploader.upload_buffer(buffer, 0, random_bytes(rng, 16 << 10));
+            buffers.push_back(device_buffer(16 << 10));
+            uploaded.push_back(random_bytes(rng, 16 << 10));
+            uploader.upload_buffer(buffers.back(), 0, uploaded.back());
             if (i % 4 == 3) uploader.submit({&wait, 1});
         }
         uploader.download_buffer(device_buffer(64), 0, 64);
@@ -382,6 +391,11 @@ TEST_F(StreamingTest, UploaderDropEverythingWhileUploadsInFlight) {
     gate.signal(1);
     device.wait_idle();
     EXPECT_EQ(device.deferred_count(), 0u);
+    // What the dropped staging ring carried arrived.
+    for (std::size_t i = 0; i < buffers.size(); ++i) {
+        const auto got = vkrc::download_buffer(transfer, buffers[i], 0, 16 << 10);
+        EXPECT_TRUE(std::equal(got.begin(), got.end(), uploaded[i].begin(), uploaded[i].end())) << "upload " << i;
+    }
 }
 
 // Device lost while batches are in flight: the next submit reports it, the
@@ -398,7 +412,10 @@ TEST(UploaderDeviceLoss, DeviceLossDuringAnUpload) {
     auto device = vkrc::Device::create(physical, {.transfer_queue = true});
     auto transfer = device.queue_for(vkrc::QueueRole::transfer).queue;
     auto uploader = vkrc::Uploader::create({.queue = transfer, .staging_size = 1 << 16});
-    auto buffer = vkrc::Buffer::create(device, {.size = 1 << 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+    // Room for every upload below at its own offset: uploads of one batch are
+    // not ordered against each other (synchronization validation reports
+    // overlapping ones as a write-after-write hazard).
+    auto buffer = vkrc::Buffer::create(device, {.size = 10 << 14, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
     std::vector<std::byte> data(1 << 14, std::byte{7});
     uploader.upload_buffer(buffer, 0, data);
     const auto first = uploader.submit();
@@ -412,7 +429,7 @@ TEST(UploaderDeviceLoss, DeviceLossDuringAnUpload) {
     // The ring keeps working as far as the host goes: space is reclaimed without waiting.
     for (int i = 0; i < 8; ++i) {
         try {
-            uploader.upload_buffer(buffer, 0, data);
+            uploader.upload_buffer(buffer, VkDeviceSize(i + 2) << 14, data);
         } catch (const vkrc::DeviceLostError&) {}
     }
     uploader = {};
@@ -474,36 +491,78 @@ TEST_F(StreamingTest, RingWrapsWhileOlderFramesAreStillOnTheGpu) {
         EXPECT_EQ(static_cast<std::uint8_t>(got[frame * slice]), frame + 1) << "frame " << frame;
         EXPECT_EQ(static_cast<std::uint8_t>(got[frame * slice + slice - 1]), frame + 1) << "frame " << frame;
     }
+    // A layer false positive: with synchronization validation on, the
+    // Khronos layer 1.3.239 may miss the gate's value signalled from the host
+    // on the opener thread while this one waits in begin_frame; it then gives
+    // up after its timeout and reports "Timeout waiting for timeline
+    // semaphore state to update. This is most likely a validation bug." How
+    // often depends on timing (on lavapipe 0, 3 or 4 times: the two
+    // semaphores waited on, each at most twice), so at most 4 of exactly
+    // that id are allowed. The values above show the frames ran after the
+    // gate and in order; any other message still fails the test.
+    const auto messages = log->take();
+    const auto timeouts = std::count_if(messages.begin(), messages.end(), [](const std::string& m) {
+        return m.starts_with("UNASSIGNED-VkSemaphore-state-timeout: ");
+    });
+    EXPECT_LE(timeouts, 4) << "layer timeouts";
+    EXPECT_EQ(messages.size(), std::size_t(timeouts)) << messages.front();
     EXPECT_THROW(ring.end_frame(), vkrc::UsageError);
     EXPECT_THROW(ring.allocate(4), vkrc::UsageError);
 }
 
+// Three dispatches read their own ring allocation through one dynamic
+// uniform descriptor; each copies what it read into its slot of out.
 TEST_F(StreamingTest, RingDynamicUniformDescriptor) {
     auto ring = vkrc::FrameRing::create({.queue = queue});
     auto set_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{.binding = 0,
                                .descriptor_type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT},
+                              {.binding = 1,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
     auto descriptors = vkrc::DescriptorPool::create(
-        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1}}});
+        device,
+        {.max_sets = 1,
+         .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
     auto set = descriptors.allocate(set_layout);
+    auto out = vkrc::Buffer::create(
+        device, {.size = 16, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {vkrc::MemoryUsage::readback}});
     vkrc::write_dynamic_buffer(set, 0, ring, 64);
-    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
+    auto layout = vkrc::PipelineLayout::create(
+        device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 4}}});
+    auto pipeline =
+        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::read_uniform_comp));
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = pool.allocate();
     ring.begin_frame();
     cmd.begin();
-    for (int draw = 0; draw < 3; ++draw) {
+    cmd.bind_pipeline(pipeline);
+    for (std::uint32_t draw = 0; draw < 3; ++draw) {
         auto a = ring.allocate(64);
-        a.view.write_value(0, draw);
+        a.view.write_value(0, 100 + draw);
         const VkDescriptorSet raw = set.vk();
         const std::uint32_t offset = a.dynamic_offset();
         cmd.fn().vkCmdBindDescriptorSets(cmd.vk(), VK_PIPELINE_BIND_POINT_COMPUTE, layout.vk(), 0, 1, &raw, 1, &offset);
+        cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, draw);
+        cmd.dispatch(1, 1);
+        // Each writes its own word of out, but through the same descriptor:
+        // ordered, as synchronization validation tracks the whole range.
+        auto after = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        cmd.pipeline_barrier(std::span(&after, 1), {}, {});
     }
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
     cmd.end();
     vkrc::submit(queue, {.command_buffers = {&cmd, 1}});
     ring.end_frame();
     queue.wait_idle();
+    for (std::uint32_t draw = 0; draw < 3; ++draw) {
+        EXPECT_EQ(out.allocation().read_value<std::uint32_t>(draw * 4), 100 + draw) << "dispatch " << draw;
+    }
 }
 
 // fill_pattern on the compute queue, behind a host gate; the graphics queue

@@ -2,6 +2,12 @@
 #include "support/features.hpp"
 #include "support/vk_test.hpp"
 
+#include "shaders/sample_ycbcr.comp.h"
+
+#include <algorithm>
+#include <cstring>
+#include <span>
+
 namespace {
 
 using vkrc_test::VulkanTest;
@@ -100,23 +106,81 @@ vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcr
 }
 
 // Shaders reach a Y'CbCr sampler only as an immutable sampler of a set layout,
-// which keeps it (and so the conversion) alive.
+// which keeps it (and so the conversion) alive. A 4x4 NV12 image of Y' 16,
+// Cb 128, Cr 240 (BT.709, narrow range: Y 0, Cb 0, Cr 0.5) samples as
+// R = 1.5748 * 0.5 (201 of 255), G and B 0 (clamped), through a layout whose
+// sampler's handle is gone.
 TEST_F(YcbcrTest, YcbcrSamplerImmutableInASetLayout) {
     auto conversion = nv12_conversion(device);
     auto set_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{.binding = 0,
                                .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-                               .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT,
-                               .immutable_samplers = {ycbcr_sampler(device, conversion)}}}});
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT,
+                               .immutable_samplers = {ycbcr_sampler(device, conversion)}},
+                              {.binding = 1,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                               .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
     EXPECT_EQ(conversion.use_count(), 2u) << "held by the layout's sampler";
     // A multi-planar format may take several descriptors of the pool (up to one per plane).
-    auto pool = vkrc::DescriptorPool::create(
-        device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3}}});
+    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1,
+                                                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
+                                                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
     auto set = pool.allocate(set_layout);
-    auto image =
-        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto image = vkrc::Image::create(
+        device,
+        {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
     auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+    auto out = vkrc::Buffer::create(
+        device, {.size = 64, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .memory = {vkrc::MemoryUsage::readback}});
     set.write_image(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
+    auto staging = vkrc::Buffer::create(
+        device, {.size = 24, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT, .memory = {vkrc::MemoryUsage::upload}});
+    std::uint8_t planes[24];
+    std::fill(planes, planes + 16, std::uint8_t{16});                       // Y', 4x4
+    for (int i = 16; i < 24; i += 2) planes[i] = 128, planes[i + 1] = 240;  // Cb Cr, 2x2
+    staging.allocation().write(0, planes, sizeof planes);
+    auto layout = vkrc::PipelineLayout::create(
+        device, {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, 8}}});
+    auto pipeline =
+        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::sample_ycbcr_comp));
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = commands.allocate();
+    cmd.begin();
+    auto to_copy = vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                       VK_PIPELINE_STAGE_2_NONE, 0, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
+                                       VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
+    VkBufferImageCopy regions[2]{};
+    regions[0].imageSubresource = {VK_IMAGE_ASPECT_PLANE_0_BIT, 0, 0, 1};
+    regions[0].imageExtent = {4, 4, 1};
+    regions[1].bufferOffset = 16;
+    regions[1].imageSubresource = {VK_IMAGE_ASPECT_PLANE_1_BIT, 0, 0, 1};
+    regions[1].imageExtent = {2, 2, 1};
+    cmd.copy_buffer_to_image(staging, image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, regions);
+    auto to_sample =
+        vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_sample, 1));
+    cmd.bind_pipeline(pipeline);
+    cmd.bind_descriptor_set(pipeline, 0, set);
+    const std::uint32_t params[2] = {4, 4};
+    cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(params), params);
+    cmd.dispatch(1, 1);
+    auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    for (VkDeviceSize texel = 0; texel < 16; ++texel) {
+        vkrc_test::Rgba rgba;
+        const auto packed = out.allocation().read_value<std::uint32_t>(texel * 4);
+        std::memcpy(rgba.data(), &packed, 4);
+        EXPECT_TRUE(vkrc_test::within_one(rgba, {201, 0, 0, 255})) << "texel " << texel;
+    }
 }
 
 TEST_F(YcbcrTest, YcbcrMisuseIsAUsageError) {

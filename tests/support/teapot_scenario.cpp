@@ -47,7 +47,8 @@ struct Target {
 
 }  // namespace
 
-std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const TeapotScenarioOptions& options) {
+std::vector<std::array<std::uint8_t, 4>> run_teapot_scenario(const vkrc::InstanceCreateInfo& info,
+                                                             const TeapotScenarioOptions& options) {
     auto instance = vkrc::Instance::create(info);
     auto physical_device = vkrc::PhysicalDevice::select(instance, test_device_requirements());
     auto device = vkrc::Device::create(physical_device);
@@ -196,8 +197,12 @@ std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const Teap
 
     std::vector<std::array<std::uint8_t, 4>> pixels(extent * extent);
     readback.allocation().read(0, std::span(pixels));
+    return pixels;
+}
+
+std::size_t covered_pixels(const std::vector<std::array<std::uint8_t, 4>>& frame) {
     std::size_t covered = 0;
-    for (const auto& p : pixels) covered += (p[0] | p[1] | p[2]) != 0;
+    for (const auto& p : frame) covered += (p[0] | p[1] | p[2]) != 0;
     return covered;
 }
 

@@ -8,7 +8,10 @@
 
 #include <vkrc/vkrc.hpp>
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace vkrc_test {
 
@@ -18,8 +21,12 @@ struct TeapotScenarioOptions {
     int frames = 3;
 };
 
-// Runs the scene on a new instance made from info; returns the number of
-// pixels of the last frame the teapots covered (a sanity check of the run).
-std::size_t run_teapot_scenario(const vkrc::InstanceCreateInfo& info, const TeapotScenarioOptions& options = {});
+// Runs the scene on a new instance made from info; returns the last frame,
+// 64 x 64 RGBA8 pixels row by row.
+std::vector<std::array<std::uint8_t, 4>> run_teapot_scenario(const vkrc::InstanceCreateInfo& info,
+                                                             const TeapotScenarioOptions& options = {});
+
+// The pixels of frame the teapots cover (not the black background).
+std::size_t covered_pixels(const std::vector<std::array<std::uint8_t, 4>>& frame);
 
 }  // namespace vkrc_test

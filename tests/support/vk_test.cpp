@@ -1,8 +1,11 @@
 #include "vk_test.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <mutex>
+#include <random>
+#include <span>
 #include <string>
 
 namespace vkrc_test {
@@ -19,17 +22,56 @@ namespace vkrc_test {
     return ::testing::AssertionSuccess();
 }
 
-std::size_t ValidationLog::take_expected(const std::string& id) {
-    std::lock_guard lock(mutex_);
-    std::size_t before = messages_.size();
-    std::erase_if(messages_, [&](const std::string& m) { return m.find(id) != std::string::npos; });
-    return before - messages_.size();
+ValidationLog::~ValidationLog() {
+    if (messages_.empty()) return;
+    ADD_FAILURE() << messages_.size() << " validation message(s) never asserted, first: " << messages_.front().id
+                  << ": " << messages_.front().text;
 }
+
+void ValidationLog::add(const vkrc::DebugMessage& m) {
+    std::lock_guard lock(mutex_);
+    messages_.push_back({m.message_id_name ? m.message_id_name : "-", m.message ? m.message : ""});
+}
+
+std::vector<std::string> ValidationLog::take() {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> all;
+    for (const auto& m : messages_) all.push_back(m.id + ": " + m.text);
+    messages_.clear();
+    return all;
+}
+
+::testing::AssertionResult ValidationLog::take_expected(std::string_view id, std::size_t count) {
+    std::lock_guard lock(mutex_);
+    const auto taken = std::erase_if(messages_, [&](const Message& m) { return m.id == id; });
+    if (taken == count) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << taken << " message(s) with id " << id << ", expected " << count;
+}
+
+namespace {
+
+// Synchronization validation always; GPU-assisted validation on request (it
+// instruments every shader: see docs/validation.md for its cost on lavapipe).
+const VkValidationFeaturesEXT* validation_features() {
+    static const bool gpu_av = [] {
+        const char* v = std::getenv("VKRC_TEST_GPU_AV");
+        return v && *v && *v != '0';
+    }();
+    static const VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,
+                                                           VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT};
+    static const VkValidationFeaturesEXT features{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                                  .enabledValidationFeatureCount = gpu_av ? 2u : 1u,
+                                                  .pEnabledValidationFeatures = enables};
+    return &features;
+}
+
+}  // namespace
 
 vkrc::InstanceCreateInfo validated_instance_info(const std::shared_ptr<ValidationLog>& log) {
     vkrc::InstanceCreateInfo info;
     info.application_name = "vkrc tests";
     info.validation = true;
+    info.next = validation_features();
     info.debug_callback = [log](const vkrc::DebugMessage& m) {
         vkrc::print_debug_message(m);
         log->add(m);
@@ -41,6 +83,19 @@ vkrc::DeviceRequirements test_device_requirements() {
     vkrc::DeviceRequirements req;
     if (const char* name = std::getenv("VKRC_TEST_DEVICE")) req.name_contains = name;
     return req;
+}
+
+std::uint32_t test_seed() {
+    static const std::uint32_t seed = [] {
+        if (const char* v = std::getenv("VKRC_TEST_SEED"); v && *v) {
+            return static_cast<std::uint32_t>(std::strtoul(v, nullptr, 0));
+        }
+        return static_cast<std::uint32_t>(std::random_device{}());
+    }();
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::printf("%s.%s: VKRC_TEST_SEED=%u\n", test ? test->test_suite_name() : "-", test ? test->name() : "-", seed);
+    std::fflush(stdout);  // before a crash can lose it
+    return seed;
 }
 
 vkrc::DescriptorSetLayout sample_texels_set_layout(const vkrc::Device& device) {
@@ -85,9 +140,19 @@ void VulkanTest::TearDown() {
     expect_no_validation_messages(*log);
 }
 
+GpuGate::~GpuGate() {
+    if (device_) device_.wait_idle();
+}
+
+void GpuGate::submit(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd, const vkrc::Fence& fence) const {
+    const auto gate = wait();
+    vkrc::submit(queue, {.waits = std::span(&gate, 1), .command_buffers = std::span(&cmd, 1)}, fence);
+}
+
 void expect_no_validation_messages(ValidationLog& log) {
-    auto messages = log.take();
-    EXPECT_TRUE(messages.empty()) << messages.size() << " validation message(s), first: " << messages.front();
+    const auto messages = log.take();
+    EXPECT_TRUE(messages.empty()) << messages.size()
+                                  << " validation message(s), first: " << (messages.empty() ? "" : messages.front());
 }
 
 }  // namespace vkrc_test
