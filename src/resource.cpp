@@ -636,16 +636,16 @@ ImageView ImageView::adopt(const Image& image, VkImageView view, VkFormat format
 }
 
 BufferView BufferView::adopt(const Buffer& buffer, VkBufferView view, Ownership ownership) {
-    return BufferView(
-        detail::registered(detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
-                               detail::Caller{"vkrc::BufferView::adopt"}, buffer, "the Buffer", view, "VkBufferView", ownership),
-                           buffer.device(), detail::DescribedKind::buffer_view, true));
+    return BufferView(detail::registered(
+        detail::adopted_state<detail::BufferViewState, &detail::BufferViewState::buffer>(
+            detail::Caller{"vkrc::BufferView::adopt"}, buffer, "the Buffer", view, "VkBufferView", ownership),
+        buffer.device(), detail::DescribedKind::buffer_view, true));
 }
 
 Sampler Sampler::adopt(const Device& device, VkSampler sampler, Ownership ownership) {
     return Sampler(
-        detail::registered(detail::adopted_state<detail::SamplerState>(detail::Caller{"vkrc::Sampler::adopt"}, device, "the Device",
-                                                                       sampler, "VkSampler", ownership),
+        detail::registered(detail::adopted_state<detail::SamplerState>(detail::Caller{"vkrc::Sampler::adopt"}, device,
+                                                                       "the Device", sampler, "VkSampler", ownership),
                            device, detail::DescribedKind::sampler));
 }
 
