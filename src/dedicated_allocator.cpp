@@ -7,10 +7,7 @@ VKRC_BEGIN_NAMESPACE
 
 AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationRequest& request) {
     const detail::Caller caller{"vkrc::DedicatedAllocator::allocate"};
-    const auto& props = device.memory_properties();
-    const std::uint32_t type =
-        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
-    detail::check_request(caller, device, request, type);
+    const std::uint32_t type = detail::checked_memory_type(caller, device, request);
     const bool dedicated_info = request.requires_dedicated || request.prefers_dedicated || request.intent.dedicated;
     {
         // Reserved now, so that concurrent calls cannot pass the limit together.
@@ -36,7 +33,7 @@ AllocationInfo DedicatedAllocator::allocate(DeviceView device, const AllocationR
     info.dedicated = true;
     info.allocator = this;
     LockGuard lock(mutex_);
-    auto& heap = stats_.heaps[props.memoryTypes[type].heapIndex];
+    auto& heap = stats_.heaps[device.memory_properties().memoryTypes[type].heapIndex];
     detail::add_block(heap, info.size);
     detail::add_range(heap, info.size);
     stats_.vk_allocate_calls += 1;

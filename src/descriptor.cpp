@@ -508,8 +508,7 @@ void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, V
     const detail::Caller caller{"vkrc::DescriptorSet::write_buffer"};
     VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element,
-                       detail::Caller{"vkrc::DescriptorSet::write_buffer"});
+    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
@@ -517,8 +516,7 @@ void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, Vk
     const detail::Caller caller{"vkrc::DescriptorSet::write_image"};
     VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorImageInfo info{sampler, view, layout};
-    write_image_infos(*state_, binding, type, Span(&info, 1), array_element,
-                      detail::Caller{"vkrc::DescriptorSet::write_image"});
+    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
 }
 
 void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,

@@ -53,15 +53,18 @@ void fill_budget(DeviceView device, AllocatorStatistics& stats) noexcept {
 
 namespace detail {
 
-void check_request(const Caller& caller, DeviceView device, const AllocationRequest& request, std::uint32_t type) {
+std::uint32_t checked_memory_type(const Caller& caller, DeviceView device, const AllocationRequest& request) {
+    const auto& props = device.memory_properties();
+    const std::uint32_t type =
+        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
     caller.require(request.requirements.size != 0, "size is 0");
     caller.require(request.dedicated_buffer == VK_NULL_HANDLE || request.dedicated_image == VK_NULL_HANDLE,
                    "both dedicated_buffer and dedicated_image are set");
-    const auto& props = device.memory_properties();
     const std::uint32_t heap = props.memoryTypes[type].heapIndex;
     caller.require(request.requirements.size <= props.memoryHeaps[heap].size, request.requirements.size,
                    " bytes requested, more than the whole of memory heap ", heap, " (", props.memoryHeaps[heap].size,
                    " bytes)");
+    return type;
 }
 
 VkDeviceMemory allocate_device_memory(DeviceView device, VkDeviceSize size, std::uint32_t type,

@@ -10,8 +10,10 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// Throws UsageError for a zero size, two dedicated resources, or a size larger than the heap.
-void check_request(const Caller& caller, DeviceView device, const AllocationRequest& request, std::uint32_t type);
+// The memory type an allocator gives request (choose_memory_type); throws
+// UsageError for a zero size, two dedicated resources, or a size larger
+// than the type's heap.
+std::uint32_t checked_memory_type(const Caller& caller, DeviceView device, const AllocationRequest& request);
 // vkAllocateMemory (with VkMemoryDedicatedAllocateInfo when a resource is
 // given, VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT when device_address), mapped
 // whole when host-visible.

@@ -523,10 +523,7 @@ std::uint32_t PoolAllocator::shard_count() const noexcept { return impl_->shard_
 
 AllocationInfo PoolAllocator::allocate(DeviceView d, const AllocationRequest& request) {
     const detail::Caller caller{"vkrc::PoolAllocator::allocate"};
-    const auto& props = d.memory_properties();
-    const std::uint32_t type =
-        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
-    detail::check_request(caller, d, request, type);
+    const std::uint32_t type = detail::checked_memory_type(caller, d, request);
     auto& m = *impl_;
     m.bind(d, caller);
 
