@@ -64,6 +64,21 @@ inline void append_piece(std::string& out, const VkExtent3D& e) {
     out += std::to_string(e.width) + "x" + std::to_string(e.height) + "x" + std::to_string(e.depth);
 }
 
+// Throws UsageError "name: about: what..." (about may be null). Out of line,
+// cold and given the names by value, so a passing check on a per-frame path
+// (present, submit) costs its compare and branch: no Caller is put in memory.
+template <class... What>
+[[noreturn, gnu::noinline, gnu::cold]] void refuse_as(const char* name, const char* about, const What&... what) {
+    std::string message(name);
+    message += ": ";
+    if (about) {
+        message += about;
+        message += ": ";
+    }
+    (append_piece(message, what), ...);
+    throw UsageError(message);
+}
+
 // The public function that checks its arguments. Usage, once per function:
 //     const detail::Caller caller{"vkrc::DescriptorPool::create"};
 //     caller.require(info.max_sets != 0, "max_sets is 0");
@@ -86,14 +101,7 @@ public:
     }
     template <class... What>
     [[noreturn]] void refuse(const What&... what) const {
-        std::string message(name_);
-        message += ": ";
-        if (about_) {
-            message += about_;
-            message += ": ";
-        }
-        (append_piece(message, what), ...);
-        throw UsageError(message);
+        refuse_as(name_, about_, what...);
     }
     // "name: the_name handle is empty", the_name saying which (e.g. "the
     // Device", "a ShaderModule").
