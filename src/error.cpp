@@ -57,27 +57,13 @@ const char* to_string(VkResult result) noexcept {
 
 namespace detail {
 namespace {
-#include "enum_names.inl"
-
-template <class Enum>
-std::string enum_text_of(Enum value, const char* type) {
-    const char* name = enum_name(value);
-    return name ? std::string(name) : std::string(type) + "(" + std::to_string(static_cast<long long>(value)) + ")";
+// The value's name, or its type and number for a value the table lacks.
+std::string enum_text_of(const char* name, const char* type, long long value) {
+    return name ? std::string(name) : std::string(type) + "(" + std::to_string(value) + ")";
 }
 }  // namespace
 
-std::string enum_text(VkDescriptorType value) { return enum_text_of(value, "VkDescriptorType"); }
-std::string enum_text(VkFormat value) { return enum_text_of(value, "VkFormat"); }
-std::string enum_text(VkPhysicalDeviceType value) { return enum_text_of(value, "VkPhysicalDeviceType"); }
-std::string enum_text(VkColorSpaceKHR value) { return enum_text_of(value, "VkColorSpaceKHR"); }
-std::string enum_text(VkImageLayout value) { return enum_text_of(value, "VkImageLayout"); }
-std::string enum_text(VkImageType value) { return enum_text_of(value, "VkImageType"); }
-std::string enum_text(VkImageTiling value) { return enum_text_of(value, "VkImageTiling"); }
-std::string enum_text(VkImageViewType value) { return enum_text_of(value, "VkImageViewType"); }
-std::string enum_text(VkSampleCountFlagBits value) { return enum_text_of(value, "VkSampleCountFlagBits"); }
-std::string enum_text(VkSamplerAddressMode value) { return enum_text_of(value, "VkSamplerAddressMode"); }
-std::string enum_text(VkFilter value) { return enum_text_of(value, "VkFilter"); }
-std::string enum_text(VkSamplerMipmapMode value) { return enum_text_of(value, "VkSamplerMipmapMode"); }
+#include "enum_names.inl"
 
 void throw_empty_handle(const char* call) {
     Caller(call).refuse(
