@@ -417,9 +417,12 @@ void update_keeping(const detail::DescriptorSetState& s, SlotWrite* writes, std:
 }
 
 // One vkUpdateDescriptorSets of count descriptors of binding whose infos
-// (of the type's kind) start at infos, keeping what they point to.
-void write_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+// (of the type's kind) start at infos, keeping what they point to. set is the
+// written DescriptorSet's state, null for an empty handle.
+void write_infos(const detail::DescriptorSetState* set, std::uint32_t binding, VkDescriptorType type,
                  std::uint32_t array_element, std::size_t count, const void* infos, const detail::Caller& caller) {
+    if (!set) detail::throw_empty_handle(caller.name());
+    const auto& s = *set;
     const std::size_t b = check_write(s, binding, type, array_element, count, caller);
     if (count == 0) return;
     const auto& layout = *s.layout.state();
@@ -448,21 +451,21 @@ void write_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkD
         s, writes, count, [&] { d.fn.vkUpdateDescriptorSets(d.device, 1, &w, 0, nullptr); }, caller);
 }
 
-void write_buffer_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+void write_buffer_infos(const detail::DescriptorSetState* s, std::uint32_t binding, VkDescriptorType type,
                         Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element,
                         const detail::Caller& caller) {
     caller.require(is_buffer_type(type), "descriptor type ", type, " is not a buffer type");
     write_infos(s, binding, type, array_element, infos.size(), infos.data(), caller);
 }
 
-void write_image_infos(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+void write_image_infos(const detail::DescriptorSetState* s, std::uint32_t binding, VkDescriptorType type,
                        Span<const VkDescriptorImageInfo> infos, std::uint32_t array_element,
                        const detail::Caller& caller) {
     caller.require(is_image_type(type), "descriptor type ", type, " is not an image or sampler type");
     write_infos(s, binding, type, array_element, infos.size(), infos.data(), caller);
 }
 
-void write_texel_views(const detail::DescriptorSetState& s, std::uint32_t binding, VkDescriptorType type,
+void write_texel_views(const detail::DescriptorSetState* s, std::uint32_t binding, VkDescriptorType type,
                        Span<const VkBufferView> views, std::uint32_t array_element, const detail::Caller& caller) {
     caller.require(is_texel_type(type), "descriptor type ", type, " is not a texel buffer type");
     write_infos(s, binding, type, array_element, views.size(), views.data(), caller);
@@ -500,43 +503,38 @@ void DescriptorSet::write_buffer_view(std::uint32_t binding, VkDescriptorType ty
     caller.require_handle(view, "the BufferView");
     caller.require(view.buffer().device() == pool().device(), "the buffer view belongs to another device");
     const VkBufferView raw = view.vk();
-    write_texel_views(*state_, binding, type, Span(&raw, 1), array_element, caller);
+    write_texel_views(state_.get(), binding, type, Span(&raw, 1), array_element, caller);
 }
 
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, VkBuffer buffer, VkDeviceSize offset,
                                  VkDeviceSize range, std::uint32_t array_element) const {
-    const detail::Caller caller{"vkrc::DescriptorSet::write_buffer"};
-    VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorBufferInfo info{buffer, offset, range};
-    write_buffer_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
+    write_buffer_infos(state_.get(), binding, type, Span(&info, 1), array_element,
+                       detail::Caller{"vkrc::DescriptorSet::write_buffer"});
 }
 
 void DescriptorSet::write_image(std::uint32_t binding, VkDescriptorType type, VkImageView view, VkImageLayout layout,
                                 VkSampler sampler, std::uint32_t array_element) const {
-    const detail::Caller caller{"vkrc::DescriptorSet::write_image"};
-    VKRC_REQUIRE_STATE(caller.name());
     const VkDescriptorImageInfo info{sampler, view, layout};
-    write_image_infos(*state_, binding, type, Span(&info, 1), array_element, caller);
+    write_image_infos(state_.get(), binding, type, Span(&info, 1), array_element,
+                      detail::Caller{"vkrc::DescriptorSet::write_image"});
 }
 
 void DescriptorSet::write_buffers(std::uint32_t binding, VkDescriptorType type,
                                   Span<const VkDescriptorBufferInfo> infos, std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffers");
-    write_buffer_infos(*state_, binding, type, infos, array_element,
+    write_buffer_infos(state_.get(), binding, type, infos, array_element,
                        detail::Caller{"vkrc::DescriptorSet::write_buffers"});
 }
 
 void DescriptorSet::write_images(std::uint32_t binding, VkDescriptorType type, Span<const VkDescriptorImageInfo> infos,
                                  std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_images");
-    write_image_infos(*state_, binding, type, infos, array_element,
+    write_image_infos(state_.get(), binding, type, infos, array_element,
                       detail::Caller{"vkrc::DescriptorSet::write_images"});
 }
 
 void DescriptorSet::write_buffer_views(std::uint32_t binding, VkDescriptorType type, Span<const VkBufferView> views,
                                        std::uint32_t array_element) const {
-    VKRC_REQUIRE_STATE("vkrc::DescriptorSet::write_buffer_views");
-    write_texel_views(*state_, binding, type, views, array_element,
+    write_texel_views(state_.get(), binding, type, views, array_element,
                       detail::Caller{"vkrc::DescriptorSet::write_buffer_views"});
 }
 

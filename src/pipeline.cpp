@@ -322,34 +322,10 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::vertex_attribute(std::uint32_t
     attributes_.push_back({location, binding, format, offset});
     return *this;
 }
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::topology(VkPrimitiveTopology t) {
-    topology_ = t;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::polygon_mode(VkPolygonMode m) {
-    raster_.polygon_mode = m;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::cull_mode(VkCullModeFlags m) {
-    raster_.cull_mode = m;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::front_face(VkFrontFace f) {
-    raster_.front_face = f;
-    return *this;
-}
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::depth_test(bool test, bool write, VkCompareOp compare) {
     depth_stencil_.depth_test_enable = test;
     depth_stencil_.depth_write_enable = write;
     depth_stencil_.depth_compare_op = compare;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend(const VkPipelineColorBlendAttachmentState& state) {
-    blend_ = state;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::samples(VkSampleCountFlagBits s) {
-    multisample_.rasterization_samples = s;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_state(VkDynamicState state) {

@@ -76,23 +76,6 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Comp
         layout, VK_PIPELINE_BIND_POINT_COMPUTE, info.cache, ci, "vkCreateComputePipelines"));
 }
 
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::rasterization(const RasterizationState& state) {
-    raster_ = state;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::depth_stencil(const DepthStencilState& state) {
-    depth_stencil_ = state;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::multisample(const MultisampleState& state) {
-    multisample_ = state;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_attachments(
-    Span<const VkPipelineColorBlendAttachmentState> states) {
-    blends_ = states;
-    return *this;
-}
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_constants(const float (&constants)[4]) {
     std::copy(std::begin(constants), std::end(constants), blend_constants_);
     return *this;
@@ -100,22 +83,6 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_constants(const float (&
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::logic_op(VkLogicOp op) {
     logic_op_enable_ = true;
     logic_op_ = op;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::viewports(Span<const VkViewport> viewports) {
-    viewports_ = viewports;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::scissors(Span<const VkRect2D> scissors) {
-    scissors_ = scissors;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_states(Span<const VkDynamicState> states) {
-    dynamic_states_ = states;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::primitive_restart(bool enable) {
-    primitive_restart_ = enable;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::specialization(VkShaderStageFlagBits stage,
@@ -129,22 +96,6 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::specialization(VkShaderStageFl
         }
     }
     specializations_.push_back(std::move(copy));
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::tessellation(std::uint32_t patch_control_points) {
-    patch_control_points_ = patch_control_points;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::view_mask(std::uint32_t mask) {
-    view_mask_ = mask;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::flags(VkPipelineCreateFlags flags) {
-    flags_ = flags;
-    return *this;
-}
-GraphicsPipelineBuilder& GraphicsPipelineBuilder::next(const void* chain) {
-    next_ = chain;
     return *this;
 }
 

@@ -256,19 +256,37 @@ public:
     GraphicsPipelineBuilder& vertex_attribute(std::uint32_t location, std::uint32_t binding, VkFormat format,
                                               std::uint32_t offset);
     // Primitive topology (default: triangle list).
-    GraphicsPipelineBuilder& topology(VkPrimitiveTopology topology);
+    GraphicsPipelineBuilder& topology(VkPrimitiveTopology topology) {
+        topology_ = topology;
+        return *this;
+    }
     // Polygon mode (default: fill).
-    GraphicsPipelineBuilder& polygon_mode(VkPolygonMode mode);
+    GraphicsPipelineBuilder& polygon_mode(VkPolygonMode mode) {
+        raster_.polygon_mode = mode;
+        return *this;
+    }
     // Cull mode (default: back faces).
-    GraphicsPipelineBuilder& cull_mode(VkCullModeFlags mode);
+    GraphicsPipelineBuilder& cull_mode(VkCullModeFlags mode) {
+        raster_.cull_mode = mode;
+        return *this;
+    }
     // Front face winding (default: counter-clockwise).
-    GraphicsPipelineBuilder& front_face(VkFrontFace face);
+    GraphicsPipelineBuilder& front_face(VkFrontFace face) {
+        raster_.front_face = face;
+        return *this;
+    }
     // Depth test, write and compare op (default: test and write with LESS).
     GraphicsPipelineBuilder& depth_test(bool test, bool write = true, VkCompareOp compare = VK_COMPARE_OP_LESS);
     // The blend state of every colour attachment (default: no blending, all channels written).
-    GraphicsPipelineBuilder& blend(const VkPipelineColorBlendAttachmentState& state);
+    GraphicsPipelineBuilder& blend(const VkPipelineColorBlendAttachmentState& state) {
+        blend_ = state;
+        return *this;
+    }
     // Rasterization samples (default: one).
-    GraphicsPipelineBuilder& samples(VkSampleCountFlagBits samples);
+    GraphicsPipelineBuilder& samples(VkSampleCountFlagBits samples) {
+        multisample_.rasterization_samples = samples;
+        return *this;
+    }
     // Adds a dynamic state to viewport and scissor (the default set).
     GraphicsPipelineBuilder& dynamic_state(VkDynamicState state);
     // Targets a render pass subpass (default: none, dynamic rendering); wins over rendering().
@@ -281,14 +299,26 @@ public:
     // Full state (issue 14). Each replaces what the narrower calls above set:
     // rasterization their polygon mode, cull mode and front face; depth_stencil
     // depth_test's; multisample samples'.
-    GraphicsPipelineBuilder& rasterization(const RasterizationState& state);
+    GraphicsPipelineBuilder& rasterization(const RasterizationState& state) {
+        raster_ = state;
+        return *this;
+    }
     // The whole depth and stencil state (default: DepthStencilState's defaults).
-    GraphicsPipelineBuilder& depth_stencil(const DepthStencilState& state);
+    GraphicsPipelineBuilder& depth_stencil(const DepthStencilState& state) {
+        depth_stencil_ = state;
+        return *this;
+    }
     // The whole multisample state (default: one sample, no sample shading).
-    GraphicsPipelineBuilder& multisample(const MultisampleState& state);
+    GraphicsPipelineBuilder& multisample(const MultisampleState& state) {
+        multisample_ = state;
+        return *this;
+    }
     // One blend state per colour attachment (build() checks the count);
     // replaces blend() for every attachment. Different states need independentBlend.
-    GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states);
+    GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states) {
+        blends_ = states;
+        return *this;
+    }
     // The blend constants (default zero; copied), unless BLEND_CONSTANTS is dynamic.
     GraphicsPipelineBuilder& blend_constants(const float (&constants)[4]);
     // Enables the logic op (needs the logicOp feature) instead of blending.
@@ -296,25 +326,49 @@ public:
     // Static viewports and scissors (copied). Their counts are the pipeline's
     // (more than one needs multiViewport); the values count only when
     // VIEWPORT / SCISSOR are not dynamic (see dynamic_states).
-    GraphicsPipelineBuilder& viewports(Span<const VkViewport> viewports);
-    GraphicsPipelineBuilder& scissors(Span<const VkRect2D> scissors);
+    GraphicsPipelineBuilder& viewports(Span<const VkViewport> viewports) {
+        viewports_ = viewports;
+        return *this;
+    }
+    GraphicsPipelineBuilder& scissors(Span<const VkRect2D> scissors) {
+        scissors_ = scissors;
+        return *this;
+    }
     // Replaces the dynamic state list (viewport and scissor by default).
     // With VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT the counts are dynamic too.
-    GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states);
+    GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states) {
+        dynamic_states_ = states;
+        return *this;
+    }
     // Restarts strips and fans at the all-ones index value (default off).
-    GraphicsPipelineBuilder& primitive_restart(bool enable);
+    GraphicsPipelineBuilder& primitive_restart(bool enable) {
+        primitive_restart_ = enable;
+        return *this;
+    }
     // Specialization constants of the shader at stage (added with shader();
     // build() throws UsageError when there is none). Copied.
     GraphicsPipelineBuilder& specialization(VkShaderStageFlagBits stage, const Specialization& spec);
     // Patch size, required with tessellation shaders (topology PATCH_LIST).
-    GraphicsPipelineBuilder& tessellation(std::uint32_t patch_control_points);
+    GraphicsPipelineBuilder& tessellation(std::uint32_t patch_control_points) {
+        patch_control_points_ = patch_control_points;
+        return *this;
+    }
     // Multiview mask for dynamic rendering (needs the multiview feature).
-    GraphicsPipelineBuilder& view_mask(std::uint32_t mask);
+    GraphicsPipelineBuilder& view_mask(std::uint32_t mask) {
+        view_mask_ = mask;
+        return *this;
+    }
     // VkGraphicsPipelineCreateInfo::flags (default none).
-    GraphicsPipelineBuilder& flags(VkPipelineCreateFlags flags);
+    GraphicsPipelineBuilder& flags(VkPipelineCreateFlags flags) {
+        flags_ = flags;
+        return *this;
+    }
     // Chained into VkGraphicsPipelineCreateInfo (after vkrc's rendering info);
     // must live until build().
-    GraphicsPipelineBuilder& next(const void* chain);
+    GraphicsPipelineBuilder& next(const void* chain) {
+        next_ = chain;
+        return *this;
+    }
 
     // vkCreateGraphicsPipelines with what was set, through cache if given
     // (UsageError for what the builder can check: an empty layout, no stage,
