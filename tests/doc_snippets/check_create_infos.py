@@ -8,6 +8,7 @@ declares one struct, `vkrc::Name var{ .member = value, ... };`. For each:
     them, in declaration order (designated initializers must follow it);
   - a member whose comment does not begin with "required" shows the
     header's default, token for token (so no default is typed by hand);
+  - the text between its heading and the block links its header;
   - no struct has two blocks.
 And every create-info the guide or README uses has a block: each struct of
 the headers whose name ends in "Info" and appears in them, and
@@ -115,7 +116,10 @@ def appendix_blocks(path):
     if APPENDIX not in lines:
         sys.exit(f"{path}: no '{APPENDIX}' heading")
     i = lines.index(APPENDIX)
+    heading = i
     while i < len(lines):
+        if lines[i].startswith("#"):
+            heading = i
         if lines[i].strip() in ("```cpp", "```c++"):
             j = i + 1
             while not lines[j].strip().startswith("```"):
@@ -141,7 +145,7 @@ def appendix_blocks(path):
                 elif part.strip():
                     sys.exit(f"{path}:{i + 2}: not a designated initializer: {part.strip()}")
                 offset += len(part) + 1
-            yield i + 2, m.group(1), entries
+            yield i + 2, m.group(1), entries, "\n".join(lines[heading:i])
             i = j
         i += 1
 
@@ -150,7 +154,7 @@ def main():
     include_dir, guide, others = sys.argv[1], sys.argv[2], sys.argv[3:]
     structs = header_structs(include_dir)
     errors, shown = [], {}
-    for line, name, entries in appendix_blocks(guide):
+    for line, name, entries, before in appendix_blocks(guide):
         where = f"{guide}:{line}: {name}"
         if name not in structs:
             errors.append(f"{where}: no such struct in {include_dir}/vkrc/*.hpp")
@@ -159,6 +163,8 @@ def main():
             errors.append(f"{where}: shown twice (also at line {shown[name]})")
         shown[name] = line
         header, members = structs[name]
+        if f"](../include/{header})" not in before:
+            errors.append(f"{where}: the text above the block does not link ../include/{header}")
         declared = [m for m, _ in members]
         listed = [e[0] for e in entries]
         if listed != declared:
