@@ -70,6 +70,7 @@ extern vkrc::PipelineLayout layout, pipeline_layout;
 extern vkrc::ComputePipeline pipeline;
 extern vkrc::GraphicsPipelineBuilder builder;
 extern vkrc::SamplerYcbcrConversion conversion;
+extern vkrc::RenderPass render_pass;
 extern vkrc::Frame frame;
 extern vkrc::RenderingAttachment attachment;
 extern VkPipeline raw_pipeline_made_elsewhere, their_pipeline;
