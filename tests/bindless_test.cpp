@@ -120,6 +120,64 @@ TEST_F(VulkanTest, BindlessArrayIndexedNonUniformly) {
     for (std::uint32_t i = 0; i < 8; ++i) EXPECT_EQ(data[i], 100 + (i * 3) % 8) << "invocation " << i;
 }
 
+// An update-after-bind write of textures made after the command buffer's
+// end() and dropped before its submission (issue 33's never-tested
+// scenario): the set keeps what was written into it, so the GPU, held back
+// behind a gate until after the drop, still samples them.
+TEST_F(VulkanTest, BindlessWriteAfterEndOfObjectsDroppedBeforeSubmit) {
+    if (auto missing = missing_bindless_features(physical_device); !missing.empty())
+        GTEST_SKIP() << "the device lacks descriptor indexing features: " << missing;
+    device = bindless_device(physical_device);
+    queue = device.default_queue();
+    auto set_layout = bindless_layout(device);
+    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
+    auto pipeline =
+        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::bindless_comp));
+    auto pool = bindless_pool(device);
+    auto set = pool.allocate(set_layout, 64);
+    auto out = vkrc::Buffer::create(device, {.size = 8 * sizeof(std::uint32_t),
+                                             .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                             .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto nearest = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                                  .min_filter = VK_FILTER_NEAREST,
+                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST});
+    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
+    set.write_image(1, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED, nearest);
+
+    auto cmd_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = cmd_pool.allocate();
+    cmd.begin();
+    cmd.bind_pipeline(pipeline);
+    cmd.bind_descriptor_set(pipeline, 0, set);
+    cmd.dispatch(1);
+    const auto to_host = vkrc_test::compute_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    {
+        vkrc_test::OneShotCommands clear(queue);
+        std::vector<vkrc::Image> textures;
+        std::vector<vkrc::ImageView> views;
+        std::vector<VkDescriptorImageInfo> infos;
+        for (std::uint32_t k = 0; k < 8; ++k) {
+            textures.push_back(uint_texture(device, clear.cmd, 200 + k));
+            views.push_back(vkrc::ImageView::create(textures.back()));
+            infos.push_back({VK_NULL_HANDLE, views.back().vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+        }
+        clear.run(queue);
+        set.write_images(2, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, infos, 10);
+    }  // the textures and their views dropped: only the set holds them
+    const vkrc_test::GpuGate gate(device);
+    auto fence = vkrc::Fence::create(device);
+    gate.submit(queue, cmd, fence);
+    EXPECT_EQ(fence.status(), VK_NOT_READY);
+    gate.open();
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+
+    std::uint32_t data[8] = {};
+    out.allocation().read(0, data, 8);
+    for (std::uint32_t i = 0; i < 8; ++i) EXPECT_EQ(data[i], 200 + (i * 3) % 8) << "invocation " << i;
+}
+
 TEST_F(VulkanTest, BindlessMisuseIsAUsageError) {
     if (auto missing = missing_bindless_features(physical_device); !missing.empty())
         GTEST_SKIP() << "the device lacks descriptor indexing features: " << missing;

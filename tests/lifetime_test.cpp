@@ -233,6 +233,52 @@ TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
     EXPECT_EQ(device.deferred_count(), 0u);
 }
 
+// Two logical devices of one physical device, each with work held behind its
+// own gate while its buffer, command pool and (for the second) the Device
+// handle itself are dropped (issue 33's never-tested scenario): each device's
+// deferred destruction waits for its own timeline, and the gates open in the
+// reverse order of submission.
+TEST_F(VulkanTest, WorkInFlightOnTwoDevicesWithDropsOnBoth) {
+    std::optional<vkrc::Device> second = vkrc::Device::create(physical_device);
+    struct Work {
+        vkrc::Queue queue;
+        vkrc::Buffer readback;
+        vkrc::CommandBuffer cmd;
+        std::optional<vkrc_test::GpuGate> gate;
+        vkrc::Fence fence;
+    };
+    Work works[2];
+    const vkrc::Device* devices[2] = {&device, &*second};
+    for (int i = 0; i < 2; ++i) {
+        Work& w = works[i];
+        w.queue = devices[i]->default_queue();
+        w.readback = make_readback(*devices[i]);
+        auto buffer = make_buffer(*devices[i], VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+        auto pool = vkrc::CommandPool::create(*devices[i], {.queue_family_index = w.queue.family_index()});
+        w.cmd = pool.allocate();
+        w.cmd.begin();
+        record_fill_copy(w.cmd, buffer, w.readback, 40u + static_cast<std::uint32_t>(i));
+        w.cmd.end();
+        w.gate.emplace(*devices[i]);
+        w.fence = vkrc::Fence::create(*devices[i]);
+        w.gate->submit(w.queue, w.cmd, w.fence);
+    }                // each iteration drops its buffer and its command pool's handle
+    second.reset();  // the second Device's handle: its children keep it
+    for (Work& w : works) {
+        EXPECT_EQ(w.fence.status(), VK_NOT_READY);
+        EXPECT_GE(w.queue.device().deferred_count(), 1u);
+    }
+    for (int i = 1; i >= 0; --i) {
+        works[i].gate->open();
+        ASSERT_EQ(works[i].fence.wait(), VK_SUCCESS);
+        EXPECT_TRUE(all_equal(works[i].readback, 40u + static_cast<std::uint32_t>(i))) << "device " << i;
+    }
+    for (Work& w : works) {
+        w.queue.device().collect_garbage();
+        EXPECT_EQ(w.queue.device().deferred_count(), 0u);
+    }
+}
+
 // Dropped during recording, before end().
 TEST_F(VulkanTest, BufferDroppedWhileRecording) {
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
