@@ -1,6 +1,7 @@
 // examples/renderer's scene, free of Vulkan: where the teapots stand, the
-// camera and the light. main.cpp renders it; support/renderer_check.cpp
-// computes from it where a shadow must fall in the rendered image.
+// camera, the light and the streamed texture's steps. main.cpp renders it;
+// support/renderer_check.cpp computes from it where a shadow must fall in
+// the rendered image and which colour the streamed texture gives it.
 #pragma once
 
 #include "scene/teapot_scene.hpp"
