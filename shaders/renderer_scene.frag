@@ -1,5 +1,6 @@
 #version 450
-// examples/renderer: the material's texture from the texture array (its
+#extension GL_EXT_nonuniform_qualifier : require
+// examples/renderer: the material's texture from the bindless table (its
 // index in push constants), a directional light shadowed through the shadow
 // map (3x3 comparison taps, each itself a filtered 2x2 comparison), an
 // ambient sky term. Writes linear HDR colour.
@@ -16,9 +17,10 @@ layout(set = 0, binding = 0) uniform Frame {
     vec4 camera_position;
 } frame;
 layout(set = 0, binding = 1) uniform sampler2DShadow shadow_map;
-// Sized for the fallback without descriptor indexing; with it the array is
-// partially bound and only the textures that exist are written.
-layout(set = 1, binding = 0) uniform sampler2D textures[16];
+// The bindless table (vkrc::BindlessTable's binding 0): partially bound,
+// only its live slots are written. The index is a push constant, uniform
+// across a draw, so it needs no nonuniformEXT.
+layout(set = 1, binding = 0) uniform sampler2D textures[];
 
 layout(push_constant) uniform Draw {
     mat4 world;

@@ -1,7 +1,8 @@
 // A small forward renderer written only against vkrc (no raw Vulkan call), to be read top to bottom:
 // teapots (scene.hpp) on a textured ground under a directional light, a shadow map, bindless textures
-// with mip chains blitted on the GPU, a multisampled HDR main pass recorded on several threads, a
-// compute tone-map, GPU timestamps per pass.
+// in a vkrc::BindlessTable (mip chains blitted on the GPU; one texture streamed out and a new one in
+// every few frames on the transfer queue), a multisampled HDR main pass recorded on several threads,
+// a compute tone-map, GPU timestamps per pass.
 //     renderer [--threads N] [--frames N] [--resize-every N] [--report N] [--validation]   a window
 //     renderer --headless [--out FILE.png] [--frames N] [--threads N] [--validation]  (1 frame by default)
 #include <vkrc/glfw.hpp>
@@ -29,10 +30,14 @@ constexpr bool multi_thread = VKRC_IS_MULTI_THREAD != 0;  // which vkrc policy t
 constexpr VkFormat hdr_format = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;
 constexpr VkFormat ldr_format = VK_FORMAT_R8G8B8A8_UNORM;  // what the tone-map shader stores (rgba8)
-constexpr std::uint32_t shadow_size = 1024, texture_size = 256, max_textures = 16, frames_in_flight = 2;
+constexpr std::uint32_t shadow_size = 1024, texture_size = 256, frames_in_flight = 2;
+// The table's size, within the device's limits: a few textures are live at a time, and a larger
+// table would be pool memory held for nothing.
+constexpr std::uint32_t max_textures = 256;
 constexpr int fixed_level = 16;  // the tessellation a renderer without LOD would draw everywhere
 
-// The uniforms every draw reads (set 0, binding 0; in the frame ring), and one draw's push constants.
+// The uniforms every draw reads (set 0, binding 0; in the frame ring), and one draw's push constants
+// (texture_index: the draw's material's slot in the bindless table, set 1).
 struct FrameUniforms {
     glm::mat4 view_proj, light_view_proj;
     glm::vec4 light_direction, camera_position;
@@ -60,7 +65,9 @@ struct Geometry {
     }
 };
 struct Draw {
-    DrawConstants constants;
+    glm::mat4 world;
+    std::uint32_t material;  // 0: the ground's; then scene.hpp's Teapot::texture
+    float uv_scale;
     MeshRange mesh;
 };
 // One tessellation level of the teapot, with its largest distance from the exact surface (model units).
@@ -78,6 +85,32 @@ std::array<std::uint8_t, 4> texel(std::uint32_t index, std::uint32_t x, std::uin
     if (index == 0) return {v, std::uint8_t(v - 12), std::uint8_t(v - 30), 255};
     if (index == 1) return (x + y) % 64 < 24 ? Rgba{200, 40, 30, 255} : Rgba{235, 220, 190, 255};
     return dx * dx + dy * dy < 64 ? Rgba{240, 240, 245, 255} : Rgba{40, 80, 190, 255};
+}
+
+// The texture streamed in at step (scene.hpp): every mip level, box-filtered on the CPU (a transfer
+// queue cannot blit), packed level after level as the Uploader takes them.
+std::vector<std::uint8_t> streamed_texels(std::uint32_t step) {
+    const auto colour = renderer::streamed_colour(step);
+    std::vector<std::uint8_t> texels;
+    for (std::uint32_t y = 0; y < texture_size; ++y)
+        for (std::uint32_t x = 0; x < texture_size; ++x) {
+            for (const std::uint8_t c : colour) texels.push_back((x + y) % 32 < 16 ? c : std::uint8_t(c * 3 / 4));
+            texels.push_back(255);
+        }
+    std::size_t level = 0;  // where the level being halved starts
+    for (std::uint32_t size = texture_size; size > 1; size /= 2) {
+        const std::size_t next = texels.size();
+        for (std::uint32_t y = 0; y < size; y += 2)
+            for (std::uint32_t x = 0; x < size; x += 2)
+                for (std::uint32_t c = 0; c < 4; ++c) {
+                    auto at = [&](std::uint32_t u, std::uint32_t v) {
+                        return unsigned(texels[level + (v * size + u) * 4 + c]);
+                    };
+                    texels.push_back(std::uint8_t((at(x, y) + at(x + 1, y) + at(x, y + 1) + at(x + 1, y + 1) + 2) / 4));
+                }
+        level = next;
+    }
+    return texels;
 }
 
 // The images the main pass and the tone-map use, re-created when the presented extent changes.
@@ -125,6 +158,12 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     if (!multi_thread && threads > 1) throw std::runtime_error("the st build records on one thread: --threads 1");
     vkrc::InstanceCreateInfo instance_info{.application_name = "vkrc renderer", .validation = options.validation};
     vkrc::DeviceRequirements requirements;
+    // The textures are bindless (a vkrc::BindlessTable, indexed by a push constant): a device
+    // without descriptor indexing is rejected, with the missing features named.
+    auto& indexing = requirements.required_features.vulkan12;
+    indexing.runtimeDescriptorArray = indexing.descriptorBindingPartiallyBound = VK_TRUE;
+    indexing.descriptorBindingSampledImageUpdateAfterBind = indexing.descriptorBindingUpdateUnusedWhilePending =
+        VK_TRUE;
     vkrc::glfw::WindowSurface window;
     if (!options.headless) {
         window =
@@ -134,14 +173,12 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     }
     auto instance = options.headless ? vkrc::Instance::create(instance_info) : window.instance;
     const auto physical = vkrc::PhysicalDevice::select(instance, requirements);
-    // Bindless textures need descriptor indexing; without it a fully written fixed array does.
-    const auto& have = physical.features().vulkan12;
-    const bool bindless = have.descriptorBindingPartiallyBound && have.descriptorBindingSampledImageUpdateAfterBind;
-    vkrc::DeviceCreateInfo device_info{.enabled_extension_names = requirements.required_extensions};
-    device_info.vulkan12_features.descriptorBindingPartiallyBound = bindless;
-    device_info.vulkan12_features.descriptorBindingSampledImageUpdateAfterBind = bindless;
-    auto device = vkrc::Device::create(physical, device_info);
+    // A transfer queue of its own where the device has one: textures stream in on it while frames render.
+    auto device = vkrc::Device::create(physical, {.transfer_queue = true,
+                                                  .enabled_extension_names = requirements.required_extensions,
+                                                  .vulkan12_features = indexing});
     auto queue = device.default_queue();
+    const auto transfer = device.queue_for(vkrc::QueueRole::transfer);
     const bool blit_output = !options.headless;
     vkrc::Swapchain swapchain;
     vkrc::HeadlessPresenter headless;
@@ -158,8 +195,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     const auto& limits = physical.properties().limits;
     const auto samples = VkSampleCountFlagBits(
         limits.framebufferColorSampleCounts & limits.framebufferDepthSampleCounts & VK_SAMPLE_COUNT_4_BIT ? 4 : 1);
-    std::printf("device: %s; %s textures; %ux MSAA; %u recording thread(s)\n", physical.name(),
-                bindless ? "bindless" : "fixed-array (no descriptor indexing)", unsigned(samples), threads);
+    std::printf("device: %s; transfers on %s; %ux MSAA; %u recording thread(s)\n", physical.name(),
+                transfer.shares_graphics_queue ? "the graphics queue" : "a queue of their own", unsigned(samples),
+                threads);
 
     // 2. Geometry: the ground and the teapot at several tessellation levels, each with its error
     //    against the exact surface, so that each teapot is drawn as coarse as its size allows.
@@ -173,8 +211,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         lods.push_back({level, teapot::geometric_error(teapot::newell_teapot(), mesh, 3).max, geometry.add(mesh)});
     }
 
-    // 3. Streaming: the buffers and each texture's level 0 (generated here) go through the Uploader
+    // 3. Loading: the buffers and each texture's level 0 (generated here) go through an Uploader
     //    in one batch; the mip chains are then blitted on the GPU, every level read back and checked.
+    //    The textures go into the bindless table, which holds them from then on (step 4).
     auto uploader = vkrc::Uploader::create({.queue = queue, .staging_size = 8 << 20});
     constexpr auto transfer_dst = VK_BUFFER_USAGE_TRANSFER_DST_BIT;  // the same bit for images
     auto gpu_buffer = [&](const auto& data, VkBufferUsageFlags usage) {
@@ -188,7 +227,6 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     auto indices = gpu_buffer(geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     const std::uint32_t mip_levels = std::uint32_t(std::log2(texture_size)) + 1;
     std::vector<vkrc::Image> textures;
-    std::vector<vkrc::ImageView> texture_views;
     for (std::uint32_t index = 0; index < 3; ++index) {
         constexpr auto usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | transfer_dst;
         const VkExtent3D extent{texture_size, texture_size, 1};
@@ -198,7 +236,6 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         for (std::uint32_t y = 0; y < texture_size; ++y)
             for (std::uint32_t x = 0; x < texture_size; ++x)
                 for (auto c : texel(index, x, y)) texels.push_back(c);
-        texture_views.push_back(vkrc::ImageView::create(textures.back()));
         uploader.upload_image(textures.back(), std::as_bytes(std::span(texels)),
                               {.new_layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, .level_count = 1});
     }
@@ -231,7 +268,19 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                 textures.size(), mip_levels);
 
     // 4. Descriptors. Set 0: the per-frame uniforms (a dynamic uniform buffer over the frame ring)
-    //    and the shadow map, sampled with comparison. Set 1: the textures, indexed by a push constant.
+    //    and the shadow map, sampled with comparison. Set 1: the textures in a BindlessTable; a push
+    //    constant holds a draw's index. The table keeps what it holds: a removed texture lives until
+    //    the frames that may sample it are done, and its slot is reused after that.
+    auto texture_sampler = vkrc::Sampler::create(device);  // trilinear, repeating
+    auto table = vkrc::BindlessTable::create(
+        device,
+        {.image_capacity = std::min(max_textures, vkrc::BindlessTable::max_capacity(device, vkrc::BindlessKind::image)),
+         .buffer_capacity = 0,
+         .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT});
+    std::vector<vkrc::BindlessIndex> materials;  // each material's texture: ground, stripes, dots
+    for (const auto& texture : textures)
+        materials.push_back(table.add(vkrc::ImageView::create(texture), texture_sampler));
+    textures.clear();  // the table holds them now
     auto ring = vkrc::FrameRing::create({.queue = queue, .frame_size = 64 << 10, .frames_in_flight = frames_in_flight});
     vkrc::ImageView shadow_view;
     const auto shadow_map =
@@ -242,44 +291,30 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                                                          .compare_enable = true,
                                                          .compare_op = VK_COMPARE_OP_LESS_OR_EQUAL,
                                                          .border_color = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE});
-    auto texture_sampler = vkrc::Sampler::create(device);  // trilinear, repeating
     constexpr VkShaderStageFlags graphics = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
     auto frame_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1, graphics},
                               {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT}}});
-    const VkDescriptorBindingFlags indexing =
-        VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_UPDATE_AFTER_BIND_BIT;
-    auto texture_layout = vkrc::DescriptorSetLayout::create(
-        device, {.flags = bindless ? VkFlags(VK_DESCRIPTOR_SET_LAYOUT_CREATE_UPDATE_AFTER_BIND_POOL_BIT) : 0u,
-                 .bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, max_textures, VK_SHADER_STAGE_FRAGMENT_BIT,
-                               bindless ? indexing : 0}}});
     auto post_layout = vkrc::DescriptorSetLayout::create(
         device, {.bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT},
                               {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_COMPUTE_BIT}}});
-    // One pool for every set; update-after-bind sets need its flag.
+    // One pool for set 0 and the tone-map's sets (one per frame in flight).
     auto descriptor_pool = vkrc::DescriptorPool::create(
-        device, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT |
-                          (bindless ? VkFlags(VK_DESCRIPTOR_POOL_CREATE_UPDATE_AFTER_BIND_BIT) : 0u),
-                 .max_sets = 2 + frames_in_flight,
+        device, {.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT,
+                 .max_sets = 1 + frames_in_flight,
                  .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, 1},
-                                {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + max_textures + frames_in_flight},
+                                {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 + frames_in_flight},
                                 {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, frames_in_flight}}});
     auto frame_set = descriptor_pool.allocate(frame_layout);
     vkrc::write_dynamic_buffer(frame_set, 0, ring, sizeof(FrameUniforms));
     frame_set.write_image(1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, shadow_view,
                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, shadow_sampler);
-    auto texture_set = descriptor_pool.allocate(texture_layout);
-    // Bindless: just the textures that exist. The fixed array is written whole.
-    std::vector<VkDescriptorImageInfo> texture_infos;
-    for (std::size_t i = 0; i < (bindless ? textures.size() : max_textures); ++i)
-        texture_infos.push_back({texture_sampler.vk(), texture_views[i % textures.size()].vk(), fragment_read.layout});
-    texture_set.write_images(0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, texture_infos);
-    const std::array<VkDescriptorSet, 2> scene_sets{frame_set.vk(), texture_set.vk()};
+    const std::array<VkDescriptorSet, 2> scene_sets{frame_set.vk(), table.set().vk()};
 
     // 5. Pipelines: the depth-only shadow pass (depth bias against acne),
     //    the multisampled HDR main pass, the tone-map compute shader.
     auto scene_layout =
-        vkrc::PipelineLayout::create(device, {.set_layouts = {frame_layout, texture_layout},
+        vkrc::PipelineLayout::create(device, {.set_layouts = {frame_layout, table.layout()},
                                               .push_constant_ranges = {{graphics, 0, sizeof(DrawConstants)}}});
     auto shadow_pipeline =
         vkrc::GraphicsPipelineBuilder(scene_layout)
@@ -321,7 +356,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         cmd.bind_vertex_buffers(0, std::array{positions.vk(), normals.vk()}, std::array<VkDeviceSize, 2>{0, 0});
         cmd.bind_index_buffer(indices, 0, VK_INDEX_TYPE_UINT16);
         for (const Draw& d : list) {
-            cmd.push_constants(scene_layout, graphics, d.constants);
+            cmd.push_constants(scene_layout, graphics, DrawConstants{d.world, materials[d.material].index, d.uv_scale});
             cmd.draw_indexed(d.mesh.index_count, 1, d.mesh.first_index, d.mesh.vertex_offset);
         }
     };
@@ -360,7 +395,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
     // 7. The scene's draws: the ground, then each teapot at its level.
     std::vector<Draw> draws;
     auto build_draws = [&](VkExtent2D extent) {
-        draws = {{{glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -8.0f)) * renderer::z_up_to_y_up(), 0, 0.25f},
+        draws = {{glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -8.0f)) * renderer::z_up_to_y_up(), 0, 0.25f,
                   ground}};
         std::size_t drawn = 0, fixed = 0;
         std::printf("tessellation for %ux%u: levels", extent.width, extent.height);
@@ -372,7 +407,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                 std::min(extent.width, extent.height) / (2.0 * std::tan(renderer::camera_fov / 2.0) * distance);
             std::size_t l = 0;
             while (l + 1 < lods.size() && lods[l].error * teapot.scale * pixels_per_unit >= 1.0) ++l;
-            draws.push_back({{renderer::teapot_world(teapot), teapot.texture, 0.4f}, lods[l].mesh});
+            draws.push_back({renderer::teapot_world(teapot), teapot.texture, 0.4f, lods[l].mesh});
             drawn += lods[l].mesh.index_count / 3;
             fixed += lods.back().mesh.index_count / 3;
             std::printf(" %d", lods[l].level);
@@ -381,7 +416,30 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                     fixed - drawn);
     };
 
-    // 8. The frame loop: wait for the frame's last use and read its timestamps, acquire, write the
+    // 8. Streaming while rendering: every stream_every frames (scene.hpp) the streamed material's
+    //    texture is replaced. The new one, every level made on the CPU, goes through an Uploader on
+    //    the transfer queue; the frame that first samples it waits on the batch's Ticket and records
+    //    its ownership acquire (where the transfer queue's family is another). The old index is
+    //    removed from the table, which releases the texture once the frames that sample it are done.
+    auto streamer = vkrc::Uploader::create({.queue = transfer.queue, .staging_size = 2 << 20});
+    // Slots used: the highest index + 1; removed slots come back once the GPU is done with them.
+    std::uint32_t streamed_in = 0, slots_used = std::uint32_t(materials.size());
+    auto stream_texture = [&](std::uint32_t step) {
+        auto texture =
+            vkrc::Image::create(device, {.format = ldr_format,
+                                         .extent = {texture_size, texture_size, 1},
+                                         .mip_levels = mip_levels,
+                                         .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+        const auto texels = streamed_texels(step);
+        streamer.upload_image(texture, std::as_bytes(std::span(texels)));
+        auto& slot = materials[renderer::streamed_material];
+        table.remove(slot);
+        slot = table.add(vkrc::ImageView::create(texture), texture_sampler);
+        ++streamed_in, slots_used = std::max(slots_used, slot.index + 1);
+        return streamer.submit();
+    };
+
+    // 9. The frame loop: wait for the frame's last use and read its timestamps, acquire, write the
     //    uniforms, record the main pass's draws on the threads, then record and submit every pass.
     Targets targets;
     vkrc::Frame frame;
@@ -403,6 +461,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
             continue;
         }
         f.done.unsignal();
+        vkrc::Ticket streamed;  // the new texture's upload, when this frame streams one in
+        if (n > 0 && n % renderer::stream_every == 0)
+            streamed = stream_texture(renderer::streamed_step(std::uint32_t(n)));
         if (frame.extent.width != targets.extent.width || frame.extent.height != targets.extent.height) {
             targets = make_targets(device, frame.extent, samples, blit_output);
             build_draws(frame.extent);
@@ -439,6 +500,7 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
 
         const auto& cmd = f.cmd;
         cmd.begin();
+        streamed.record_acquire(cmd);  // nothing when the families are the same or nothing was streamed
         cmd.reset_query_pool(timestamps, q, 4);
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q);
         // Shadow pass: the teapots' depth from the light, once the last frame is done sampling the map.
@@ -509,7 +571,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
                                            use::presented(frame.present_layout))});
         cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, timestamps, q + 3);
         cmd.end();
-        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},
+        std::vector<vkrc::SemaphoreSubmit> waits(frame.waits().begin(), frame.waits().end());
+        if (streamed) waits.push_back(streamed.wait(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT));
+        vkrc::submit(queue, {.waits = waits, .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},
                      f.done);
         ring.end_frame();
         presenter.present(frame);
@@ -521,6 +585,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         if (options.report_every > 0 && n % options.report_every == 0) report("every --report frames");
     }
     device.wait_idle();
+    std::printf("streamed %u textures in; %u slots used; the table holds %u, %zu removed ones waiting for the GPU\n",
+                streamed_in, slots_used, table.live_count(vkrc::BindlessKind::image),
+                table.pending_count(vkrc::BindlessKind::image));
     for (std::uint32_t i = 0; i < frames_in_flight; ++i) add_timestamps(in_flight[i], i * 4);
     report("at exit");
     if (options.headless) vkrc_examples::save_last_frame(headless, options.out_file);

@@ -1,6 +1,7 @@
 // examples/renderer's scene, free of Vulkan: where the teapots stand, the
-// camera and the light. main.cpp renders it; support/renderer_check.cpp
-// computes from it where a shadow must fall in the rendered image.
+// camera, the light and the streamed texture's steps. main.cpp renders it;
+// support/renderer_check.cpp computes from it where a shadow must fall in
+// the rendered image and which colour the streamed texture gives it.
 #pragma once
 
 #include "scene/teapot_scene.hpp"
@@ -28,6 +29,21 @@ inline constexpr std::array<Teapot, 5> teapots = {{{{-5.0f, 0.0f, 4.0f}, 1.0f, 2
                                                    {{6.0f, 0.0f, -13.0f}, 1.5f, 160.0f, 1},
                                                    {{-9.0f, 0.0f, -24.0f}, 2.0f, 210.0f, 2}}};
 inline constexpr float ground_half_size = 40.0f;  // the ground: a square about the origin, texture 0
+
+// While it renders, the renderer streams material 2's texture out and a new
+// one in every stream_every frames: frame n shows step n / stream_every.
+// Often enough that a short headless run (the image check's) sees two
+// steps, seldom enough that the uploads stay a small part of a frame.
+inline constexpr std::uint32_t stream_every = 8, streamed_material = 2;
+inline std::uint32_t streamed_step(std::uint32_t frame) { return frame / stream_every; }
+// Step s (from 1) is stripes of this colour and a darker shade of it. Its
+// strongest channel differs from the last step's (green, red, blue, green,
+// ...; the first texture is blue), so the image check can tell which step
+// an image shows.
+inline std::array<std::uint8_t, 3> streamed_colour(std::uint32_t step) {
+    constexpr std::array<std::array<std::uint8_t, 3>, 3> palette = {{{50, 190, 60}, {210, 70, 40}, {90, 60, 210}}};
+    return palette[(step - 1) % palette.size()];
+}
 
 inline glm::mat4 teapot_world(const Teapot& t) {
     const glm::mat4 placed = glm::rotate(glm::translate(glm::mat4(1.0f), t.position), glm::radians(t.yaw_degrees),
