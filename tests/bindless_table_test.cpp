@@ -212,22 +212,13 @@ TEST_F(BindlessTableTest, MisuseIsAUsageError) {
     }
 }
 
-// The seed of a randomised test: VKRC_TEST_SEED, else a random one; printed.
-std::uint32_t test_seed() {
-    std::uint32_t seed = 0;
-    if (const char* v = std::getenv("VKRC_TEST_SEED")) seed = static_cast<std::uint32_t>(std::strtoul(v, nullptr, 10));
-    else seed = std::random_device{}();
-    std::printf("bindless table fuzz: VKRC_TEST_SEED=%u\n", seed);
-    return seed;
-}
-
 // 500 rounds, up to 3 frames in flight: each round adds and removes random
 // textures (the test keeps a handle to some, drops others at once), then
 // records a read of up to four live ones. A frame's results are checked when
 // its fence is waited for: a slot reused while a frame could still read it
 // would show another texture's value.
 TEST_F(BindlessTableTest, FuzzAddRemoveReuseWithFramesInFlight) {
-    const std::uint32_t seed = test_seed();
+    const std::uint32_t seed = vkrc_test::test_seed();
     std::mt19937 rng(seed);
     constexpr std::uint32_t capacity = 24, frames = 3, rounds = 500;
     auto table = vkrc::BindlessTable::create(device, {.image_capacity = capacity, .buffer_capacity = frames});

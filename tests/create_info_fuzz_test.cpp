@@ -21,11 +21,6 @@ namespace {
 
 using vkrc_test::VulkanTest;
 
-unsigned test_seed() {
-    if (const char* text = std::getenv("VKRC_TEST_SEED")) return static_cast<unsigned>(std::strtoul(text, nullptr, 0));
-    return std::random_device{}();
-}
-
 class Fuzzer {
 public:
     explicit Fuzzer(unsigned seed) : rng_(seed) {}
@@ -212,8 +207,7 @@ std::string view_text(const vkrc::ImageViewCreateInfo& v, const vkrc::Image& ima
 }
 
 TEST_F(VulkanTest, CreateInfoFuzzNeverReachesVulkanInvalid) {
-    const unsigned seed = test_seed();
-    std::printf("CreateInfoFuzzNeverReachesVulkanInvalid seed: %u (VKRC_TEST_SEED replays it)\n", seed);
+    const unsigned seed = vkrc_test::test_seed();
     SCOPED_TRACE("seed " + std::to_string(seed));
     Fuzzer f(seed);
     const VkPhysicalDeviceLimits limits = physical_device.properties().limits;
