@@ -6,6 +6,45 @@
 
 VKRC_BEGIN_NAMESPACE
 
+namespace detail {
+
+class BindlessTableState final : public RefCounted {
+public:
+    static constexpr const char* type_name = "vkrc::BindlessTable";
+    DescriptorSetLayout layout;
+    DescriptorPool pool;
+    DescriptorSet set;
+    struct Slot {
+        std::uint32_t generation = 0;
+        bool live = false;
+    };
+    // One per BindlessKind; under mutex.
+    struct Array {
+        std::uint32_t capacity = 0;
+        std::uint32_t fresh = 0;  // slots below it have been handed out once
+        std::uint32_t live = 0;
+        std::uint32_t pending = 0;  // removed, not yet back in free
+        List<Slot> slots;
+        List<std::uint32_t> free;  // reusable now
+    };
+    // Where removed slots come back: a removal is a DeferredAction (the one
+    // machinery of deferred destruction: held while a command buffer that
+    // may bind the set is open, then until the work submitted by then
+    // completes) that puts the slot here. The action holds a reference to
+    // this box, which holds nothing, so it outlives neither the table's
+    // device nor forms a cycle; ready has room for every slot.
+    class Returns final : public RefCounted {
+    public:
+        Mutex mutex;
+        List<std::uint64_t> ready;  // kind << 32 | index
+    };
+    Array arrays[2];
+    Ref<Returns> returns;
+    mutable Mutex mutex;
+};
+
+}  // namespace detail
+
 namespace {
 
 constexpr VkDescriptorType kind_type[2] = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -206,6 +245,21 @@ std::size_t BindlessTable::pending_count(BindlessKind kind) const {
     LockGuard lock(state_->mutex);
     collect(*state_);
     return array_of(*state_, kind).pending;
+}
+
+BindlessTable::BindlessTable() noexcept = default;
+BindlessTable::~BindlessTable() = default;
+BindlessTable::BindlessTable(const BindlessTable& other) noexcept = default;
+BindlessTable::BindlessTable(BindlessTable&& other) noexcept = default;
+BindlessTable& BindlessTable::operator=(const BindlessTable& other) noexcept = default;
+BindlessTable& BindlessTable::operator=(BindlessTable&& other) noexcept = default;
+
+const DescriptorSetLayout& BindlessTable::layout() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::BindlessTable::layout").layout;
+}
+const DescriptorSet& BindlessTable::set() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::BindlessTable::set").set; }
+std::uint32_t BindlessTable::capacity(BindlessKind kind) const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::BindlessTable::capacity").arrays[static_cast<int>(kind)].capacity;
 }
 
 VKRC_END_NAMESPACE

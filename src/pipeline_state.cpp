@@ -76,6 +76,11 @@ ComputePipeline ComputePipeline::create(const PipelineLayout& layout, const Comp
         layout, VK_PIPELINE_BIND_POINT_COMPUTE, info.cache, ci, "vkCreateComputePipelines"));
 }
 
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_attachments(
+    Span<const VkPipelineColorBlendAttachmentState> states) {
+    blends_ = states;
+    return *this;
+}
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_constants(const float (&constants)[4]) {
     std::copy(std::begin(constants), std::end(constants), blend_constants_);
     return *this;
@@ -83,6 +88,18 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::blend_constants(const float (&
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::logic_op(VkLogicOp op) {
     logic_op_enable_ = true;
     logic_op_ = op;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::viewports(Span<const VkViewport> viewports) {
+    viewports_ = viewports;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::scissors(Span<const VkRect2D> scissors) {
+    scissors_ = scissors;
+    return *this;
+}
+GraphicsPipelineBuilder& GraphicsPipelineBuilder::dynamic_states(Span<const VkDynamicState> states) {
+    dynamic_states_ = states;
     return *this;
 }
 GraphicsPipelineBuilder& GraphicsPipelineBuilder::specialization(VkShaderStageFlagBits stage,

@@ -80,57 +80,17 @@ public:
     // Slots of kind removed and still waiting for the GPU.
     std::size_t pending_count(BindlessKind kind) const;
 
+    // Out of line: the table's state is vkrc's own (src/bindless.cpp), so
+    // an includer compiles no part of it.
+    BindlessTable() noexcept;
+    ~BindlessTable();
+    BindlessTable(const BindlessTable& other) noexcept;
+    BindlessTable(BindlessTable&& other) noexcept;
+    BindlessTable& operator=(const BindlessTable& other) noexcept;
+    BindlessTable& operator=(BindlessTable&& other) noexcept;
+
 private:
     using Handle::Handle;
 };
-
-namespace detail {
-
-class BindlessTableState final : public RefCounted {
-public:
-    static constexpr const char* type_name = "vkrc::BindlessTable";
-    DescriptorSetLayout layout;
-    DescriptorPool pool;
-    DescriptorSet set;
-    struct Slot {
-        std::uint32_t generation = 0;
-        bool live = false;
-    };
-    // One per BindlessKind; under mutex.
-    struct Array {
-        std::uint32_t capacity = 0;
-        std::uint32_t fresh = 0;  // slots below it have been handed out once
-        std::uint32_t live = 0;
-        std::uint32_t pending = 0;  // removed, not yet back in free
-        List<Slot> slots;
-        List<std::uint32_t> free;  // reusable now
-    };
-    // Where removed slots come back: a removal is a DeferredAction (the one
-    // machinery of deferred destruction: held while a command buffer that
-    // may bind the set is open, then until the work submitted by then
-    // completes) that puts the slot here. The action holds a reference to
-    // this box, which holds nothing, so it outlives neither the table's
-    // device nor forms a cycle; ready has room for every slot.
-    class Returns final : public RefCounted {
-    public:
-        Mutex mutex;
-        List<std::uint64_t> ready;  // kind << 32 | index
-    };
-    Array arrays[2];
-    Ref<Returns> returns;
-    mutable Mutex mutex;
-};
-
-}  // namespace detail
-
-inline const DescriptorSetLayout& BindlessTable::layout() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::BindlessTable::layout").layout;
-}
-inline const DescriptorSet& BindlessTable::set() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::BindlessTable::set").set;
-}
-inline std::uint32_t BindlessTable::capacity(BindlessKind kind) const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::BindlessTable::capacity").arrays[static_cast<int>(kind)].capacity;
-}
 
 VKRC_END_NAMESPACE

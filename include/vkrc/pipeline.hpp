@@ -315,10 +315,7 @@ public:
     }
     // One blend state per colour attachment (build() checks the count);
     // replaces blend() for every attachment. Different states need independentBlend.
-    GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states) {
-        blends_ = states;
-        return *this;
-    }
+    GraphicsPipelineBuilder& blend_attachments(Span<const VkPipelineColorBlendAttachmentState> states);
     // The blend constants (default zero; copied), unless BLEND_CONSTANTS is dynamic.
     GraphicsPipelineBuilder& blend_constants(const float (&constants)[4]);
     // Enables the logic op (needs the logicOp feature) instead of blending.
@@ -326,20 +323,11 @@ public:
     // Static viewports and scissors (copied). Their counts are the pipeline's
     // (more than one needs multiViewport); the values count only when
     // VIEWPORT / SCISSOR are not dynamic (see dynamic_states).
-    GraphicsPipelineBuilder& viewports(Span<const VkViewport> viewports) {
-        viewports_ = viewports;
-        return *this;
-    }
-    GraphicsPipelineBuilder& scissors(Span<const VkRect2D> scissors) {
-        scissors_ = scissors;
-        return *this;
-    }
+    GraphicsPipelineBuilder& viewports(Span<const VkViewport> viewports);
+    GraphicsPipelineBuilder& scissors(Span<const VkRect2D> scissors);
     // Replaces the dynamic state list (viewport and scissor by default).
     // With VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT the counts are dynamic too.
-    GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states) {
-        dynamic_states_ = states;
-        return *this;
-    }
+    GraphicsPipelineBuilder& dynamic_states(Span<const VkDynamicState> states);
     // Restarts strips and fans at the all-ones index value (default off).
     GraphicsPipelineBuilder& primitive_restart(bool enable) {
         primitive_restart_ = enable;
