@@ -12,7 +12,8 @@ build directory:
       being an extension, or extensions joined by '+' that must all be enabled
   src/feature_names.inl
       VKRC_FEATURE(member, version label, field) for the VkBool32 fields of
-      VkPhysicalDeviceFeatures and VkPhysicalDeviceVulkan11/12/13Features
+      VkPhysicalDeviceFeatures, VkPhysicalDeviceVulkan11/12/13Features and
+      the extension feature structs of vkrc::DeviceFeatures
 Usage: gen_registry_tables.py vk.xml OUTDIR
 """
 import os
@@ -24,7 +25,8 @@ DEVICE_HANDLES = ("VkDevice", "VkQueue", "VkCommandBuffer")
 FEATURE_STRUCTS = [("core", "Vulkan 1.0", "VkPhysicalDeviceFeatures"),
                    ("vulkan11", "Vulkan 1.1", "VkPhysicalDeviceVulkan11Features"),
                    ("vulkan12", "Vulkan 1.2", "VkPhysicalDeviceVulkan12Features"),
-                   ("vulkan13", "Vulkan 1.3", "VkPhysicalDeviceVulkan13Features")]
+                   ("vulkan13", "Vulkan 1.3", "VkPhysicalDeviceVulkan13Features"),
+                   ("mesh_shader", "VK_EXT_mesh_shader", "VkPhysicalDeviceMeshShaderFeaturesEXT")]
 
 root = ET.parse(REGISTRY).getroot()
 

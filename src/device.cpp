@@ -367,9 +367,18 @@ std::vector<VkDeviceQueueCreateInfo> queue_create_infos(const detail::Caller& ca
     return infos;
 }
 
-// The extensions asked for, and those vkrc enables where the device has them.
+// Whether info sets any of VK_EXT_mesh_shader's features.
+bool wants_mesh_shader(const DeviceCreateInfo& info) {
+    const auto& f = info.mesh_shader_features;
+    return f.taskShader || f.meshShader || f.multiviewMeshShader || f.primitiveFragmentShadingRateMeshShader ||
+           f.meshShaderQueries;
+}
+
+// The extensions asked for, those whose features info sets, and those vkrc
+// enables where the device has them.
 std::vector<const char*> device_extensions(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
+    if (wants_mesh_shader(info)) detail::add_unique(extensions, VK_EXT_MESH_SHADER_EXTENSION_NAME);
     if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
         detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
@@ -384,9 +393,16 @@ std::vector<const char*> device_extensions(const PhysicalDevice& physical, const
 // Its members point at each other, so it is made in place and never copied.
 struct FeatureChain {
     explicit FeatureChain(const DeviceCreateInfo& info)
-        : f13(info.vulkan13_features), f12(info.vulkan12_features), f11(info.vulkan11_features) {
+        : mesh(info.mesh_shader_features),
+          f13(info.vulkan13_features),
+          f12(info.vulkan12_features),
+          f11(info.vulkan11_features) {
+        // An extension's struct only when some feature of it is asked for:
+        // chained, it would need the extension enabled.
+        mesh.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT;
+        mesh.pNext = const_cast<void*>(info.next);
         f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        f13.pNext = const_cast<void*>(info.next);
+        f13.pNext = wants_mesh_shader(info) ? &mesh : const_cast<void*>(info.next);
         f13.synchronization2 = VK_TRUE;
         f13.dynamicRendering = VK_TRUE;
         // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
@@ -408,10 +424,12 @@ struct FeatureChain {
         d.vulkan11 = f11;
         d.vulkan12 = f12;
         d.vulkan13 = f13;
-        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
+        d.mesh_shader = mesh;
+        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = d.mesh_shader.pNext = nullptr;
         return d;
     }
 
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh;
     VkPhysicalDeviceVulkan13Features f13;
     VkPhysicalDeviceVulkan12Features f12;
     VkPhysicalDeviceVulkan11Features f11;

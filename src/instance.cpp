@@ -17,18 +17,23 @@ namespace {
 
 constexpr const char* validation_layer = "VK_LAYER_KHRONOS_validation";
 
-// The 1.0-1.3 features of versions both the device and the instance have.
-void read_features(const InstanceFunctions& f, VkPhysicalDevice raw, std::uint32_t version, DeviceFeatures& out) {
+// The 1.0-1.3 features of versions both the device and the instance have,
+// and those of the extensions in DeviceFeatures that the device offers (a
+// struct of an extension it lacks must not be chained).
+void read_features(const InstanceFunctions& f, VkPhysicalDevice raw, std::uint32_t version, Span<const Text> extensions,
+                   DeviceFeatures& out) {
     if (version < VK_API_VERSION_1_2) {
         f.vkGetPhysicalDeviceFeatures(raw, &out.core);
         return;
     }
     out.vulkan11.pNext = &out.vulkan12;
     out.vulkan12.pNext = version >= VK_API_VERSION_1_3 ? &out.vulkan13 : nullptr;
+    void*& tail = version >= VK_API_VERSION_1_3 ? out.vulkan13.pNext : out.vulkan12.pNext;
+    if (detail::contains(extensions, VK_EXT_MESH_SHADER_EXTENSION_NAME)) tail = &out.mesh_shader;
     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &out.vulkan11};
     f.vkGetPhysicalDeviceFeatures2(raw, &features);
     out.core = features.features;
-    out.vulkan11.pNext = out.vulkan12.pNext = nullptr;
+    out.vulkan11.pNext = out.vulkan12.pNext = out.vulkan13.pNext = nullptr;
 }
 
 }  // namespace
@@ -205,10 +210,10 @@ List<PhysicalDevice> Instance::physical_devices() const {
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, nullptr);
         s.queue_families.resize(families);
         f.vkGetPhysicalDeviceQueueFamilyProperties(raw, &families, s.queue_families.data());
-        read_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.features);
         auto exts = detail::enumerate<VkExtensionProperties>(f.vkEnumerateDeviceExtensionProperties,
                                                              "vkEnumerateDeviceExtensionProperties", raw, nullptr);
         for (const auto& e : exts) s.extensions.push_back(e.extensionName);
+        read_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.extensions, s.features);
         s.default_queue_family = device.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
         devices.push_back(std::move(device));
     }

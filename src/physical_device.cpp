@@ -13,7 +13,8 @@
 VKRC_BEGIN_NAMESPACE
 
 namespace {
-// Adds "lacks feature <name> (Vulkan 1.x)" for each feature wanted but missing.
+// Adds "lacks feature <name> (Vulkan 1.x)" (or "(VK_EXT_...)", the extension
+// that provides it) for each feature wanted but missing.
 void add_missing_features(const DeviceFeatures& want, const DeviceFeatures& have, std::vector<std::string>& reasons) {
 #define VKRC_FEATURE(group, version, name) \
   if (want.group.name && !have.group.name) reasons.push_back("lacks feature " #name " (" version ")");

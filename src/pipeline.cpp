@@ -309,6 +309,14 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::shader(VkShaderStageFlagBits s
     caller.require_handle(module, "the ShaderModule");
     caller.require(module.device() == layout_.device(),
                    "the ShaderModule belongs to another device than the pipeline layout");
+    // VUID-VkPipelineShaderStageCreateInfo-stage-02091 and -02092.
+    const auto& mesh_features = layout_.device().state()->enabled_features.mesh_shader;
+    caller.require(stage != VK_SHADER_STAGE_MESH_BIT_EXT || mesh_features.meshShader,
+                   "a mesh shader on a device created without the meshShader feature "
+                   "(DeviceCreateInfo::mesh_shader_features)");
+    caller.require(stage != VK_SHADER_STAGE_TASK_BIT_EXT || mesh_features.taskShader,
+                   "a task shader on a device created without the taskShader feature "
+                   "(DeviceCreateInfo::mesh_shader_features)");
     stages_.push_back({stage, module, entry_point});
     return *this;
 }

@@ -26,6 +26,9 @@ VkSpecializationInfo specialization_info(Span<const VkSpecializationMapEntry> en
 
 constexpr VkShaderStageFlags tessellation_stages =
     VK_SHADER_STAGE_TESSELLATION_CONTROL_BIT | VK_SHADER_STAGE_TESSELLATION_EVALUATION_BIT;
+// The primitive shading stages a mesh pipeline replaces (VUID-VkGraphicsPipelineCreateInfo-pStages-02095).
+constexpr VkShaderStageFlags vertex_pipeline_stages =
+    VK_SHADER_STAGE_VERTEX_BIT | tessellation_stages | VK_SHADER_STAGE_GEOMETRY_BIT;
 
 bool contains(Span<const VkDynamicState> states, VkDynamicState state) {
     return std::find(states.begin(), states.end(), state) != states.end();
@@ -146,6 +149,22 @@ void GraphicsPipelineBuilder::check_tessellation() const {
     build_caller.require(!tessellated || patch_control_points_ > 0, "tessellation shaders without tessellation()");
     build_caller.require(!tessellated || topology_ == VK_PRIMITIVE_TOPOLOGY_PATCH_LIST,
                          "tessellation shaders need topology PATCH_LIST");
+}
+
+bool GraphicsPipelineBuilder::check_mesh_stages() const {
+    VkShaderStageFlags present = 0;
+    for (const auto& st : stages_) present |= st.stage;
+    const bool mesh = (present & VK_SHADER_STAGE_MESH_BIT_EXT) != 0;
+    // VUID-VkGraphicsPipelineCreateInfo-stage-02096: a task stage only feeds a mesh stage.
+    build_caller.require(mesh || (present & VK_SHADER_STAGE_TASK_BIT_EXT) == 0, "a task shader without a mesh shader");
+    if (!mesh) return false;
+    build_caller.require((present & vertex_pipeline_stages) == 0,
+                         "a mesh shader with vertex, tessellation or geometry shaders (stage flags ",
+                         detail::Hex{present & vertex_pipeline_stages}, "): a pipeline has one or the other");
+    // Vulkan ignores vertex input with a mesh stage: refused rather than silently unused.
+    build_caller.require(bindings_.empty() && attributes_.empty(), "vertex bindings or attributes (", bindings_.size(),
+                         " and ", attributes_.size(), ") with a mesh shader, which has no vertex input");
+    return true;
 }
 
 VkPipelineViewportStateCreateInfo GraphicsPipelineBuilder::viewport_state() const {
@@ -276,6 +295,7 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     std::vector<VkSpecializationInfo> specs(stages_.size());
     attach_specializations(stages, specs);
     check_tessellation();
+    const bool mesh = check_mesh_stages();
     const auto vertex = vertex_input_state();
     const auto assembly = input_assembly_state();
     VkPipelineTessellationStateCreateInfo tessellation{VK_STRUCTURE_TYPE_PIPELINE_TESSELLATION_STATE_CREATE_INFO};
@@ -300,8 +320,9 @@ GraphicsPipeline GraphicsPipelineBuilder::build(const PipelineCache& cache) cons
     ci.pTessellationState = patch_control_points_ ? &tessellation : nullptr;
     ci.stageCount = static_cast<std::uint32_t>(stages.size());
     ci.pStages = stages.data();
-    ci.pVertexInputState = &vertex;
-    ci.pInputAssemblyState = &assembly;
+    // A mesh pipeline makes its own primitives: no vertex input, no input assembly.
+    ci.pVertexInputState = mesh ? nullptr : &vertex;
+    ci.pInputAssemblyState = mesh ? nullptr : &assembly;
     ci.pViewportState = &viewport;
     ci.pRasterizationState = &raster;
     ci.pMultisampleState = &multisample;

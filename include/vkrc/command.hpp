@@ -416,6 +416,31 @@ public:
                                            stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
     }
 
+    // Mesh shading (VK_EXT_mesh_shader: DeviceCreateInfo::mesh_shader_features)
+    // with a pipeline that has a mesh stage: group_count_x * y * z workgroups
+    // of the task shader, or of the mesh shader when there is none.
+    void draw_mesh_tasks(std::uint32_t group_count_x, std::uint32_t group_count_y = 1,
+                         std::uint32_t group_count_z = 1) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_mesh_tasks");
+        fn_->vkCmdDrawMeshTasksEXT(cmd_, group_count_x, group_count_y, group_count_z);
+    }
+    // The group counts from VkDrawMeshTasksIndirectCommandEXTs in buffer, as draw_indirect.
+    void draw_mesh_tasks_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset, std::uint32_t draw_count,
+                                  std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_mesh_tasks_indirect");
+        fn_->vkCmdDrawMeshTasksIndirectEXT(cmd_, buffer, offset, draw_count,
+                                           stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
+    }
+    // The draw count from count_buffer as draw_indirect_count (also needs drawIndirectCount).
+    void draw_mesh_tasks_indirect_count(Raw<VkBuffer> buffer, VkDeviceSize offset, Raw<VkBuffer> count_buffer,
+                                        VkDeviceSize count_offset, std::uint32_t max_draw_count,
+                                        std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_mesh_tasks_indirect_count");
+        fn_->vkCmdDrawMeshTasksIndirectCountEXT(
+            cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
+            stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
+    }
+
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
     void begin_query(Raw<VkQueryPool> pool, std::uint32_t query,
                      VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {

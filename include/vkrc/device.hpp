@@ -65,6 +65,9 @@ struct DeviceCreateInfo {
     VkPhysicalDeviceVulkan11Features vulkan11_features{};
     VkPhysicalDeviceVulkan12Features vulkan12_features{};
     VkPhysicalDeviceVulkan13Features vulkan13_features{};
+    // With any feature set, vkrc chains it and enables VK_EXT_mesh_shader
+    // (mesh and task shaders: GraphicsPipelineBuilder, draw_mesh_tasks).
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh_shader_features{};
     // Enable VK_EXT_memory_budget when the device has it (for allocator statistics). Default true.
     bool enable_memory_budget = true;
     // Chained after vkrc's feature structs (must not repeat them). Null: none.

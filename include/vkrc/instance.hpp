@@ -109,8 +109,9 @@ constexpr T with_type(VkStructureType type) noexcept {
 }
 }  // namespace detail
 
-// The Vulkan 1.0-1.3 feature structs, unchained: the sTypes are set and every
-// pNext is null, so copies are safe (vkrc chains them when it queries).
+// The Vulkan 1.0-1.3 feature structs and those of the extensions vkrc wraps,
+// unchained: the sTypes are set and every pNext is null, so copies are safe
+// (vkrc chains them when it queries).
 struct DeviceFeatures {
     VkPhysicalDeviceFeatures core{};
     VkPhysicalDeviceVulkan11Features vulkan11 =
@@ -119,6 +120,9 @@ struct DeviceFeatures {
         detail::with_type<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
     VkPhysicalDeviceVulkan13Features vulkan13 =
         detail::with_type<VkPhysicalDeviceVulkan13Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES);
+    // VK_EXT_mesh_shader (taskShader, meshShader): read only from a device that offers the extension.
+    VkPhysicalDeviceMeshShaderFeaturesEXT mesh_shader = detail::with_type<VkPhysicalDeviceMeshShaderFeaturesEXT>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT);
 };
 
 // What a device must offer to be chosen. Every unmet item is reported.
@@ -176,8 +180,8 @@ public:
     const VkPhysicalDeviceProperties& properties() const VKRC_UNCHECKED_NOEXCEPT;
     const VkPhysicalDeviceMemoryProperties& memory_properties() const VKRC_UNCHECKED_NOEXCEPT;
     const List<VkQueueFamilyProperties>& queue_families() const VKRC_UNCHECKED_NOEXCEPT;
-    // The 1.0-1.3 features, read once (those of versions the device or the
-    // instance lacks stay VK_FALSE).
+    // The 1.0-1.3 and extension features, read once (those of versions the
+    // device or the instance lacks, or of extensions the device lacks, stay VK_FALSE).
     const DeviceFeatures& features() const VKRC_UNCHECKED_NOEXCEPT;
     // vkGetPhysicalDeviceFormatProperties2 with VkFormatProperties3 (64-bit
     // flags); before Vulkan 1.3, the 32-bit flags widened. pNext is null.

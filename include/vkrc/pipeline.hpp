@@ -246,7 +246,11 @@ public:
     explicit GraphicsPipelineBuilder(PipelineLayout layout);
 
     // Adds a stage (required: at least one). Keeps the module alive until the builder dies; entry_point
-    // is kept as a pointer: it must outlive build().
+    // is kept as a pointer: it must outlive build(). TASK_BIT_EXT and MESH_BIT_EXT need the device's
+    // taskShader and meshShader features (DeviceCreateInfo::mesh_shader_features; UsageError otherwise).
+    // With a mesh stage the pipeline has no vertex input or input assembly (topology and
+    // primitive_restart are unused), and build() refuses vertex, tessellation or geometry stages and
+    // vertex bindings or attributes beside it, and a task stage without one.
     GraphicsPipelineBuilder& shader(VkShaderStageFlagBits stage, const ShaderModule& module,
                                     const char* entry_point = "main");
     // Adds a vertex buffer binding (default: none).
@@ -360,7 +364,8 @@ public:
 
     // vkCreateGraphicsPipelines with what was set, through cache if given
     // (UsageError for what the builder can check: an empty layout, no stage,
-    // a blend count other than the colour attachments'). It may build again.
+    // a blend count other than the colour attachments', a mesh stage beside
+    // vertex stages or vertex input, a task stage without a mesh stage). It may build again.
     GraphicsPipeline build(const PipelineCache& cache = {}) const;
 
 private:
@@ -416,6 +421,8 @@ private:
     List<VkPipelineShaderStageCreateInfo> shader_stages() const;
     void attach_specializations(Span<VkPipelineShaderStageCreateInfo> stages, Span<VkSpecializationInfo> infos) const;
     void check_tessellation() const;
+    // Whether there is a mesh stage; refuses what Vulkan forbids beside one (or a task stage without one).
+    bool check_mesh_stages() const;
     VkPipelineViewportStateCreateInfo viewport_state() const;
     VkPipelineRasterizationStateCreateInfo rasterization_state() const;
     VkPipelineMultisampleStateCreateInfo multisample_state() const;

@@ -58,7 +58,7 @@ extern vkrc::CommandBuffer cmd, primary;
 extern std::vector<vkrc::CommandBuffer> secondaries;
 extern std::array<vkrc::Fence, 2> fences;
 extern vkrc::Fence done;
-extern vkrc::Buffer buffer, vertex_buffer, vertices, starts, steps, src, dst, pixels;
+extern vkrc::Buffer buffer, vertex_buffer, vertices, starts, steps, src, dst, pixels, args, counts;
 extern vkrc::Image image, texture, depth, shadow_map;
 extern vkrc::ImageView view, depth_view;
 extern vkrc::Sampler sampler;
@@ -103,5 +103,5 @@ extern VkDeviceSize bytes;
   [[maybe_unused]] auto& log = vkrc_snippets::log;
 
 namespace vkrc_shaders {  // vkrc_add_shaders' headers
-extern const std::span<const std::uint32_t> triangle_vert, triangle_frag, collatz_comp;
+extern const std::span<const std::uint32_t> triangle_vert, triangle_frag, collatz_comp, cull_task, meshlets_mesh;
 }
