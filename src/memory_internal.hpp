@@ -50,6 +50,15 @@ inline void add_tallies(HeapStatistics& to, const HeapStatistics& from) noexcept
     to.allocation_count += from.allocation_count;
 }
 
+// A pool's new block grows it by at least 1 / pool_growth_divisor of what
+// it holds: its last, part-used block stays a bounded share of it.
+inline constexpr VkDeviceSize pool_growth_divisor = 8;
+// The size of a pool's next block (see PoolAllocatorCreateInfo): for a
+// request of request bytes (aligned and padded) in a pool that holds reserved
+// bytes of a heap of heap_size bytes.
+VkDeviceSize next_block_size(const PoolAllocatorCreateInfo& info, VkDeviceSize heap_size, VkDeviceSize reserved,
+                             VkDeviceSize request) noexcept;
+
 // Vulkan's alignments are powers of two; the division is for anything else.
 constexpr VkDeviceSize align_up(VkDeviceSize v, VkDeviceSize a) noexcept {
     return (a & (a - 1)) == 0 ? (v + a - 1) & ~(a - 1) : (v + a - 1) / a * a;

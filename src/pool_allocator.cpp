@@ -66,6 +66,7 @@ struct Pool {
     std::uint32_t memory_type = 0;
     bool device_address = false;  // blocks allocated with VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT
     std::vector<Block*> blocks;
+    VkDeviceSize reserved = 0;  // bytes of its blocks
     std::uint64_t fl_bitmap = 0;
     std::uint32_t sl_bitmap[fl_count] = {};
     Node* heads[fl_count][sl_count] = {};
@@ -290,6 +291,23 @@ std::uint32_t resolve_shards(std::uint32_t wanted) noexcept {
 
 }  // namespace
 
+namespace detail {
+
+VkDeviceSize next_block_size(const PoolAllocatorCreateInfo& info, VkDeviceSize heap_size, VkDeviceSize reserved,
+                             VkDeviceSize request) noexcept {
+    // Small heaps get blocks of at most an eighth of the heap.
+    const VkDeviceSize cap = std::min(info.max_block_size, std::max<VkDeviceSize>(heap_size / 8, 1 << 20));
+    // Twice the request (as VMA), so that its like fits beside it; a request
+    // above half the cap gets a block of its own size.
+    const VkDeviceSize room = request > cap / 2 ? request : request * 2;
+    const VkDeviceSize wanted = std::max(room, reserved / pool_growth_divisor);
+    VkDeviceSize size = std::min(info.min_block_size, cap);
+    while (size < cap && size < wanted) size *= 2;
+    return std::max(std::min(size, cap), request);
+}
+
+}  // namespace detail
+
 struct PoolAllocator::Impl {
     PoolAllocatorCreateInfo info;
     std::unique_ptr<Shard[]> shards;
@@ -315,6 +333,7 @@ struct PoolAllocator::Impl {
     void count_memory_object(DeviceView d);
     Block& new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least);
     void free_block(DeviceView d, Shard& shard, Pool& pool, Block& block) noexcept;
+    void release_spare(DeviceView d, Shard& shard, Pool& pool) noexcept;
     // allocate()'s two paths; out arrives with size and memory_type set.
     void allocate_dedicated(DeviceView d, const AllocationRequest& request, AllocationInfo& out);
     void allocate_range(DeviceView d, const AllocationRequest& request, AllocationInfo& out);
@@ -374,18 +393,8 @@ void PoolAllocator::Impl::count_memory_object(DeviceView d) {
 }
 
 Block& PoolAllocator::Impl::new_block(DeviceView d, Shard& shard, Pool& pool, VkDeviceSize at_least) {
-    const auto& props = d.memory_properties();
-    const VkDeviceSize heap_size = props.memoryHeaps[heap_of[pool.memory_type]].size;
-    // Small heaps get blocks of at most an eighth of the heap.
-    const VkDeviceSize max_size = std::min(info.max_block_size, std::max<VkDeviceSize>(heap_size / 8, 1 << 20));
-    // A pool grows by about a quarter of its size at a time, between the two limits:
-    // small pools waste little in a half-used last block, large ones make
-    // few vkAllocateMemory calls.
-    VkDeviceSize reserved = 0;
-    for (Block* b : pool.blocks) reserved += b->size;
-    VkDeviceSize size = std::min(info.min_block_size, max_size);
-    while (size < max_size && size * 2 <= reserved / 4) size *= 2;
-    size = std::max(size, at_least);
+    const VkDeviceSize heap_size = d.memory_properties().memoryHeaps[heap_of[pool.memory_type]].size;
+    VkDeviceSize size = detail::next_block_size(info, heap_size, pool.reserved, at_least);
     auto block = std::make_unique<Block>();
     count_memory_object(d);
     Node* node = nullptr;
@@ -418,6 +427,7 @@ Block& PoolAllocator::Impl::new_block(DeviceView d, Shard& shard, Pool& pool, Vk
     block->first = node;
     pool.insert_free(node);
     pool.blocks.push_back(block.get());
+    pool.reserved += size;
     detail::add_block(heap(shard, pool.memory_type), size);
     return *block.release();
 }
@@ -431,9 +441,25 @@ void PoolAllocator::Impl::free_block(DeviceView d, Shard& shard, Pool& pool, Blo
     }
     d.fn().vkFreeMemory(d.vk(), block.memory, nullptr);
     detail::remove_block(heap(shard, pool.memory_type), block.size);
+    pool.reserved -= block.size;
     memory_objects.fetch_sub(1, __ATOMIC_RELAXED);
     std::erase(pool.blocks, &block);
     delete &block;
+}
+
+// Called when a block of pool has emptied: with more than spare_blocks
+// empty blocks, the smallest goes. A program that loads and drops resources
+// swings by more than one block (an eighth of a large pool), and a block
+// freed and made again costs a vkAllocateMemory (and a map) each time.
+void PoolAllocator::Impl::release_spare(DeviceView d, Shard& shard, Pool& pool) noexcept {
+    std::uint32_t empty = 0;
+    Block* smallest = nullptr;
+    for (Block* b : pool.blocks) {
+        if (b->allocations != 0) continue;
+        ++empty;
+        if (!smallest || b->size < smallest->size) smallest = b;
+    }
+    if (empty > info.spare_blocks) free_block(d, shard, pool, *smallest);
 }
 
 // A VkDeviceMemory of its own, counted in the statistics of a shard.
@@ -577,13 +603,7 @@ void PoolAllocator::free(DeviceView d, const AllocationInfo& allocation) {
     pool.insert_free(node);
 
     if (block.allocations == 0) {
-        // Keep one empty block per pool as a spare; release any other (the smaller).
-        for (Block* other : pool.blocks) {
-            if (other != &block && other->allocations == 0) {
-                m.free_block(d, shard, pool, other->size <= block.size ? *other : block);
-                break;
-            }
-        }
+        m.release_spare(d, shard, pool);
     }
 }
 

@@ -24,6 +24,7 @@ using vkrc::detail::MemoryRange;
 using vkrc_test::VulkanTest;
 
 constexpr VkDeviceSize MiB = VkDeviceSize{1} << 20;
+constexpr VkDeviceSize KiB = VkDeviceSize{1} << 10;
 
 // ------------------------------------------------------------ pure range arithmetic
 
@@ -634,17 +635,96 @@ TEST_F(PoolTest, LargeRequestsAreDedicatedAndEmptyBlocksReleased) {
     EXPECT_EQ(big.offset, 0u);
     pool.free(view(), big);
     EXPECT_EQ(pool.statistics(view()).total().block_count, 0u);
-    // Three blocks' worth, then all freed: one spare block stays.
+    // Three blocks' worth, then all freed: spare_blocks (two) stay.
     std::vector<vkrc::AllocationInfo> all;
     for (int i = 0; i < 6; ++i) all.push_back(pool.allocate(view(), request(400 * 1024)));
     EXPECT_EQ(pool.statistics(view()).total().block_count, 3u);
     for (auto& a : all) pool.free(view(), a);
     const auto total = pool.statistics(view()).total();
-    EXPECT_EQ(total.block_count, 1u);
+    EXPECT_EQ(total.block_count, 2u);
     EXPECT_EQ(total.allocation_count, 0u);
     EXPECT_EQ(total.allocation_bytes, 0u);
     pool.release(view());
     EXPECT_EQ(pool.statistics(view()).total().block_count, 0u);
+}
+
+// Issue 32: the first block of a kind is min_block_size (1 MiB by default,
+// cheap to allocate and map at start-up), not a large one.
+TEST_F(PoolTest, FirstBlockIsSmall) {
+    vkrc::PoolAllocator pool;
+    const auto a = pool.allocate(view(), request(4096));
+    EXPECT_EQ(a.memory_size, 1 * MiB);
+    EXPECT_EQ(pool.statistics(view()).total().block_bytes, 1 * MiB);
+    pool.free(view(), a);
+    pool.release(view());
+}
+
+// The block sizes chosen for a fixed sequence of requests: min_block_size
+// doubled until it holds twice the request and an eighth of the pool.
+TEST_F(PoolTest, BlocksHoldTwiceTheRequestAndGrowByAnEighth) {
+    vkrc::PoolAllocatorCreateInfo info;
+    info.min_block_size = 64 * KiB;
+    info.max_block_size = 16 * MiB;
+    vkrc::PoolAllocator pool(info);
+    // 28 KiB ranges: two to a 64 KiB block (twice the request fits) until the
+    // pool holds 512 KiB; then a 576 KiB pool's eighth (72 KiB) asks for 128 KiB.
+    std::vector<vkrc::AllocationInfo> all;
+    std::vector<VkDeviceSize> block_sizes;
+    for (int i = 0; i < 20; ++i) {
+        all.push_back(pool.allocate(view(), request(28 * KiB)));
+        if (i == 0 || all[all.size() - 2].memory != all.back().memory) block_sizes.push_back(all.back().memory_size);
+    }
+    const std::vector<VkDeviceSize> expected{64 * KiB, 64 * KiB, 64 * KiB, 64 * KiB, 64 * KiB,
+                                             64 * KiB, 64 * KiB, 64 * KiB, 64 * KiB, 128 * KiB};
+    EXPECT_EQ(block_sizes, expected);
+    // A request needs a block of twice its size: 300 KiB gets 1 MiB (the
+    // first doubling of 64 KiB to hold 600 KiB), not another 128 KiB.
+    all.push_back(pool.allocate(view(), request(300 * KiB)));
+    EXPECT_EQ(all.back().memory_size, 1 * MiB);
+    EXPECT_EQ(pool.statistics(view()).vk_allocate_calls, 11u);
+    for (auto& a : all) pool.free(view(), a);
+    pool.release(view());
+}
+
+// dedicated_threshold 0 means max_block_size / 2: a request just above it
+// has its own VkDeviceMemory, one at it a block of the pool.
+TEST_F(PoolTest, DefaultDedicatedThresholdIsHalfTheLargestBlock) {
+    vkrc::PoolAllocatorCreateInfo info;
+    info.max_block_size = 4 * MiB;
+    vkrc::PoolAllocator pool(info);
+    const auto at = pool.allocate(view(), request(2 * MiB));
+    const auto above = pool.allocate(view(), request(2 * MiB + 256));
+    EXPECT_FALSE(at.dedicated);
+    EXPECT_EQ(at.memory_size, 4 * MiB);
+    EXPECT_TRUE(above.dedicated);
+    EXPECT_EQ(above.memory_size, 2 * MiB + 256);
+    pool.free(view(), at);
+    pool.free(view(), above);
+    pool.release(view());
+}
+
+// Empty blocks beyond spare_blocks are released, the smallest first.
+TEST_F(PoolTest, EmptyBlocksBeyondTheSparesAreReleasedSmallestFirst) {
+    for (std::uint32_t spares : {0u, 1u, 2u}) {
+        vkrc::PoolAllocatorCreateInfo info;
+        info.max_block_size = 4 * MiB;
+        info.spare_blocks = spares;
+        vkrc::PoolAllocator pool(info);
+        const auto small = pool.allocate(view(), request(4096));        // the first block, 1 MiB
+        const auto large = pool.allocate(view(), request(1536 * KiB));  // does not fit: a 4 MiB block
+        EXPECT_EQ(small.memory_size, 1 * MiB);
+        EXPECT_EQ(large.memory_size, 4 * MiB);
+        pool.free(view(), small);
+        pool.free(view(), large);
+        const auto total = pool.statistics(view()).total();
+        const VkDeviceSize kept[] = {0, 4 * MiB, 5 * MiB};
+        EXPECT_EQ(total.block_bytes, kept[spares]) << spares << " spare blocks";
+        // A kept block serves again without a vkAllocateMemory.
+        const auto again = pool.allocate(view(), request(4096));
+        EXPECT_EQ(pool.statistics(view()).vk_allocate_calls, spares == 0 ? 3u : 2u);
+        pool.free(view(), again);
+        pool.release(view());
+    }
 }
 
 TEST_F(PoolTest, ServesOneDeviceAtATime) {
@@ -824,9 +904,9 @@ TEST_F(PoolTest, ShardedConcurrentAllocateAndFree) {
     auto total = pool.statistics(view()).total();
     EXPECT_EQ(total.allocation_count, all.size());
     EXPECT_GE(total.allocation_bytes, bytes);
-    // Every block in use holds a live range; a spare per shard may be empty.
+    // Every block in use holds a live range; spare_blocks per shard may be empty.
     EXPECT_GE(total.block_count, memories.size());
-    EXPECT_LE(total.block_count, memories.size() + pool.shard_count());
+    EXPECT_LE(total.block_count, memories.size() + info.spare_blocks * pool.shard_count());
 
     on_threads(thread_count, [&](int t) {
         for (auto& a : live[static_cast<std::size_t>((t + 1) % thread_count)]) pool.free(view(), a);
@@ -834,7 +914,7 @@ TEST_F(PoolTest, ShardedConcurrentAllocateAndFree) {
     total = pool.statistics(view()).total();
     EXPECT_EQ(total.allocation_count, 0u);
     EXPECT_EQ(total.allocation_bytes, 0u);
-    EXPECT_LE(total.block_count, pool.shard_count());
+    EXPECT_LE(total.block_count, info.spare_blocks * pool.shard_count());
     EXPECT_EQ(total.block_bytes, total.block_count * MiB);
     EXPECT_GE(pool.statistics(view()).vk_allocate_calls, memories.size());
     pool.release(view());
@@ -906,7 +986,7 @@ TEST_F(PoolTest, ConcurrentAllocateAndFree) {
     for (auto& th : threads) th.join();
     const auto total = pool->statistics(view()).total();
     EXPECT_EQ(total.allocation_count, 0u);
-    EXPECT_LE(total.block_count, pool->shard_count());  // a spare per shard at most
+    EXPECT_LE(total.block_count, info.spare_blocks * pool->shard_count());  // the spares of each shard at most
 }
 #endif
 

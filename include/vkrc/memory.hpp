@@ -169,13 +169,22 @@ private:
 
 // Every member is optional. Copied by the PoolAllocator's constructor.
 struct PoolAllocatorCreateInfo {
-    // Blocks start at min_block_size and double up to max_block_size (both
-    // capped at an eighth of small heaps). Defaults 64 MiB and 256 MiB;
+    // Each kind of block (see PoolAllocator) starts with one block of
+    // min_block_size; a new block is min_block_size doubled while it holds
+    // less than twice the request that needs it or an eighth of the bytes of
+    // that kind already reserved, up to max_block_size (both capped at an
+    // eighth of small heaps); never less than the request. A small first
+    // block keeps start-up cheap (allocating and mapping a 64 MiB one took
+    // about 20 ms on NVIDIA); growing by an eighth keeps the part-used last
+    // block a small share of a large pool. Defaults 1 MiB and 256 MiB;
     // min_block_size non-zero and at most max_block_size.
-    VkDeviceSize min_block_size = VkDeviceSize{64} << 20;
+    VkDeviceSize min_block_size = VkDeviceSize{1} << 20;
     VkDeviceSize max_block_size = VkDeviceSize{256} << 20;
-    // Requests larger than this get their own VkDeviceMemory; 0: max_block_size / 2.
+    // Requests larger than this get their own VkDeviceMemory; 0: max_block_size / 2 (as VMA).
     VkDeviceSize dedicated_threshold = 0;
+    // Empty blocks kept per kind of block (and shard) for reuse; one more
+    // empty block releases the smallest. Default 2.
+    std::uint32_t spare_blocks = 2;
     // Independent parts (each with its own lock, blocks and spare block) that
     // threads allocating at once spread over, so that they do not queue on
     // one lock. 0: min(8, hardware threads) under the multi-thread policy;
@@ -191,7 +200,7 @@ inline constexpr std::uint32_t max_pool_shards = 64;
 // hold either upload ranges (host-written) or gpu_only and readback ones
 // (GPU-written) or custom ones, never two of these, so that a capture tool
 // that copies host-written pages to the device never overwrites GPU writes;
-// empty blocks are released keeping at most one spare per kind of block
+// empty blocks are released keeping at most spare_blocks per kind of block
 // (memory type and the classes above) and shard; its own VkDeviceMemory count stays within maxMemoryAllocationCount.
 // The device's default allocator. Serves one device at a time; used directly
 // (not through Allocation), call release() before that device goes.
@@ -202,7 +211,7 @@ inline constexpr std::uint32_t max_pool_shards = 64;
 // when all are held, and free() goes back to the shard that made the range,
 // from any thread. Shards share no blocks, so the memory trade-off is: with
 // threads allocating at once, up to shard count x block size may be
-// reserved per memory type (a partly used block and a spare in each shard)
+// reserved per memory type (a partly used block and the spares in each shard)
 // where one shard would reserve one block's worth.
 class PoolAllocator final : public DeviceAllocator {
 public:
