@@ -11,14 +11,21 @@
 #include "support/teapot_scenario.hpp"
 #include "support/vk_test.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <memory>
 #include <new>
+#include <set>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -56,6 +63,53 @@ vkrc::InstanceCreateInfo injected_instance_info(const std::shared_ptr<vkrc_test:
     return ::testing::AssertionSuccess();
 }
 
+std::string read_text(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// The functions of the table vkrc's sources call: every vkX read as a member
+// (fn.vkX(...), fn().vkX, ->vkX) or named as one (&DeviceFunctions::vkX).
+std::set<std::string> functions_vkrc_calls() {
+    std::set<std::string> out;
+    const std::filesystem::path root = VKRC_SOURCE_DIR;
+    for (const char* dir : {"src", "include/vkrc"}) {
+        for (const auto& entry : std::filesystem::recursive_directory_iterator(root / dir)) {
+            if (!entry.is_regular_file()) continue;
+            const std::string text = read_text(entry.path());
+            for (std::size_t at = text.find("vk"); at != std::string::npos; at = text.find("vk", at + 2)) {
+                if (at == 0 || !std::strchr(".>:", text[at - 1]) || !std::isupper(text[at + 2])) continue;
+                std::size_t end = at + 2;
+                while (end < text.size() && (std::isalnum(text[end]) || text[end] == '_')) ++end;
+                // An assignment (a table slot cleared) is no call.
+                const std::size_t next = text.find_first_not_of(' ', end);
+                if (next != std::string::npos && text[next] == '=' && text[next + 1] != '=') continue;
+                out.insert(text.substr(at, end - at));
+            }
+        }
+    }
+    return out;
+}
+
+// The functions docs/reliability.md lists under "Failures vkrc absorbs by
+// design": every `vkX` from that line to the end of its bullet list.
+std::set<std::string> documented_absorptions() {
+    const std::string text = read_text(std::filesystem::path(VKRC_SOURCE_DIR) / "docs/reliability.md");
+    const std::size_t begin = text.find("Failures vkrc absorbs by design");
+    std::set<std::string> out;
+    if (begin == std::string::npos) return out;
+    const std::size_t first_bullet = text.find("\n- ", begin);
+    std::size_t end = text.find("\n\n", first_bullet);
+    if (end == std::string::npos) end = text.size();
+    for (std::size_t at = text.find("`vk", begin); at < end; at = text.find("`vk", at + 1)) {
+        const std::size_t close = text.find('`', at + 1);
+        out.insert(text.substr(at + 1, close - at - 1));
+    }
+    return out;
+}
+
 bool all_errors() {
     if (const char* v = std::getenv("VKRC_FAULT_ALL_ERRORS")) return *v && *v != '0';
 #if defined(__SANITIZE_THREAD__)
@@ -65,36 +119,57 @@ bool all_errors() {
 #endif
 }
 
+// The errors injected into call k. The teapot and descriptor scenarios
+// (every_error) get all four; the others, which run fewer calls' worth of
+// setup again and again, get device loss (vkrc's other way out) and one of
+// the other three in turn. Under ThreadSanitizer (all_errors() false) each
+// call gets one, in turn.
+std::vector<VkResult> errors_at(std::uint64_t k, bool every_error) {
+    if (!all_errors()) return {injected_errors[k % injected_errors.size()]};
+    if (every_error) return {injected_errors.begin(), injected_errors.end()};
+    return {injected_errors[k % 3], VK_ERROR_DEVICE_LOST};
+}
+
 // Runs scenario once to count its failable calls and take its reference
 // result (which plausible must accept), then once per call and error with
 // that call failing (see the file comment): a run whose failure vkrc
 // absorbed must give the reference result again.
 template <class Scenario, class Plausible>
 void inject_into_every_call(const char* what, const Scenario& scenario, const Plausible& plausible,
-                            std::uint64_t min_points) {
+                            std::uint64_t min_points, bool every_error = false) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     const auto info = injected_instance_info(log);
     faults::arm(0, VK_SUCCESS);
     const auto start = std::chrono::steady_clock::now();
     // The reference frame: a run vkrc absorbed a failure in must draw it again.
+    faults::forget_called();
     const auto reference = scenario(info);
     const std::uint64_t points = faults::failable_calls();
+    // Scenarios that mark the end of their setup are injected after it.
+    const std::uint64_t setup = faults::setup_calls();
+    const auto reference_calls = faults::called_functions(setup != 0);
+    std::set<std::string> failed;  // the functions a failure was injected into
     EXPECT_TRUE(plausible(reference)) << what << ": the scenario did not run";
     vkrc_test::expect_no_validation_messages(*log);
-    ASSERT_GT(points, min_points) << "the wrapper does not see vkrc's calls";
+    ASSERT_GT(points - setup, min_points) << "the wrapper does not see vkrc's calls";
 
     std::uint64_t runs = 0, thrown = 0, not_reached = 0;
     std::map<std::string, int> absorbed;  // calls whose failure vkrc handled without throwing
     // VKRC_FAULT_FIRST=k starts at call k and prints each run (to find a hang).
     const char* first = std::getenv("VKRC_FAULT_FIRST");
-    for (std::uint64_t k = first ? std::strtoull(first, nullptr, 10) : 1; k <= points; ++k) {
-        for (std::size_t e = 0; e < injected_errors.size(); ++e) {
-            if (!all_errors() && e != k % injected_errors.size()) continue;
-            const VkResult error = injected_errors[e];
+    for (std::uint64_t k = first ? std::strtoull(first, nullptr, 10) : setup + 1; k <= points; ++k) {
+        for (const VkResult error : errors_at(k, every_error)) {
             ++runs;
             if (first)
                 std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
             faults::arm(k, error);
+            // The name is read after the run: fired_in() is reset by the next arm().
+            struct NoteFired {
+                std::set<std::string>& failed;
+                ~NoteFired() {
+                    if (faults::fired()) failed.insert(faults::fired_in());
+                }
+            } note{failed};
             try {
                 const auto frame = scenario(info);
                 absorbed[faults::fired_in() ? faults::fired_in() : "-"]++;
@@ -124,18 +199,31 @@ void inject_into_every_call(const char* what, const Scenario& scenario, const Pl
     faults::arm(0, VK_SUCCESS);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf(
-        "fault injection (%s): %llu injection points exercised in %llu runs (%.1f s), %llu ended in vkrc::Error, "
-        "%llu not reached (fewer timeline polls)\n",
-        what, static_cast<unsigned long long>(points), static_cast<unsigned long long>(runs), seconds,
-        static_cast<unsigned long long>(thrown), static_cast<unsigned long long>(not_reached));
-    for (const auto& [name, count] : absorbed) std::printf("  absorbed by vkrc: %s x%d\n", name.c_str(), count);
+        "fault injection (%s): %llu injection points exercised (after %llu setup calls) in %llu runs (%.1f s), %llu "
+        "ended in vkrc::Error, %llu not reached (fewer timeline polls)\n",
+        what, static_cast<unsigned long long>(points - setup), static_cast<unsigned long long>(setup),
+        static_cast<unsigned long long>(runs), seconds, static_cast<unsigned long long>(thrown),
+        static_cast<unsigned long long>(not_reached));
+    const auto documented = documented_absorptions();
+    EXPECT_FALSE(documented.empty()) << "no absorbed failures found in docs/reliability.md";
+    for (const auto& [name, count] : absorbed) {
+        std::printf("  absorbed by vkrc: %s x%d\n", name.c_str(), count);
+        if (name != "-") {
+            EXPECT_TRUE(documented.contains(name))
+                << what << ": vkrc absorbed a failure of " << name
+                << ", which docs/reliability.md does not list under \"Failures vkrc absorbs by design\"";
+        }
+    }
+    for (const auto& name : reference_calls) {
+        EXPECT_TRUE(failed.contains(name)) << what << ": " << name << " was called but no failure injected into it";
+    }
     EXPECT_GT(thrown, runs / 2);
 }
 
 TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
     inject_into_every_call(
         "teapot scene", [](const vkrc::InstanceCreateInfo& info) { return vkrc_test::run_teapot_scenario(info); },
-        frame_is_the_scene, 50);
+        frame_is_the_scene, 50, true);
 }
 
 // Descriptor references and the bindless table (issue 30): a table made,
@@ -183,7 +271,66 @@ std::size_t run_descriptor_scenario(const vkrc::InstanceCreateInfo& info) {
 
 TEST(FaultInjection, EveryFailableCallOfDescriptorReferencesAndTheBindlessTableFailsCleanly) {
     inject_into_every_call(
-        "descriptors and bindless table", run_descriptor_scenario, [](std::size_t live) { return live > 0; }, 10);
+        "descriptors and bindless table", run_descriptor_scenario, [](std::size_t live) { return live > 0; }, 10, true);
+}
+
+struct NamedScenario {
+    const char* name;
+    std::function<void(const vkrc::InstanceCreateInfo&)> run;
+};
+
+// Every scenario the tests above inject failures into.
+std::vector<NamedScenario> every_scenario() {
+    return {{"teapot scene", [](const auto& info) { vkrc_test::run_teapot_scenario(info); }},
+            {"descriptors and bindless table", run_descriptor_scenario}};
+}
+
+// The table's functions that return VkResult and that vkrc's sources call,
+// but that no scenario above calls (so no failure is ever injected into
+// them), with the reason each is acceptable. Any other fails the test below.
+const std::map<std::string, std::string>& never_injected_allowed() {
+    static const std::map<std::string, std::string> allowed = {};
+    return allowed;
+}
+
+// The report: every failable function vkrc calls is called by some scenario
+// (and so, by the tests above, has a failure injected into it), or is on the
+// short list above.
+TEST(FaultInjection, EveryFailableFunctionVkrcCallsIsInjected) {
+    auto log = std::make_shared<vkrc_test::ValidationLog>();
+    const auto info = injected_instance_info(log);
+    // What each scenario's test injects failures into: its calls after its
+    // setup when it marks one, else all its calls.
+    std::set<std::string> called;
+    for (const auto& scenario : every_scenario()) {
+        faults::arm(0, VK_SUCCESS);
+        faults::forget_called();
+        scenario.run(info);
+        for (auto& name : faults::called_functions(faults::setup_calls() != 0)) called.insert(std::move(name));
+    }
+    vkrc_test::expect_no_validation_messages(*log);
+
+    const auto vkrc_calls = functions_vkrc_calls();
+    std::size_t failable_called = 0;
+    std::vector<std::string> never;
+    for (const auto& name : faults::failable_functions()) {
+        if (!vkrc_calls.contains(name)) continue;
+        ++failable_called;
+        if (!called.contains(name)) never.push_back(name);
+    }
+    EXPECT_GT(failable_called, 50u) << "the scan of src/ and include/vkrc/ found too few calls";
+    std::printf("fault injection: %zu failable functions vkrc calls, %zu reached by the scenarios, %zu never:\n",
+                failable_called, failable_called - never.size(), never.size());
+    const auto& allowed = never_injected_allowed();
+    for (const auto& name : never) {
+        const auto reason = allowed.find(name);
+        std::printf("  %s: %s\n", name.c_str(), reason == allowed.end() ? "NOT ALLOWED" : reason->second.c_str());
+        EXPECT_TRUE(reason != allowed.end()) << name << " is called by vkrc but no scenario calls it";
+    }
+    for (const auto& [name, reason] : allowed) {
+        EXPECT_TRUE(std::ranges::find(never, name) != never.end())
+            << name << " is on the allow-list but a scenario now reaches it (or vkrc no longer calls it)";
+    }
 }
 
 // A user allocator that fails its k-th allocation in one of three ways.

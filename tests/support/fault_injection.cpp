@@ -23,6 +23,10 @@ std::atomic<std::uint64_t> calls{0};
 std::atomic<std::uint64_t> armed_call{0};
 std::atomic<VkResult> armed_error{VK_SUCCESS};
 std::atomic<const char*> fired_name{nullptr};
+// Which failable functions were called since forget_called().
+std::atomic<bool> called[int(Fn::count)];
+std::atomic<bool> called_after_setup[int(Fn::count)];
+std::atomic<std::uint64_t> setup_end{0};
 // The device of the scenario, for simulating loss (one device at a time).
 std::atomic<VkDevice> current_device{VK_NULL_HANDLE};
 const char* names[int(Fn::count)] = {
@@ -68,6 +72,8 @@ VkResult next_call(Fn id) {
         fired_name.store(names[int(id)]);
         return VK_ERROR_DEVICE_LOST;
     }
+    called[int(id)].store(true);
+    if (setup_end.load() != 0) called_after_setup[int(id)].store(true);
     std::uint64_t n = calls.fetch_add(1) + 1;
     if (n == armed_call.load()) {
         fired_name.store(names[int(id)]);
@@ -107,6 +113,20 @@ const Entry entries[] = {
 #include <vkrc/detail/function_list.inl>
 };
 
+// Whether each entry returns VkResult.
+template <class Pfn>
+struct ReturnsResult;
+template <class R, class... Args>
+struct ReturnsResult<R(VKAPI_PTR*)(Args...)> : std::is_same<R, VkResult> {};
+#define VKRC_FAILABLE(name) ReturnsResult<PFN_##name>::value,
+const bool failable[] = {
+#define VKRC_GLOBAL_FUNCTION(name) VKRC_FAILABLE(name)
+#define VKRC_INSTANCE_FUNCTION(name) VKRC_FAILABLE(name)
+#define VKRC_DEVICE_FUNCTION(name) VKRC_FAILABLE(name)
+#include <vkrc/detail/function_list.inl>
+};
+#undef VKRC_FAILABLE
+
 PFN_vkVoidFunction intercept(const char* name, PFN_vkVoidFunction found) {
     if (!found) return nullptr;
     for (int i = 0; i < int(Fn::count); ++i) {
@@ -138,6 +158,7 @@ PFN_vkGetInstanceProcAddr get_instance_proc_addr() { return &wrapped_get_instanc
 
 void arm(std::uint64_t call, VkResult error) {
     lost.store(false);
+    setup_end.store(0);
     armed_error.store(error);
     armed_call.store(call);
     calls.store(0);
@@ -150,6 +171,27 @@ void lose_device() {
     lost.store(true);
 }
 bool fired() { return fired_name.load() != nullptr; }
+
+std::vector<std::string> failable_functions() {
+    std::vector<std::string> out;
+    for (int i = 0; i < int(Fn::count); ++i)
+        if (failable[i]) out.emplace_back(names[i]);
+    return out;
+}
+std::vector<std::string> called_functions(bool after_setup) {
+    std::vector<std::string> out;
+    for (int i = 0; i < int(Fn::count); ++i)
+        if ((after_setup ? called_after_setup : called)[i].load()) out.emplace_back(names[i]);
+    return out;
+}
+void forget_called() {
+    for (auto& c : called) c.store(false);
+    for (auto& c : called_after_setup) c.store(false);
+}
+void end_of_setup() {
+    if (setup_end.load() == 0) setup_end.store(calls.load());
+}
+std::uint64_t setup_calls() { return setup_end.load(); }
 const char* fired_in() { return fired_name.load(); }
 
 }  // namespace vkrc_test::faults

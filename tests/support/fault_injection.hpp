@@ -7,6 +7,8 @@
 #include <vulkan/vulkan_core.h>
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace vkrc_test::faults {
 
@@ -28,5 +30,21 @@ std::uint64_t failable_calls();
 // Whether the armed failure has been returned, and by which function.
 bool fired();
 const char* fired_in();
+
+// The wrapped functions that return VkResult (the ones a failure can be
+// injected into), by name.
+std::vector<std::string> failable_functions();
+// The failable functions called since the last forget_called(), by name
+// (after_setup: only those called after end_of_setup()): a scenario's
+// reference run names what its injection runs will fail.
+std::vector<std::string> called_functions(bool after_setup = false);
+void forget_called();
+
+// Marks the end of a scenario's setup (instance, device): the calls before
+// it are those of every scenario, injected already by the teapot scene's
+// test, so the other scenarios' tests start injecting after it.
+void end_of_setup();
+// The failable calls made before end_of_setup() since the last arm() (0: not marked).
+std::uint64_t setup_calls();
 
 }  // namespace vkrc_test::faults
