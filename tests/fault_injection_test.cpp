@@ -1,15 +1,21 @@
-// For every failable Vulkan call the teapot scenario makes (setup plus three
-// frames, tests/support/teapot_scenario.cpp), run it again with that call
-// failing: it must end in vkrc::Error carrying the injected result
+// For every failable Vulkan call a scenario makes, run it again with that
+// call failing: it must end in vkrc::Error carrying the injected result
 // (DeviceLostError for VK_ERROR_DEVICE_LOST), or carry on where vkrc absorbs
-// the failure by design (listed in docs/reliability.md), never crash or hang,
-// and leave nothing behind: the validation layer's object tracker reports
-// leaked Vulkan objects at vkDestroyInstance, LeakSanitizer reports host
-// memory in the ASan build. The same over a user allocator that fails at
-// each of its allocations.
+// the failure by design (only as docs/reliability.md lists, and with the
+// reference result), never crash or hang, and leave nothing behind: the
+// validation layer's object tracker reports leaked Vulkan objects at
+// vkDestroyInstance, LeakSanitizer reports host memory in the ASan build.
+// The scenarios: the teapot scene (tests/support/teapot_scenario.cpp), the
+// descriptor references and bindless table below, and compute, render pass,
+// streaming, non-coherent memory and presentation (under a private Xvfb;
+// tests/support/fault_scenarios.cpp). A report checks that together they
+// reach every failable function vkrc calls. The same over a user allocator
+// that fails at each of its allocations.
 #include "support/fault_injection.hpp"
+#include "support/fault_scenarios.hpp"
 #include "support/teapot_scenario.hpp"
 #include "support/vk_test.hpp"
+#include "support/xvfb.hpp"
 
 #include <algorithm>
 #include <array>
@@ -24,6 +30,7 @@
 #include <map>
 #include <memory>
 #include <new>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -119,14 +126,14 @@ bool all_errors() {
 #endif
 }
 
-// The errors injected into call k. The teapot and descriptor scenarios
-// (every_error) get all four; the others, which run fewer calls' worth of
-// setup again and again, get device loss (vkrc's other way out) and one of
-// the other three in turn. Under ThreadSanitizer (all_errors() false) each
-// call gets one, in turn.
-std::vector<VkResult> errors_at(std::uint64_t k, bool every_error) {
-    if (!all_errors()) return {injected_errors[k % injected_errors.size()]};
-    if (every_error) return {injected_errors.begin(), injected_errors.end()};
+// The errors injected into call k: all four (per_call 4: the teapot and
+// descriptor scenarios); device loss (vkrc's other way out) and one of the
+// other three in turn (2: the scenarios that repeat the setup, injected after
+// it); or one of the four in turn (1: presentation, whose frames repeat the
+// same calls). Under ThreadSanitizer (all_errors() false) always one.
+std::vector<VkResult> errors_at(std::uint64_t k, int per_call) {
+    if (!all_errors() || per_call == 1) return {injected_errors[k % injected_errors.size()]};
+    if (per_call == 4) return {injected_errors.begin(), injected_errors.end()};
     return {injected_errors[k % 3], VK_ERROR_DEVICE_LOST};
 }
 
@@ -136,7 +143,7 @@ std::vector<VkResult> errors_at(std::uint64_t k, bool every_error) {
 // absorbed must give the reference result again.
 template <class Scenario, class Plausible>
 void inject_into_every_call(const char* what, const Scenario& scenario, const Plausible& plausible,
-                            std::uint64_t min_points, bool every_error = false) {
+                            std::uint64_t min_points, int errors_per_call = 2) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     const auto info = injected_instance_info(log);
     faults::arm(0, VK_SUCCESS);
@@ -157,43 +164,49 @@ void inject_into_every_call(const char* what, const Scenario& scenario, const Pl
     std::map<std::string, int> absorbed;  // calls whose failure vkrc handled without throwing
     // VKRC_FAULT_FIRST=k starts at call k and prints each run (to find a hang).
     const char* first = std::getenv("VKRC_FAULT_FIRST");
-    for (std::uint64_t k = first ? std::strtoull(first, nullptr, 10) : setup + 1; k <= points; ++k) {
-        for (const VkResult error : errors_at(k, every_error)) {
-            ++runs;
-            if (first)
-                std::fprintf(stderr, "call %llu: %s\n", static_cast<unsigned long long>(k), vkrc::to_string(error));
-            faults::arm(k, error);
-            // The name is read after the run: fired_in() is reset by the next arm().
-            struct NoteFired {
-                std::set<std::string>& failed;
-                ~NoteFired() {
-                    if (faults::fired()) failed.insert(faults::fired_in());
-                }
-            } note{failed};
-            try {
-                const auto frame = scenario(info);
-                absorbed[faults::fired_in() ? faults::fired_in() : "-"]++;
-                EXPECT_TRUE(frame == reference) << "injecting " << vkrc::to_string(error) << " into call " << k << " ("
-                                                << faults::fired_in() << ") was absorbed, but the frame differs";
-            } catch (const vkrc::Error& ex) {
-                ++thrown;
-                EXPECT_EQ(ex.result(), error) << "call " << k << " (" << faults::fired_in() << "): " << ex.what();
-                if (error == VK_ERROR_DEVICE_LOST) {
-                    EXPECT_NE(dynamic_cast<const vkrc::DeviceLostError*>(&ex), nullptr) << ex.what();
-                }
-            } catch (const std::exception& ex) {
-                ADD_FAILURE() << "call " << k << " (" << faults::fired_in() << "): unexpected exception " << ex.what();
+    // One run with the failure armed by arm(), described by where.
+    auto run_once = [&](const std::string& where, VkResult error, const std::function<void()>& arm) {
+        ++runs;
+        if (first) std::fprintf(stderr, "%s: %s\n", where.c_str(), vkrc::to_string(error));
+        arm();
+        try {
+            const auto frame = scenario(info);
+            absorbed[faults::fired_in() ? faults::fired_in() : "-"]++;
+            EXPECT_TRUE(frame == reference) << "injecting " << vkrc::to_string(error) << " into " << where << " ("
+                                            << faults::fired_in() << ") was absorbed, but the frame differs";
+        } catch (const vkrc::Error& ex) {
+            ++thrown;
+            EXPECT_EQ(ex.result(), error) << where << " (" << faults::fired_in() << "): " << ex.what();
+            if (error == VK_ERROR_DEVICE_LOST) {
+                EXPECT_NE(dynamic_cast<const vkrc::DeviceLostError*>(&ex), nullptr) << ex.what();
             }
+        } catch (const std::exception& ex) {
+            ADD_FAILURE() << where << " (" << faults::fired_in() << "): unexpected exception " << ex.what();
+        }
+        if (faults::fired()) failed.insert(faults::fired_in());
+        auto messages = log->take();
+        EXPECT_TRUE(messages.empty()) << "injecting " << vkrc::to_string(error) << " into " << where << " ("
+                                      << faults::fired_in() << "): " << messages.size()
+                                      << " validation message(s), first: " << messages.front();
+    };
+    for (std::uint64_t k = first ? std::strtoull(first, nullptr, 10) : setup + 1; k <= points; ++k) {
+        for (const VkResult error : errors_at(k, errors_per_call)) {
+            run_once("call " + std::to_string(k), error, [&] { faults::arm(k, error); });
             // How often vkrc polls its queue timelines (vkGetSemaphoreCounterValue)
             // depends on how far the GPU got, so a run may make fewer calls.
             if (!faults::fired()) {
                 ++not_reached;
                 EXPECT_LT(faults::failable_calls(), k) << "call " << k << " was made but the failure not returned";
             }
-            auto messages = log->take();
-            EXPECT_TRUE(messages.empty())
-                << "injecting " << vkrc::to_string(error) << " into call " << k << " (" << faults::fired_in()
-                << "): " << messages.size() << " validation message(s), first: " << messages.front();
+        }
+    }
+    // Fewer polls move the calls after them forward: a function whose calls
+    // all came late (the teardown's vkDeviceWaitIdle) may have been passed
+    // over. Its first call (after the setup) fails now.
+    for (const auto& name : reference_calls) {
+        if (failed.contains(name)) continue;
+        for (const VkResult error : errors_at(0, errors_per_call)) {
+            run_once("the first " + name, error, [&] { faults::arm_function(name.c_str(), error, setup != 0); });
         }
     }
     faults::arm(0, VK_SUCCESS);
@@ -223,7 +236,7 @@ void inject_into_every_call(const char* what, const Scenario& scenario, const Pl
 TEST(FaultInjection, EveryFailableCallOfTheTeapotSceneFailsCleanly) {
     inject_into_every_call(
         "teapot scene", [](const vkrc::InstanceCreateInfo& info) { return vkrc_test::run_teapot_scenario(info); },
-        frame_is_the_scene, 50, true);
+        frame_is_the_scene, 50, 4);
 }
 
 // Descriptor references and the bindless table (issue 30): a table made,
@@ -271,7 +284,23 @@ std::size_t run_descriptor_scenario(const vkrc::InstanceCreateInfo& info) {
 
 TEST(FaultInjection, EveryFailableCallOfDescriptorReferencesAndTheBindlessTableFailsCleanly) {
     inject_into_every_call(
-        "descriptors and bindless table", run_descriptor_scenario, [](std::size_t live) { return live > 0; }, 10, true);
+        "descriptors and bindless table", run_descriptor_scenario, [](std::size_t live) { return live > 0; }, 10, 4);
+}
+
+// A private display and a window for the presentation scenario.
+struct Display {
+    vkrc_test::Xvfb xvfb;
+    std::optional<vkrc::glfw::Window> window;
+    Display() {
+        if (xvfb.running()) window = vkrc::glfw::Window::create({.width = 64, .height = 64, .title = "vkrc faults"});
+    }
+};
+
+vkrc_test::ScenarioResult run_presentation(const vkrc::InstanceCreateInfo& info, const vkrc::glfw::Window& window) {
+    auto with_glfw = info;
+    for (const char* name : vkrc::glfw::required_instance_extensions())
+        with_glfw.enabled_extension_names.push_back(name);
+    return vkrc_test::run_presentation_scenario(with_glfw, window);
 }
 
 struct NamedScenario {
@@ -279,10 +308,68 @@ struct NamedScenario {
     std::function<void(const vkrc::InstanceCreateInfo&)> run;
 };
 
-// Every scenario the tests above inject failures into.
-std::vector<NamedScenario> every_scenario() {
+// Every scenario the tests below inject failures into.
+std::vector<NamedScenario> every_scenario(const vkrc::glfw::Window& window) {
     return {{"teapot scene", [](const auto& info) { vkrc_test::run_teapot_scenario(info); }},
-            {"descriptors and bindless table", run_descriptor_scenario}};
+            {"descriptors and bindless table", run_descriptor_scenario},
+            {"compute", vkrc_test::run_compute_scenario},
+            {"render pass", vkrc_test::run_render_pass_scenario},
+            {"streaming", vkrc_test::run_streaming_scenario},
+            {"non-coherent memory", vkrc_test::run_non_coherent_scenario},
+            {"presentation", [&window](const auto& info) { run_presentation(info, window); }}};
+}
+
+// Samplers, buffer views, Y'CbCr, compute pipelines, pipeline caches, update
+// templates, queries, events, private data, timeline semaphores.
+TEST(FaultInjection, EveryFailableCallOfTheComputeScenarioFailsCleanly) {
+    inject_into_every_call(
+        "compute", vkrc_test::run_compute_scenario,
+        [](const vkrc_test::ScenarioResult& r) {
+            return r.size() == 73 && r[0] == 1 && r[2] == 1 && r[3] == 2 && r[4] == 0x5eed && r[68] == 1 &&
+                   r[69] == 1 && r[70] == 1 && r[71] == 42 && r[72] == 43;
+        },
+        20);
+}
+
+TEST(FaultInjection, EveryFailableCallOfARenderPassAndFramebufferFailsCleanly) {
+    inject_into_every_call(
+        "render pass", vkrc_test::run_render_pass_scenario,
+        [](const vkrc_test::ScenarioResult& r) {
+            return r.size() == 16 && r[0] != 0 && std::ranges::count(r, r[0]) == 16;
+        },
+        10);
+}
+
+TEST(FaultInjection, EveryFailableCallOfTheUploaderAndFrameRingFailsCleanly) {
+    inject_into_every_call(
+        "streaming", vkrc_test::run_streaming_scenario,
+        [](const vkrc_test::ScenarioResult& r) {
+            const vkrc_test::ScenarioResult frames{1, 2, 3, 4, 2, 3, 4, 5, 3, 4, 5, 6};
+            return r.size() == 44 && r[0] == 0x1000 && r[15] == 0x100f && r[16] == 0x1000 && r[31] == 0x100f &&
+                   std::equal(frames.begin(), frames.end(), r.begin() + 32);
+        },
+        10);
+}
+
+TEST(FaultInjection, EveryFailableCallOnNonCoherentMemoryFailsCleanly) {
+    inject_into_every_call(
+        "non-coherent memory", vkrc_test::run_non_coherent_scenario,
+        [](const vkrc_test::ScenarioResult& r) {
+            return r == vkrc_test::ScenarioResult{0, 7, 11, 13, 17};
+        },
+        10);
+}
+
+TEST(FaultInjection, EveryFailableCallOfPresentationFailsCleanly) {
+    Display display;
+    ASSERT_TRUE(display.window) << display.xvfb.error();
+    inject_into_every_call(
+        "presentation", [&](const auto& info) { return run_presentation(info, *display.window); },
+        [](const vkrc_test::ScenarioResult& r) {
+            // acquire and present of three frames, recreate, one more frame: all success.
+            return r.size() == 11 && std::count(r.begin(), r.begin() + 9, 0u) == 9 && r[9] == 64 && r[10] == 64;
+        },
+        20, 1);
 }
 
 // The table's functions that return VkResult and that vkrc's sources call,
@@ -297,12 +384,14 @@ const std::map<std::string, std::string>& never_injected_allowed() {
 // (and so, by the tests above, has a failure injected into it), or is on the
 // short list above.
 TEST(FaultInjection, EveryFailableFunctionVkrcCallsIsInjected) {
+    Display display;
+    ASSERT_TRUE(display.window) << display.xvfb.error();
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     const auto info = injected_instance_info(log);
     // What each scenario's test injects failures into: its calls after its
     // setup when it marks one, else all its calls.
     std::set<std::string> called;
-    for (const auto& scenario : every_scenario()) {
+    for (const auto& scenario : every_scenario(*display.window)) {
         faults::arm(0, VK_SUCCESS);
         faults::forget_called();
         scenario.run(info);

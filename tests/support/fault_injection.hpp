@@ -21,6 +21,9 @@ PFN_vkGetInstanceProcAddr get_instance_proc_addr();
 // wrapper waits for the device to finish its work (a lost device runs
 // nothing), so destroying what was in use is then valid.
 void arm(std::uint64_t call, VkResult error);
+// The same for the first call of the function named name (after
+// end_of_setup() when after_setup).
+void arm_function(const char* name, VkResult error, bool after_setup);
 // The device is lost from now on (until the next arm()): its work so far is
 // finished, and every call that reports loss (submits, waits, status
 // queries, present, acquire) returns VK_ERROR_DEVICE_LOST; other calls work.
@@ -46,5 +49,10 @@ void forget_called();
 void end_of_setup();
 // The failable calls made before end_of_setup() since the last arm() (0: not marked).
 std::uint64_t setup_calls();
+
+// While on, vkGetPhysicalDeviceMemoryProperties(2) report every host-visible
+// memory type without HOST_COHERENT, so that vkrc flushes and invalidates
+// (lavapipe has coherent memory only; flushing it is valid all the same).
+void hide_host_coherence(bool on);
 
 }  // namespace vkrc_test::faults
