@@ -32,6 +32,7 @@
 #include <new>
 #include <optional>
 #include <set>
+#include <span>
 #include <sstream>
 #include <string>
 
@@ -420,6 +421,127 @@ TEST(FaultInjection, EveryFailableFunctionVkrcCallsIsInjected) {
         EXPECT_TRUE(std::ranges::find(never, name) != never.end())
             << name << " is on the allow-list but a scenario now reaches it (or vkrc no longer calls it)";
     }
+}
+
+// Frames on one device: an image cleared to a colour by dynamic rendering and
+// copied to a readback buffer, all made once.
+class ClearedFrames {
+public:
+    static constexpr std::uint32_t side = 16;
+
+    explicit ClearedFrames(const vkrc::Queue& queue)
+        : queue_(queue),
+          image_(vkrc::Image::create(queue.device(),
+                                     {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                      .extent = {side, side, 1},
+                                      .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT})),
+          view_(vkrc::ImageView::create(image_)),
+          readback_(vkrc::Buffer::create(queue.device(), {.size = side * side * 4,
+                                                          .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                          .memory = {.usage = vkrc::MemoryUsage::readback}})),
+          pool_(vkrc::CommandPool::create(queue.device(), {.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+                                                           .queue_family_index = queue.family_index()})),
+          cmd_(pool_.allocate()),
+          fence_(vkrc::Fence::create(queue.device())) {}
+
+    // Renders a frame cleared to rgba; whether every pixel read back is it.
+    ::testing::AssertionResult render(std::array<std::uint8_t, 4> rgba) const {
+        cmd_.reset_commands();
+        cmd_.begin();
+        const auto to_attachment =
+            vkrc::image_barrier(image_.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+        cmd_.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
+        vkrc::RenderingAttachment target{.image_view = view_.vk()};
+        for (int c = 0; c < 4; ++c) target.clear_value.color.float32[c] = float(rgba[c]) / 255.0f;
+        cmd_.begin_rendering({.render_area = {{0, 0}, {side, side}}, .color_attachments = std::span(&target, 1)});
+        cmd_.end_rendering();
+        const auto to_copy = vkrc::image_barrier(
+            image_.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+        cmd_.pipeline_barrier({}, {}, std::span(&to_copy, 1));
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {side, side, 1};
+        cmd_.copy_image_to_buffer(image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_, std::span(&region, 1));
+        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        cmd_.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        cmd_.end();
+        fence_.unsignal();
+        vkrc::submit(queue_, {.command_buffers = std::span(&cmd_, 1)}, fence_);
+        if (fence_.wait() != VK_SUCCESS) return ::testing::AssertionFailure() << "the fence wait failed";
+        std::vector<vkrc_test::Rgba> pixels(side * side);
+        readback_.allocation().read(0, std::span(pixels));
+        for (std::size_t i = 0; i < pixels.size(); ++i) {
+            if (!vkrc_test::within_one(pixels[i], rgba)) return ::testing::AssertionFailure() << "pixel " << i;
+        }
+        return ::testing::AssertionSuccess();
+    }
+
+private:
+    vkrc::Queue queue_;
+    vkrc::Image image_;
+    vkrc::ImageView view_;
+    vkrc::Buffer readback_;
+    vkrc::CommandPool pool_;
+    vkrc::CommandBuffer cmd_;
+    vkrc::Fence fence_;
+};
+
+// Out of device memory, caught, is not the end: while no memory can be
+// allocated (every vkAllocateMemory fails, the PoolAllocator's smaller retry
+// too), creating a 64 MiB image or buffer throws vkrc::Error naming the
+// call, the device is not lost and renders correct frames with what it has;
+// once memory is back, it allocates and renders again.
+TEST(FaultInjection, RenderingGoesOnAfterACaughtOutOfDeviceMemory) {
+    auto log = std::make_shared<vkrc_test::ValidationLog>();
+    faults::arm(0, VK_SUCCESS);
+    {
+        auto instance = vkrc::Instance::create(injected_instance_info(log));
+        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
+        auto device = vkrc::Device::create(physical);
+        ClearedFrames frames(device.default_queue());
+        EXPECT_TRUE(frames.render({255, 0, 0, 255}));
+
+        faults::fail_every("vkAllocateMemory", VK_ERROR_OUT_OF_DEVICE_MEMORY);
+        auto expect_out_of_memory = [](const std::function<void()>& allocate, const char* what) {
+            try {
+                allocate();
+                ADD_FAILURE() << what << ": no error while out of device memory";
+            } catch (const vkrc::Error& e) {
+                EXPECT_EQ(e.result(), VK_ERROR_OUT_OF_DEVICE_MEMORY) << what << ": " << e.what();
+                EXPECT_NE(std::string(e.what()).find("vkAllocateMemory"), std::string::npos) << e.what();
+            }
+        };
+        constexpr std::uint32_t big = 4096;  // 64 MiB of RGBA8: more than any block made so far
+        expect_out_of_memory(
+            [&] {
+                vkrc::Image::create(
+                    device,
+                    {.format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {big, big, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+            },
+            "image");
+        expect_out_of_memory(
+            [&] {
+                vkrc::Buffer::create(device, {.size = big * big * 4,
+                                              .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                              .memory = {.usage = vkrc::MemoryUsage::upload}});
+            },
+            "buffer");
+        EXPECT_TRUE(faults::fired()) << "vkAllocateMemory was not called";
+        EXPECT_FALSE(device.lost());
+        EXPECT_TRUE(frames.render({0, 255, 0, 255})) << "while out of memory";
+        EXPECT_TRUE(frames.render({0, 0, 255, 255})) << "while out of memory";
+
+        faults::arm(0, VK_SUCCESS);  // memory is back
+        auto later = vkrc::Buffer::create(device, {.size = big * big * 4, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+        EXPECT_TRUE(frames.render({255, 255, 255, 255})) << "after memory came back";
+        EXPECT_TRUE(ClearedFrames(device.default_queue()).render({64, 128, 192, 255})) << "on new objects";
+    }
+    vkrc_test::expect_no_validation_messages(*log);
 }
 
 // A user allocator that fails its k-th allocation in one of three ways.

@@ -30,6 +30,7 @@ std::atomic<std::uint64_t> setup_end{0};
 // arm_function's target (-1: none) and whether it waits for end_of_setup().
 std::atomic<int> armed_function{-1};
 std::atomic<bool> armed_after_setup{false};
+std::atomic<bool> armed_every{false};  // fail_every()
 std::atomic<bool> hide_coherence{false};
 // The device of the scenario, for simulating loss (one device at a time).
 std::atomic<VkDevice> current_device{VK_NULL_HANDLE};
@@ -87,7 +88,8 @@ VkResult next_call(Fn id) {
     called[int(id)].store(true);
     if (setup_end.load() != 0) called_after_setup[int(id)].store(true);
     std::uint64_t n = calls.fetch_add(1) + 1;
-    const bool function_armed = armed_function.load() == int(id) && fired_name.load() == nullptr &&
+    const bool function_armed = armed_function.load() == int(id) &&
+                                (armed_every.load() || fired_name.load() == nullptr) &&
                                 (!armed_after_setup.load() || setup_end.load() != 0);
     if (n == armed_call.load() || function_armed) {
         fired_name.store(names[int(id)]);
@@ -179,6 +181,7 @@ void arm(std::uint64_t call, VkResult error) {
     lost.store(false);
     setup_end.store(0);
     armed_function.store(-1);
+    armed_every.store(false);
     armed_error.store(error);
     armed_call.store(call);
     calls.store(0);
@@ -189,6 +192,10 @@ void arm_function(const char* name, VkResult error, bool after_setup) {
     armed_after_setup.store(after_setup);
     for (int i = 0; i < int(Fn::count); ++i)
         if (std::strcmp(names[i], name) == 0) armed_function.store(i);
+}
+void fail_every(const char* name, VkResult error) {
+    arm_function(name, error, false);
+    armed_every.store(true);
 }
 std::uint64_t failable_calls() { return calls.load(); }
 void lose_device() {

@@ -24,6 +24,9 @@ void arm(std::uint64_t call, VkResult error);
 // The same for the first call of the function named name (after
 // end_of_setup() when after_setup).
 void arm_function(const char* name, VkResult error, bool after_setup);
+// Every call of the function named name fails with error, until the next
+// arm() (e.g. vkAllocateMemory while the device is out of memory).
+void fail_every(const char* name, VkResult error);
 // The device is lost from now on (until the next arm()): its work so far is
 // finished, and every call that reports loss (submits, waits, status
 // queries, present, acquire) returns VK_ERROR_DEVICE_LOST; other calls work.
