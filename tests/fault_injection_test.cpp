@@ -15,6 +15,7 @@
 #include "support/fault_scenarios.hpp"
 #include "support/teapot_scenario.hpp"
 #include "support/vk_test.hpp"
+#include "support/watchdog.hpp"
 #include "support/xvfb.hpp"
 
 #include <algorithm>
@@ -541,6 +542,64 @@ TEST(FaultInjection, RenderingGoesOnAfterACaughtOutOfDeviceMemory) {
         EXPECT_TRUE(frames.render({255, 255, 255, 255})) << "after memory came back";
         EXPECT_TRUE(ClearedFrames(device.default_queue()).render({64, 128, 192, 255})) << "on new objects";
     }
+    vkrc_test::expect_no_validation_messages(*log);
+}
+
+// Device loss reported while the GPU is held busy: a copy waits behind a
+// gate only the host opens when the device is lost (without the injector
+// letting the work finish first). The fence wait, the queue and device
+// waits raise DeviceLostError at once (none waits for the held work), and
+// the device reads lost; then the gate opens, the copy really runs (lavapipe
+// is not lost) and its result is read back; every handle then drops without
+// a validation message.
+TEST(FaultInjection, LossIsReportedWhileTheGpuIsHeldBusy) {
+    vkrc_test::Watchdog watchdog("device loss while the GPU is held busy");
+    auto log = std::make_shared<vkrc_test::ValidationLog>();
+    faults::arm(0, VK_SUCCESS);
+    {
+        auto instance = vkrc::Instance::create(injected_instance_info(log));
+        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
+        auto device = vkrc::Device::create(physical);
+        auto queue = device.default_queue();
+        const std::array<std::uint32_t, 4> values{3, 5, 7, 9};
+        auto src = vkrc::Buffer::create(device, {.size = sizeof values,
+                                                 .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                                 .memory = {.usage = vkrc::MemoryUsage::upload}});
+        src.allocation().write(0, values.data(), values.size());
+        auto dst = vkrc::Buffer::create(device, {.size = sizeof values,
+                                                 .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                 .memory = {.usage = vkrc::MemoryUsage::readback}});
+        dst.allocation().write(0, std::array<std::uint32_t, 4>{}.data(), values.size());
+        auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+        auto cmd = pool.allocate();
+        cmd.begin();
+        const VkBufferCopy region{0, 0, sizeof values};
+        cmd.copy_buffer(src, dst, {&region, 1});
+        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        cmd.end();
+        auto gate = vkrc::Semaphore::create_timeline(device);
+        auto fence = vkrc::Fence::create(device);
+        const vkrc::SemaphoreSubmit wait{gate, 1};
+        vkrc::submit(queue, {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1)}, fence);
+
+        faults::lose_device_in_flight();
+        EXPECT_THROW(fence.wait(), vkrc::DeviceLostError);
+        EXPECT_TRUE(device.lost());
+        EXPECT_THROW(queue.wait_idle(), vkrc::DeviceLostError);
+        EXPECT_THROW(device.wait_idle(), vkrc::DeviceLostError);
+        EXPECT_EQ(device.deferred_count(), 0u);
+        std::array<std::uint32_t, 4> copied{};
+        dst.allocation().read(0, copied.data(), copied.size());
+        EXPECT_EQ(copied, (std::array<std::uint32_t, 4>{})) << "the held copy ran before the gate opened";
+
+        gate.signal(1);  // vkSignalSemaphore does not report loss
+        faults::finish_real_work();
+        dst.allocation().read(0, copied.data(), copied.size());
+        EXPECT_EQ(copied, values) << "the held copy did not run once the gate opened";
+    }
+    faults::arm(0, VK_SUCCESS);
     vkrc_test::expect_no_validation_messages(*log);
 }
 

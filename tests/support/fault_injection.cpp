@@ -203,6 +203,11 @@ void lose_device() {
     simulate_loss();
     lost.store(true);
 }
+void lose_device_in_flight() {
+    fired_name.store(nullptr);
+    lost.store(true);
+}
+void finish_real_work() { simulate_loss(); }
 bool fired() { return fired_name.load() != nullptr; }
 
 std::vector<std::string> failable_functions() {

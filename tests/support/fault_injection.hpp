@@ -31,6 +31,11 @@ void fail_every(const char* name, VkResult error);
 // finished, and every call that reports loss (submits, waits, status
 // queries, present, acquire) returns VK_ERROR_DEVICE_LOST; other calls work.
 void lose_device();
+// The same without waiting for the device's work first: what was submitted
+// keeps running on lavapipe (behind a gate, it waits), while vkrc sees the
+// loss. finish_real_work() then waits for it through the real vkDeviceWaitIdle.
+void lose_device_in_flight();
+void finish_real_work();
 // Failable calls made since the last arm().
 std::uint64_t failable_calls();
 // Whether the armed failure has been returned, and by which function.
