@@ -1,0 +1,382 @@
+#include "fault_scenarios.hpp"
+
+#include "support/fault_injection.hpp"
+#include "support/features.hpp"
+#include "support/vk_test.hpp"
+
+#include "shaders/fill_pattern.comp.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <span>
+#include <stdexcept>
+
+namespace vkrc_test {
+namespace {
+
+struct Context {
+    vkrc::Instance instance;
+    vkrc::PhysicalDevice physical;
+    vkrc::Device device;
+    vkrc::Queue queue;
+};
+
+Context make_context(const vkrc::InstanceCreateInfo& info) {
+    Context c;
+    c.instance = vkrc::Instance::create(info);
+    c.physical = vkrc::PhysicalDevice::select(c.instance, test_device_requirements());
+    c.device = vkrc::Device::create(c.physical);
+    c.queue = c.device.default_queue();
+    faults::end_of_setup();
+    return c;
+}
+
+vkrc::Buffer readback_buffer(const vkrc::Device& device, VkDeviceSize size, VkBufferUsageFlags usage) {
+    return vkrc::Buffer::create(device,
+                                {.size = size, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::readback}});
+}
+
+// Submits cmd (ended) and waits for it through a fence.
+void run_and_wait(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd) {
+    auto fence = vkrc::Fence::create(queue.device());
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    fence.wait();
+    // Signalled now: the status query is one more failable call.
+    if (fence.status() != VK_SUCCESS) throw std::logic_error("the fence waited for is not signalled");
+}
+
+VkMemoryBarrier2 copy_to_host() {
+    return vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+}
+
+constexpr VkFormat nv12 = VK_FORMAT_G8_B8R8_2PLANE_420_UNORM;
+
+// A Y'CbCr conversion and the sampler and view made with it, where the
+// device samples NV12; returns whether it could.
+bool use_ycbcr(const vkrc::PhysicalDevice& physical, const vkrc::Device& device) {
+    VkFormatProperties props{};
+    physical.fn().vkGetPhysicalDeviceFormatProperties(physical.vk(), nv12, &props);
+    const VkFormatFeatureFlags f = props.optimalTilingFeatures;
+    const VkFormatFeatureFlags locations =
+        VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT | VK_FORMAT_FEATURE_COSITED_CHROMA_SAMPLES_BIT;
+    if (!(f & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT) || !(f & locations)) return false;
+    const VkChromaLocation location = (f & VK_FORMAT_FEATURE_MIDPOINT_CHROMA_SAMPLES_BIT)
+                                          ? VK_CHROMA_LOCATION_MIDPOINT
+                                          : VK_CHROMA_LOCATION_COSITED_EVEN;
+    auto conversion = vkrc::SamplerYcbcrConversion::create(
+        device, {.format = nv12, .x_chroma_offset = location, .y_chroma_offset = location});
+    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                                  .min_filter = VK_FILTER_NEAREST,
+                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                                  .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                                  .ycbcr_conversion = conversion});
+    auto image =
+        vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
+    auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
+    return true;
+}
+
+struct FillParams {
+    std::uint32_t count;
+    std::uint32_t seed;
+};
+
+}  // namespace
+
+ScenarioResult run_compute_scenario(const vkrc::InstanceCreateInfo& info) {
+    Context c;
+    c.instance = vkrc::Instance::create(info);
+    c.physical = vkrc::PhysicalDevice::select(c.instance, test_device_requirements());
+    const bool ycbcr = supported_features(c.physical).v11.samplerYcbcrConversion;
+    vkrc::DeviceCreateInfo device_info;
+    device_info.vulkan13_features.privateData = VK_TRUE;
+    device_info.vulkan11_features.samplerYcbcrConversion = ycbcr;
+    c.device = vkrc::Device::create(c.physical, device_info);
+    c.queue = c.device.default_queue();
+    faults::end_of_setup();
+    const auto& device = c.device;
+    ScenarioResult result;
+    result.push_back(!vkrc::Instance::available_layers(info.get_instance_proc_addr).empty());
+    result.push_back(ycbcr && use_ycbcr(c.physical, device));
+
+    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
+    auto texels = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT});
+    auto texel_view = vkrc::BufferView::create(texels, {.format = VK_FORMAT_R32_UINT});
+
+    // The pipeline built once to fill a cache, then again from its data.
+    auto set_layout =
+        vkrc::DescriptorSetLayout::create(device, {.bindings = {{.binding = 0,
+                                                                 .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                                 .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
+    auto layout = vkrc::PipelineLayout::create(
+        device,
+        {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(FillParams)}}});
+    auto module = vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp);
+    auto cache = vkrc::PipelineCache::create(device);
+    vkrc::ComputePipeline::create(layout, {.module = module, .cache = cache});
+    const auto blob = cache.data();
+    auto warm_cache = vkrc::PipelineCache::create(device, blob);
+    auto pipeline = vkrc::ComputePipeline::create(layout, {.module = module, .cache = warm_cache});
+
+    // The output written into the set through an update template.
+    constexpr std::uint32_t count = 64;
+    auto out = readback_buffer(device, count * sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vkrc::set_name(device, out, "compute output");
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
+    auto set = pool.allocate(set_layout);
+    pool.allocate(set_layout);  // dropped at once: freed by the next allocate
+    auto update = vkrc::DescriptorUpdateTemplate::create(
+        device, {.entries = {{0, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0, sizeof(VkDescriptorBufferInfo)}},
+                 .descriptor_set_layout = set_layout});
+    const VkDescriptorBufferInfo target{out.vk(), 0, VK_WHOLE_SIZE};
+    set.update_with_template(update, &target);
+
+    auto queries = vkrc::QueryPool::create(device, {.query_count = 2});
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = c.queue.family_index()});
+    auto cmd = commands.allocate();
+    cmd.begin();
+    cmd.reset_query_pool(queries, 0, 2);
+    cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries, 0);
+    cmd.bind_pipeline(pipeline);
+    cmd.bind_descriptor_set(pipeline, 0, set);
+    cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, FillParams{count, 0x5eed});
+    cmd.dispatch(1);
+    cmd.write_timestamp(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries, 1);
+    const auto to_host = compute_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+
+    // The submission waits for a timeline value the host signals first (a
+    // gate left closed would hold the GPU when an injected failure stops the
+    // scenario), and signals another the host waits for.
+    auto gate = vkrc::Semaphore::create_timeline(device);
+    auto done = vkrc::Semaphore::create_timeline(device);
+    gate.signal(1);
+    const vkrc::SemaphoreSubmit wait{gate, 1, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT};
+    const vkrc::SemaphoreSubmit signal{done, 2, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT};
+    vkrc::submit(
+        c.queue,
+        {.waits = std::span(&wait, 1), .command_buffers = std::span(&cmd, 1), .signals = std::span(&signal, 1)});
+    result.push_back(done.wait(2) == VK_SUCCESS);
+    result.push_back(done.value());
+    pool.allocate(set_layout);
+    commands.reset_commands();
+
+    std::array<std::uint32_t, count> values{};
+    out.allocation().read(0, std::span(values));
+    result.insert(result.end(), values.begin(), values.end());
+    std::array<std::uint64_t, 2> ticks{};
+    result.push_back(queries.results(0, std::span(ticks)) == VK_SUCCESS && ticks[1] >= ticks[0]);
+
+    auto event = vkrc::Event::create(device);
+    event.set();
+    result.push_back(event.status() == VK_EVENT_SET);
+    event.unset();
+    result.push_back(event.status() == VK_EVENT_RESET);
+
+    auto slot = vkrc::PrivateDataSlot::create(device);
+    slot.set(VK_OBJECT_TYPE_BUFFER_VIEW, texel_view.vk(), 42);
+    slot.set(VK_OBJECT_TYPE_SAMPLER, sampler.vk(), 43);
+    result.push_back(slot.get(VK_OBJECT_TYPE_BUFFER_VIEW, texel_view.vk()));
+    result.push_back(slot.get(VK_OBJECT_TYPE_SAMPLER, sampler.vk()));
+    return result;
+}
+
+ScenarioResult run_render_pass_scenario(const vkrc::InstanceCreateInfo& info) {
+    auto c = make_context(info);
+    const auto& device = c.device;
+    constexpr std::uint32_t side = 4;
+    const VkAttachmentDescription color{0,
+                                        VK_FORMAT_R8G8B8A8_UNORM,
+                                        VK_SAMPLE_COUNT_1_BIT,
+                                        VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                        VK_ATTACHMENT_STORE_OP_STORE,
+                                        VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                        VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                        VK_IMAGE_LAYOUT_UNDEFINED,
+                                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    // The copy after the pass waits for its writes and final transition.
+    const VkSubpassDependency to_copy{0,
+                                      VK_SUBPASS_EXTERNAL,
+                                      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                      VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                      VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                                      VK_ACCESS_TRANSFER_READ_BIT,
+                                      0};
+    auto render_pass = vkrc::RenderPass::create(
+        device, {.attachments = {color},
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
+                 .dependencies = {to_copy}});
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                     .extent = {side, side, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    auto framebuffer = vkrc::Framebuffer::create(
+        device,
+        {.render_pass = render_pass, .attachments = {vkrc::ImageView::create(image)}, .width = side, .height = side});
+    auto readback = readback_buffer(device, side * side * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = c.queue.family_index()});
+    auto cmd = commands.allocate();
+    cmd.begin();
+    VkClearValue clear{};
+    clear.color = {{0.25f, 0.5f, 0.75f, 1.0f}};
+    cmd.begin_render_pass(render_pass, framebuffer, {{0, 0}, {side, side}}, std::span(&clear, 1));
+    cmd.end_render_pass();
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {side, side, 1};
+    cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, std::span(&region, 1));
+    const auto to_host = copy_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    run_and_wait(c.queue, cmd);
+
+    std::array<std::uint32_t, side * side> pixels{};
+    readback.allocation().read(0, std::span(pixels));
+    return ScenarioResult(pixels.begin(), pixels.end());
+}
+
+ScenarioResult run_streaming_scenario(const vkrc::InstanceCreateInfo& info) {
+    auto c = make_context(info);
+    const auto& device = c.device;
+    ScenarioResult result;
+
+    // Two uploads in one batch, then a download of each in the next.
+    auto uploader = vkrc::Uploader::create({.queue = c.queue, .staging_size = 64 << 10});
+    std::array<std::uint32_t, 16> words{};
+    for (std::uint32_t i = 0; i < words.size(); ++i) words[i] = 0x1000 + i;
+    auto buffer = vkrc::Buffer::create(
+        device, {.size = sizeof words, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+    uploader.upload_buffer(buffer, 0, std::as_bytes(std::span(words)));
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                     .extent = {4, 4, 1},
+                                     .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    uploader.upload_image(image, std::as_bytes(std::span(words)), {.new_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
+    uploader.submit().wait_on_host();
+    auto buffer_download = uploader.download_buffer(buffer, 0, sizeof words);
+    auto image_download = uploader.download_image(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+    uploader.submit();
+    for (const auto& download : {buffer_download, image_download}) {
+        const auto bytes = download.read();
+        std::array<std::uint32_t, 16> got{};
+        std::memcpy(got.data(), bytes.data(), std::min(bytes.size(), sizeof got));
+        result.insert(result.end(), got.begin(), got.end());
+    }
+
+    // Three frames through a two-block ring, each copied out.
+    constexpr VkDeviceSize slice = 16;
+    auto ring = vkrc::FrameRing::create(
+        {.queue = c.queue, .frame_size = 256, .frames_in_flight = 2, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+    auto out = readback_buffer(device, 3 * slice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = c.queue.family_index()});
+    for (std::uint32_t frame = 0; frame < 3; ++frame) {
+        ring.begin_frame();
+        auto a = ring.allocate(slice);
+        const std::array<std::uint32_t, 4> value{frame + 1, frame + 2, frame + 3, frame + 4};
+        a.view.write(0, std::span<const std::uint32_t>(value));
+        auto cmd = commands.allocate();
+        cmd.begin();
+        const VkBufferCopy region{a.offset, frame * slice, slice};
+        cmd.copy_buffer(a.buffer, out.vk(), {&region, 1});
+        if (frame == 2) {
+            const auto to_host = copy_to_host();
+            cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        }
+        cmd.end();
+        vkrc::submit(c.queue, {.command_buffers = {&cmd, 1}});
+        ring.end_frame();
+    }
+    c.queue.wait_idle();
+    std::array<std::uint32_t, 12> copied{};
+    out.allocation().read(0, std::span(copied));
+    result.insert(result.end(), copied.begin(), copied.end());
+    return result;
+}
+
+ScenarioResult run_non_coherent_scenario(const vkrc::InstanceCreateInfo& info) {
+    struct Hidden {
+        Hidden() { faults::hide_host_coherence(true); }
+        ~Hidden() { faults::hide_host_coherence(false); }
+    } hidden;
+    auto c = make_context(info);
+    const auto& device = c.device;
+    auto upload = vkrc::Buffer::create(
+        device,
+        {.size = 64, .usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT, .memory = {.usage = vkrc::MemoryUsage::upload}});
+    const std::array<std::uint32_t, 4> value{7, 11, 13, 17};
+    upload.allocation().write(0, value.data(), value.size());  // flushes
+    auto readback = readback_buffer(device, 64, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = c.queue.family_index()});
+    auto cmd = commands.allocate();
+    cmd.begin();
+    const VkBufferCopy region{0, 16, sizeof value};
+    cmd.copy_buffer(upload, readback, {&region, 1});
+    const auto to_host = copy_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    run_and_wait(c.queue, cmd);
+    std::array<std::uint32_t, 4> got{};
+    readback.allocation().read(16, got.data(), got.size());  // invalidates
+    return {readback.allocation().host_coherent(), got[0], got[1], got[2], got[3]};
+}
+
+ScenarioResult run_presentation_scenario(const vkrc::InstanceCreateInfo& info, const vkrc::glfw::Window& window) {
+    auto instance = vkrc::Instance::create(info);
+    auto surface = vkrc::glfw::create_surface(instance, window.get());
+    faults::end_of_setup();
+    auto requirements = test_device_requirements();
+    requirements.present_surface = surface.vk();
+    requirements.required_extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    auto physical = vkrc::PhysicalDevice::select(instance, requirements);
+    auto device = vkrc::Device::create(physical, {.enabled_extension_names = {VK_KHR_SWAPCHAIN_EXTENSION_NAME}});
+    auto queue = device.default_queue();
+    auto swapchain = vkrc::Swapchain::create(
+        queue, surface, {.image_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    auto commands = vkrc::CommandPool::create(
+        device, {.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, .queue_family_index = queue.family_index()});
+    std::array<vkrc::CommandBuffer, 2> cmds{commands.allocate(), commands.allocate()};
+    std::array<vkrc::Fence, 2> fences{vkrc::Fence::create(device, true), vkrc::Fence::create(device, true)};
+
+    ScenarioResult result;
+    vkrc::Frame frame;
+    auto render = [&](int i) {
+        const auto& cmd = cmds[i % 2];
+        fences[i % 2].wait();
+        result.push_back(static_cast<std::uint64_t>(swapchain.acquire(frame)));
+        if (!frame) return;
+        fences[i % 2].unsignal();
+        cmd.reset_commands();
+        cmd.begin();
+        const auto to_clear = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_UNDEFINED,
+                                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, vkrc::Frame::acquire_stage, 0,
+                                                  VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+        cmd.pipeline_barrier({}, {}, std::span(&to_clear, 1));
+        const VkClearColorValue colour{{0.1f, 0.2f, 0.3f, 1.0f}};
+        const VkImageSubresourceRange whole{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        cmd.clear_color_image(frame.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, colour, std::span(&whole, 1));
+        const auto to_present = vkrc::image_barrier(frame.image().vk(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                                    frame.present_layout, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+                                                    VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+        cmd.pipeline_barrier({}, {}, std::span(&to_present, 1));
+        cmd.end();
+        vkrc::submit(queue, {.waits = frame.waits(), .command_buffers = std::span(&cmd, 1), .signals = frame.signals()},
+                     fences[i % 2]);
+        result.push_back(static_cast<std::uint64_t>(swapchain.present(frame)));
+    };
+    for (int i = 0; i < 3; ++i) render(i);
+    result.push_back(static_cast<std::uint64_t>(swapchain.recreate()));
+    render(3);
+    for (const auto& f : fences) f.wait();
+    result.push_back(swapchain.extent().width);
+    result.push_back(swapchain.extent().height);
+    return result;
+}
+
+}  // namespace vkrc_test

@@ -1,0 +1,41 @@
+// Scenarios for the fault-injection tests beyond the teapot scene: each makes
+// a new instance from the given info, uses one area of vkrc, drops
+// everything, and returns what it computed (the same on every run where no
+// failure is injected, so that a run whose failure vkrc absorbed can be
+// compared with the reference).
+#pragma once
+
+#include <vkrc/glfw.hpp>
+#include <vkrc/vkrc.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace vkrc_test {
+
+using ScenarioResult = std::vector<std::uint64_t>;
+
+// Samplers, buffer views, Y'CbCr conversions (where the device has them),
+// a compute pipeline built through a pipeline cache and again from the
+// cache's data, a set written through an update template, timestamp queries,
+// host events, private data and a timeline semaphore signalled and waited
+// on from the host.
+ScenarioResult run_compute_scenario(const vkrc::InstanceCreateInfo& info);
+
+// A render pass and framebuffer clearing an image, read back.
+ScenarioResult run_render_pass_scenario(const vkrc::InstanceCreateInfo& info);
+
+// The Uploader (buffer and image uploads, a download) and three frames of a
+// FrameRing copied out to a readback buffer.
+ScenarioResult run_streaming_scenario(const vkrc::InstanceCreateInfo& info);
+
+// Mapped writes and reads on memory the injector reports as not
+// host-coherent, so that vkrc flushes and invalidates.
+ScenarioResult run_non_coherent_scenario(const vkrc::InstanceCreateInfo& info);
+
+// A swapchain on window's surface: three frames acquired, cleared and
+// presented, a re-creation, one more frame. info must enable GLFW's
+// instance extensions.
+ScenarioResult run_presentation_scenario(const vkrc::InstanceCreateInfo& info, const vkrc::glfw::Window& window);
+
+}  // namespace vkrc_test
