@@ -25,6 +25,8 @@ import re
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "bench"))
+import run_summary  # noqa: E402 (bench/run_summary.py: the per-frame instruction sum)
 STAGES = ["preinit", "acquire", "uniform", "command", "submit", "present", "wait", "update", "frame"]
 
 
@@ -522,6 +524,81 @@ def readme_row():
             f"{'all images byte-identical to raw-direct' if images else 'IMAGES DIFFER'} |"]
 
 
+HEADLINE_VARIANTS = (("vkrc-st", "vkrc-st"), ("vkrc-mt", "vkrc-mt"), ("vkhpp", "vk::raii"))
+HEADLINE_TEAPOTS = "25"
+
+
+def newest_teapot_run(pattern, variant):
+    """The newest single-thread run at HEADLINE_TEAPOTS on the device that timed variant beside raw-direct;
+    '-base-' files time an older commit beside a newer one, for comparison, and are left out."""
+    found = [r for r in results(pattern) if r["rows"][0]["teapots"] == HEADLINE_TEAPOTS and "-base-" not in r["path"]
+             and {variant, "raw-direct"} <= set(variants_of(r["rows"]))]
+    return max(found, key=lambda r: (r["meta"].get("date", ""), r["path"]), default=None)
+
+
+def ns_above(r, variant, stage):
+    """'+ns [low, high]': the block-wise ratio to raw-direct and its bootstrap interval (bench/teapot's, over
+    processes and blocks) less 1, times raw-direct's median of the stage in the same run."""
+    get = {(x["variant"], x["stage"]): x for x in r["rows"] if x["teapots"] == HEADLINE_TEAPOTS}
+    x, ref = get.get((variant, stage)), get.get(("raw-direct", stage))
+    if not x or not ref:
+        return ""
+    a, low, high = ((float(x[k]) - 1) * 1000 * float(ref["median_us"]) + 0.0
+                    for k in ("ratio_to_ref", "ref_ci_low", "ref_ci_high"))
+    return f"{a:+.0f} [{low:+.0f}, {high:+.0f}]"
+
+
+def newest_instructions():
+    found = sorted(glob.glob(os.path.join(ROOT, "docs", "results", "*lavapipe-instructions.csv")))
+    return os.path.relpath(found[-1], ROOT) if found else None
+
+
+def headline_instruction_rows(path):
+    counts = run_summary.instructions_per_frame(os.path.join(ROOT, path))
+    ref, data = counts["raw-direct"][1], data_cell(load(os.path.join(ROOT, path)))
+    return [f"| lavapipe | {name} | {counts[v][1] - ref:+.0f} ({thousands(counts[v][1])} against {thousands(ref)}) "
+            f"| | | | {data} |" for v, name in HEADLINE_VARIANTS if v in counts]
+
+
+def data_cell(r):
+    return f"`{os.path.basename(r['path'])}` (git {r['meta'].get('git', '?').split()[0]})"
+
+
+def headline_time_rows(device, pattern):
+    out, used = [], []
+    for v, name in HEADLINE_VARIANTS:
+        r = newest_teapot_run(pattern, v)
+        if r:
+            used += [r] if r not in used else []
+            out.append(headline_time_row(device, name, r, v))
+    return out + [headline_time_row(device, "A/A control", r, "raw-direct-control") for r in used]
+
+
+def headline_time_row(device, name, r, variant):
+    cells = " | ".join(ns_above(r, variant, s) for s in ("command", "submit", "frame"))
+    return f"| {device} | {name} | | {cells} | {data_cell(r)} |"
+
+
+def headline():
+    """What a user pays per frame over raw-direct (issue 32 item 4): instructions on lavapipe, time on NVIDIA."""
+    path = newest_instructions()
+    rows = (headline_instruction_rows(path) if path else []) + headline_time_rows("H100", "H100") + \
+        headline_time_rows("H200", "H200")
+    return [f"What each variant costs per frame above raw-direct (raw C through `vkGetDeviceProcAddr` pointers), "
+            f"{HEADLINE_TEAPOTS} teapots; the data file of each row is in its last column "
+            "(under `docs/results/`). Instructions: callgrind's count outside the driver (`bench/instructions.sh`), "
+            f"summed over the six per-frame stages ({', '.join(run_summary.STAGES)}); deterministic, so no "
+            "interval; every stage, those too short to time included, counts in it. Time: per stage, the median "
+            "of the block-wise ratios to raw-direct and its 95 % interval (bench/teapot's bootstrap over processes "
+            "and blocks) less 1, times raw-direct's median of the stage in the same run. Command and submit are "
+            "the CPU stages above the timer floor; the frame is GPU time (it includes the wait for the GPU, which "
+            "hides CPU work), shown for what a frame takes, not as a verdict. The A/A control is raw-direct "
+            "against itself in the same run: what the timer resolves.", "",
+            "| device | variant | instructions per frame above raw-direct | command: ns above raw-direct [95 % CI] "
+            "| submit: ns [95 % CI] | frame (GPU time): ns [95 % CI] | data |",
+            "|---|---|---:|---:|---:|---:|---|"] + rows
+
+
 UPLOAD_RAW_GOAL = 0.95  # vkrc-stream vs raw-stream throughput (issue 15)
 UPLOAD_BLOCKING_GOAL = 5.0  # vkrc-stream vs vkrc-blocking throughput, 4 KiB uploads
 # raw-stream-aa (runs from 2026-11-23 r3 on) is raw-stream again: the A/A control.
@@ -845,6 +922,7 @@ BLOCKS = {
         "H200", "**Pending:** no H200 `--threads` run is committed yet (the commands are above); committed under "
         "docs/results/, it appears here."),
     "readme-teapot": readme_row,
+    "teapot-headline": headline,
     "teapot-instructions": lambda: instructions("", "No instruction counts in docs/results/ yet."),
     "alloc-lavapipe": lambda: alloc_section("llvmpipe", "No lavapipe allocation results in docs/results/ yet."),
     "alloc-h200": lambda: alloc_section(
