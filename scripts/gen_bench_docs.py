@@ -86,6 +86,24 @@ def teapot_verdict(row, control):
     return "not met" if float(row["ref_ci_low"]) > target else "not resolved"
 
 
+GPU_TIME_STAGES = ("wait", "frame")  # the CPU waiting for the GPU: time a wrapper cannot move, so no verdict
+TIMER_FLOOR_US = 1.0  # raw-direct's median of a stage below it: judged by instruction counts only, not by time
+
+
+def stage_kind(stage, ref):
+    """'GPU time', 'timer floor' (from raw-direct's median in the same run) or '' for a timed CPU stage."""
+    if stage in GPU_TIME_STAGES:
+        return "GPU time"
+    return "timer floor" if ref and stage != "preinit" and float(ref["median_us"]) < TIMER_FLOOR_US else ""
+
+
+def stage_cells(row, control, kind):
+    """The target and verdict cells: none but a note on a GPU-time or timer-floor stage."""
+    if kind:
+        return ("", f"no verdict: {kind}") if row["target"] else ("", "")
+    return (("<= " + row["target"]) if row["target"] else ""), teapot_verdict(row, control)
+
+
 def table(result):
     rows = result["rows"]
     m = result["meta"]
@@ -96,17 +114,23 @@ def table(result):
     floor = next((r["floor_ns"] for r in rows if r["stage"] != "image" and r.get("floor_ns")), "")
     out.append(f"Floor (an empty timed region, measured in the same run): {floor} ns. "
                "*above floor* is the median minus it.")
+    out.append(f"Stages marked *GPU time* ({', '.join(GPU_TIME_STAGES)}) are the CPU waiting for the GPU, which "
+               "a wrapper cannot move: no verdict. Stages marked *timer floor* (raw-direct's median in this run "
+               f"below {TIMER_FLOOR_US:g} µs) are too short for the timer to judge: they are judged by the instruction "
+               "counts (section *Instruction counts*) only.")
     out.append("")
     out.append("| stage | variant | median (µs) | above floor (ns) | ratio to raw-direct [95 % CI] | target | verdict |")
     out.append("|---|---|---:|---:|---|---|---|")
     control = {r["stage"]: r for r in rows if r["variant"] == "raw-direct-control"}
+    ref = {r["stage"]: r for r in rows if r["variant"] == "raw-direct"}
     for stage in STAGES:
+        kind = stage_kind(stage, ref.get(stage))
         for r in rows:
             if r["stage"] != stage:
                 continue
-            out.append(f"| {stage} | {r['variant']} | {float(r['median_us']):.3f} | {r['above_floor_ns']} | "
-                       f"{fmt_ratio(r)} | {('<= ' + r['target']) if r['target'] else ''} | "
-                       f"{teapot_verdict(r, control.get(stage))} |")
+            target, verdict_text = stage_cells(r, control.get(stage), kind)
+            out.append(f"| {stage}{f' ({kind})' if kind else ''} | {r['variant']} | {float(r['median_us']):.3f} | "
+                       f"{r['above_floor_ns']} | {fmt_ratio(r)} | {target} | {verdict_text} |")
     notes = []
     for stage in ("command", "submit", "wait"):
         c = control.get(stage)
@@ -518,7 +542,7 @@ def readme_row():
     vkrc = "; ".join(f"{v} {three(v)}" for v in ("vkrc-st", "vkrc-mt", "vkrc-st-checked") if v in have)
     images = all(float(x["median_us"]) == 0 for x in r["rows"] if x["stage"] == "image")
     return [f"| teapot loop on {r['meta'].get('device', '?')}, 25 teapots, block-wise ratio to raw-direct "
-            f"(command / submit / frame; intervals and the A/A control in docs/benchmarks.md, data `{r['path']}`) "
+            f"(command / submit / frame, the frame GPU time; intervals and the A/A control in docs/benchmarks.md, data `{r['path']}`) "
             f"| raw (loader trampolines) {three('raw')}; A/A control {three('raw-direct-control')} "
             f"| {three('vkhpp')} | not run here | {vkrc}; "
             f"{'all images byte-identical to raw-direct' if images else 'IMAGES DIFFER'} |"]
