@@ -43,6 +43,13 @@ def load(path):
     return {"path": os.path.relpath(path, ROOT), "meta": meta, "rows": rows}
 
 
+def median(values):
+    """The median; of an even count, the mean of the middle two. Every median the generator computes is this."""
+    v = sorted(values)
+    n = len(v)
+    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
+
+
 def variants_of(rows):
     seen = []
     for r in rows:
@@ -365,11 +372,11 @@ def alloc_section(pattern, pending):
                        f"{thousands(x['peak_reserved_bytes'])} | {thousands(x['peak_requested_bytes'])} | "
                        f"{alloc_waste(x):.1f} % |")
     speedups = [alloc_speedup(r) for r in found]
-    median = sorted(speedups)[len(speedups) // 2]
+    middle = median(speedups)
     waste = max(alloc_waste(x) for r in found for x in r["rows"] if x["allocator"] == "pool")
     out += ["", f"Pool vs dedicated allocate+free rate: {', '.join(f'{v:.1f}x' for v in speedups)} "
-            f"(run {', '.join(str(i) for i in range(1, len(found) + 1))}; median {median:.1f}x): the speed goal "
-            f"(at least {ALLOC_SPEED_GOAL}x) is **{'met' if median >= ALLOC_SPEED_GOAL else 'not met'}** here. "
+            f"(run {', '.join(str(i) for i in range(1, len(found) + 1))}; median {middle:.1f}x): the speed goal "
+            f"(at least {ALLOC_SPEED_GOAL}x) is **{'met' if middle >= ALLOC_SPEED_GOAL else 'not met'}** here. "
             f"The pool's waste at the peak: at most {waste:.1f} %: the memory goal (under {ALLOC_WASTE_GOAL:.0f} %) "
             f"is **{'met' if waste < ALLOC_WASTE_GOAL else 'not met'}**."]
     return out
@@ -500,13 +507,12 @@ def readme_alloc_row():
     h200 = alloc_runs("H200")
 
     def median_of(runs, allocator):
-        rates = sorted(float(x["ops_per_s"]) for r in runs for x in r["rows"] if x["allocator"] == allocator)
-        return rates[len(rates) // 2]
+        return median(float(x["ops_per_s"]) for r in runs for x in r["rows"] if x["allocator"] == allocator)
 
     def part(runs, where):
         if not runs:
             return None, None
-        speed = sorted(alloc_speedup(r) for r in runs)[len(runs) // 2]
+        speed = median(alloc_speedup(r) for r in runs)
         calls = {x["vk_allocate_calls"] for r in runs for x in r["rows"] if x["allocator"] == "pool"}
         return (f"{thousands(median_of(runs, 'dedicated'))}/s on {where}",
                 f"{thousands(median_of(runs, 'pool'))}/s on {where} ({speed:.0f}x, "
@@ -632,9 +638,7 @@ UPLOAD_VARIANTS = ("vkrc-stream", "raw-stream", "vkrc-blocking", "raw-stream-aa"
 def upload_stats(rows, upload, variant, column):
     """Median and range over every block of every process."""
     values = sorted(float(x[column]) for x in rows if x["upload"] == upload and x["variant"] == variant)
-    n = len(values)
-    median = values[n // 2] if n % 2 else (values[n // 2 - 1] + values[n // 2]) / 2
-    return median, values[0], values[-1], n
+    return median(values), values[0], values[-1], len(values)
 
 
 def upload_ratios(rows, upload, a, b):
@@ -701,12 +705,6 @@ def upload_section(pattern, pending):
 CONTENTION_GOAL = 4.0  # PoolAllocator alloc+free rate at 8 threads vs 1 thread (issue 17)
 CONTENTION_GOAL_THREADS = 8
 CONTENTION_GOAL_CASE = "alloc-pool"
-
-
-def median(values):
-    v = sorted(values)
-    n = len(v)
-    return v[n // 2] if n % 2 else (v[n // 2 - 1] + v[n // 2]) / 2
 
 
 def median_ci(values, confidence=0.95):
