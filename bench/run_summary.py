@@ -3,7 +3,9 @@
 cost per frame over raw-direct, in time (from bench/teapot's 'cost' lines:
 median and 95% interval bootstrapped over processes and blocks) and in
 instructions (from bench/instructions.sh's CSV: the per-call counts of the
-seven frame stages summed), the image check, and where the rest is.
+six per-frame stages summed; update, the same scene update in every variant,
+left out), the image check, and where the rest is. scripts/gen_bench_docs.py
+sums the committed counts with instructions_per_frame too.
 
     bench/run_summary.py OUT SECONDS
 """
@@ -13,11 +15,11 @@ import sys
 
 NAMES = {"vkhpp": "vk::raii", "vkrc-st": "vkrc-st", "vkrc-mt": "vkrc-mt",
          "raw-direct-control": "A/A control"}
-STAGES = ("acquire", "uniform", "command", "submit", "present", "wait", "update")
+STAGES = ("acquire", "uniform", "command", "submit", "present", "wait")
 
 
 def instructions_per_frame(path):
-    """{variant: (all, outside the driver)}: the seven stages' per-call counts summed."""
+    """{variant: (all, outside the driver)}: the six stages' per-call counts summed."""
     totals = {}
     with open(path) as f:
         for row in csv.DictReader(line for line in f if not line.startswith("#")):
