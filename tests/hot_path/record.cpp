@@ -56,6 +56,18 @@ void hot_end_query(const Cmd& c, const vkrc::QueryPool& q) { c.end_query(q, 0); 
 void hot_copy_query_results(const Cmd& c, const vkrc::QueryPool& q, const vkrc::Buffer& b) {
     c.copy_query_results(q, 0, 2, b, 0, 8);
 }
+// Issue 31's acceleration structure commands.
+void hot_build_acceleration_structures(const Cmd& c, std::span<const VkAccelerationStructureBuildGeometryInfoKHR> i,
+                                       const VkAccelerationStructureBuildRangeInfoKHR* const* r) {
+    c.build_acceleration_structures(i, r);
+}
+void hot_copy_acceleration_structure(const Cmd& c, VkAccelerationStructureKHR a, VkAccelerationStructureKHR b) {
+    c.copy_acceleration_structure(a, b, VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);
+}
+void hot_write_acceleration_structures_properties(const Cmd& c, std::span<const VkAccelerationStructureKHR> a,
+                                                  const vkrc::QueryPool& q) {
+    c.write_acceleration_structures_properties(a, VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, q, 0);
+}
 void hot_begin_label(const Cmd& c) { c.begin_label("pass", {1.0f, 0.0f, 0.0f, 1.0f}); }
 void hot_end_label(const Cmd& c) { c.end_label(); }
 void hot_insert_label(const Cmd& c) { c.insert_label("marker"); }
