@@ -88,9 +88,9 @@ AccelerationStructure AccelerationStructure::create(const Device& device, const 
     ci.offset = info.offset;
     ci.size = size;
     ci.type = info.type;
-    auto state = detail::created_state<detail::AccelerationStructureState,
-                                       &DeviceFunctions::vkCreateAccelerationStructureKHR>(
-        device, ci, "vkCreateAccelerationStructureKHR");
+    auto state =
+        detail::created_state<detail::AccelerationStructureState, &DeviceFunctions::vkCreateAccelerationStructureKHR>(
+            device, ci, "vkCreateAccelerationStructureKHR");
     state->buffer = info.buffer;
     state->size = size;
     state->type = info.type;
@@ -113,10 +113,10 @@ namespace {
 // A structure of type and size over a buffer of its own.
 AccelerationStructure structure_of(const Device& device, VkAccelerationStructureTypeKHR type, VkDeviceSize size,
                                    const SharedAllocator& allocator) {
-    Buffer storage = Buffer::create(
-        device, {.size = size,
-                 .usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                 .allocator = allocator});
+    Buffer storage = Buffer::create(device, {.size = size,
+                                             .usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR |
+                                                      VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
+                                             .allocator = allocator});
     return AccelerationStructure::create(device, {.buffer = storage, .type = type});
 }
 
@@ -212,8 +212,8 @@ const Device& build_device(const detail::Caller& caller, const CommandBuffer& cm
 // its own. Returns dst (or what it made).
 AccelerationStructure record_build(const detail::Caller& caller, const CommandBuffer& cmd,
                                    VkAccelerationStructureBuildGeometryInfoKHR build, const std::uint32_t* counts,
-                                   const VkAccelerationStructureBuildRangeInfoKHR* ranges,
-                                   AccelerationStructure dst, const SharedAllocator& allocator) {
+                                   const VkAccelerationStructureBuildRangeInfoKHR* ranges, AccelerationStructure dst,
+                                   const SharedAllocator& allocator) {
     const Device& device = cmd.pool().device();
     const auto& fn = device.fn();
     VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
@@ -226,10 +226,9 @@ AccelerationStructure record_build(const detail::Caller& caller, const CommandBu
     const VkDeviceSize scratch_size = update ? sizes.updateScratchSize : sizes.buildScratchSize;
     VkDeviceAddress scratch_address = 0;
     // Dropped on return: held until cmd closes, then until the GPU is done.
-    const Buffer scratch = build_buffer(device, scratch_size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUsage::gpu_only,
-                                        allocator,
-                                        structure_properties(device).minAccelerationStructureScratchOffsetAlignment,
-                                        scratch_address);
+    const Buffer scratch =
+        build_buffer(device, scratch_size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, MemoryUsage::gpu_only, allocator,
+                     structure_properties(device).minAccelerationStructureScratchOffsetAlignment, scratch_address);
     build.dstAccelerationStructure = dst.vk();
     if (update) build.srcAccelerationStructure = dst.vk();
     build.scratchData.deviceAddress = scratch_address;
@@ -242,8 +241,7 @@ VkAccelerationStructureBuildGeometryInfoKHR build_info(VkAccelerationStructureTy
                                                        VkBuildAccelerationStructureFlagsKHR flags,
                                                        const VkAccelerationStructureGeometryKHR* geometries,
                                                        std::size_t count) {
-    VkAccelerationStructureBuildGeometryInfoKHR build{
-        VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+    VkAccelerationStructureBuildGeometryInfoKHR build{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
     build.type = type;
     build.flags = flags;
     build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
@@ -299,8 +297,8 @@ std::vector<VkAccelerationStructureInstanceKHR> instance_records(const detail::C
         caller.require(in.bottom_level.device() == device, "instances[", i, "].bottom_level belongs to another device");
         caller.require(in.bottom_level.type() == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, "instances[", i,
                        "].bottom_level is not a bottom-level structure");
-        caller.require(in.custom_index < (1u << 24) && in.sbt_offset < (1u << 24), "instances[", i,
-                       "]: custom_index ", in.custom_index, " or sbt_offset ", in.sbt_offset, " exceeds 24 bits");
+        caller.require(in.custom_index < (1u << 24) && in.sbt_offset < (1u << 24), "instances[", i, "]: custom_index ",
+                       in.custom_index, " or sbt_offset ", in.sbt_offset, " exceeds 24 bits");
         caller.require(in.flags < (1u << 8), "instances[", i, "]: flags ", detail::Hex{in.flags}, " exceed 8 bits");
         VkAccelerationStructureInstanceKHR r{};
         r.transform = in.transform;
@@ -353,7 +351,8 @@ AccelerationStructure build_top_level(const CommandBuffer& cmd, const TopLevelBu
     return record_top_level(caller, cmd, {}, info);
 }
 
-void rebuild_top_level(const CommandBuffer& cmd, const AccelerationStructure& top_level, const TopLevelBuildInfo& info) {
+void rebuild_top_level(const CommandBuffer& cmd, const AccelerationStructure& top_level,
+                       const TopLevelBuildInfo& info) {
     const detail::Caller caller{"vkrc::rebuild_top_level"};
     const Device& device = build_device(caller, cmd);
     caller.require_handle(top_level, "the AccelerationStructure");
@@ -373,7 +372,8 @@ AccelerationStructure compact(const CommandBuffer& cmd, const AccelerationStruct
                    "the structure was not built with ALLOW_COMPACTION (VUID-VkCopyAccelerationStructureInfoKHR-src-"
                    "03411)");
     caller.require(compacted_size != 0 && compacted_size <= source.size(), "compacted_size ", compacted_size,
-                   " is 0 or more than the structure's ", source.size(), " bytes (read it with a "
+                   " is 0 or more than the structure's ", source.size(),
+                   " bytes (read it with a "
                    "ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR query)");
     AccelerationStructure dst = structure_of(device, source.type(), compacted_size, allocator);
     cmd.copy_acceleration_structure(source, dst, VK_COPY_ACCELERATION_STRUCTURE_MODE_COMPACT_KHR);

@@ -39,20 +39,20 @@ VkTransformMatrixKHR placed(float x, float y, float z, float scale = 1.0f) {
 
 template <class T>
 vkrc::Buffer input_buffer(const vkrc::Device& device, const std::vector<T>& values) {
-    auto buffer = vkrc::Buffer::create(device, {.size = values.size() * sizeof(T),
-                                                .usage = input_usage,
-                                                .memory = {.usage = vkrc::MemoryUsage::upload}});
+    auto buffer = vkrc::Buffer::create(
+        device,
+        {.size = values.size() * sizeof(T), .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
     buffer.allocation().write(0, values.data(), values.size());
     return buffer;
 }
 
 // The geometry the tests build from, kept by handles a test may drop.
 struct Inputs {
-    vkrc::Buffer square;        // 4 vertices: the square [0,4]x[0,4] at z 0
-    vkrc::Buffer indices32;     // its two triangles, 32-bit indices
-    vkrc::Buffer indices16;     // the same, 16-bit
-    vkrc::Buffer shift_right;   // a VkTransformMatrixKHR: x + 4
-    vkrc::Buffer triangle;      // 3 vertices: (0,0), (4.2,0), (0,4.2), not indexed
+    vkrc::Buffer square;       // 4 vertices: the square [0,4]x[0,4] at z 0
+    vkrc::Buffer indices32;    // its two triangles, 32-bit indices
+    vkrc::Buffer indices16;    // the same, 16-bit
+    vkrc::Buffer shift_right;  // a VkTransformMatrixKHR: x + 4
+    vkrc::Buffer triangle;     // 3 vertices: (0,0), (4.2,0), (0,4.2), not indexed
 };
 
 Inputs make_inputs(const vkrc::Device& device) {
@@ -186,14 +186,13 @@ protected:
             device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
                                   {.binding = 1, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
         layout = vkrc::PipelineLayout::create(
-            device, {.set_layouts = {set_layout},
-                     .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Params)}}});
+            device,
+            {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(Params)}}});
         pipeline =
             vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::ray_query_comp));
-        pool = vkrc::DescriptorPool::create(
-            device, {.max_sets = 4,
-                     .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 4},
-                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4}}});
+        pool = vkrc::DescriptorPool::create(device, {.max_sets = 4,
+                                                     .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 4},
+                                                                    {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4}}});
         hits = vkrc::Buffer::create(device, {.size = width * height * 4,
                                              .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                              .memory = {.usage = vkrc::MemoryUsage::readback}});
@@ -210,7 +209,8 @@ protected:
     // Records the trace through set: a barrier from the builds before, one to the host after.
     void record_trace(const vkrc::CommandBuffer& cmd, const vkrc::DescriptorSet& set,
                       std::uint32_t cull_mask = 0x01) const {
-        const auto built = built_to(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+        const auto built =
+            built_to(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
         cmd.pipeline_barrier(std::span(&built, 1), {}, {});
         cmd.bind_pipeline(pipeline);
         cmd.bind_descriptor_set(pipeline, 0, set);
@@ -326,9 +326,48 @@ TEST_F(AccelerationStructureTest, RebuildReplacesTheKeptBottomLevels) {
     EXPECT_EQ(triangle.use_count(), 2u);
     ASSERT_EQ(scene.bottom_levels().size(), 1u);
     EXPECT_TRUE(scene.bottom_levels()[0] == triangle);
-    expect_hits(trace(scene), [](std::uint32_t x, std::uint32_t y) {
-        return float(x) + float(y) + 1.0f < 4.2f ? hit(21, 0) : miss;
-    });
+    expect_hits(trace(scene),
+                [](std::uint32_t x, std::uint32_t y) { return float(x) + float(y) + 1.0f < 4.2f ? hit(21, 0) : miss; });
+}
+
+// A rebuild recorded while gated work still traces the old build: the old
+// bottom level, its handle dropped, waits for that work (deferred
+// destruction), and the gated trace still sees the old scene.
+TEST_F(AccelerationStructureTest, RebuildReleasesTheOldBottomLevelsAfterTheWorkInFlight) {
+    vkrc::AccelerationStructure scene, triangle;
+    {
+        const Inputs in = make_inputs(device);
+        scene = build_scene(in, nullptr, &triangle);
+    }  // the squares are now kept by the scene alone
+    auto set = trace_set(scene);
+    vkrc_test::GpuGate gate(device);
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto trace_cmd = commands.allocate();
+    trace_cmd.begin();
+    record_trace(trace_cmd, set);
+    trace_cmd.end();
+    auto traced = vkrc::Fence::create(device);
+    gate.submit(queue, trace_cmd, traced);
+    const std::size_t before = device.deferred_count();
+    vkrc_test::OneShotCommands s(queue);
+    // The rebuild writes what the gated trace reads: after it in submission order.
+    const auto after_trace = vkrc::memory_barrier(
+        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR,
+        VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
+    s.cmd.pipeline_barrier(std::span(&after_trace, 1), {}, {});
+    vkrc::TopLevelBuildInfo info;
+    info.instances = {{.bottom_level = triangle, .custom_index = 21}};
+    vkrc::rebuild_top_level(s.cmd, scene, info);
+    s.cmd.end();
+    auto rebuilt = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&s.cmd, 1)}, rebuilt);
+    EXPECT_GT(device.deferred_count(), before) << "the released squares (with the build's scratch and instances) wait";
+    gate.open();
+    ASSERT_EQ(traced.wait(), VK_SUCCESS);
+    expect_hits(read_hits(), expected_scene);
+    ASSERT_EQ(rebuilt.wait(), VK_SUCCESS);
+    expect_hits(trace(scene),
+                [](std::uint32_t x, std::uint32_t y) { return float(x) + float(y) + 1.0f < 4.2f ? hit(21, 0) : miss; });
 }
 
 // Refit: the squares' vertices move by +8 in y, update_bottom_level refits
@@ -340,7 +379,8 @@ TEST_F(AccelerationStructureTest, UpdateRefitsMovedVertices) {
     vkrc::TopLevelBuildInfo top;
     {
         vkrc_test::OneShotCommands s(queue);
-        squares = vkrc::build_bottom_level(s.cmd, squares_info(in, VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR));
+        squares =
+            vkrc::build_bottom_level(s.cmd, squares_info(in, VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR));
         barrier_between_levels(s.cmd);
         top.instances = {{.bottom_level = squares, .custom_index = 3}};
         scene = vkrc::build_top_level(s.cmd, top);
@@ -357,9 +397,8 @@ TEST_F(AccelerationStructureTest, UpdateRefitsMovedVertices) {
         vkrc::rebuild_top_level(s.cmd, scene, top);
         s.run(queue);
     }
-    expect_hits(trace(scene), [](std::uint32_t x, std::uint32_t y) {
-        return y >= 8 && y < 12 && x < 8 ? hit(3, x / 4) : miss;
-    });
+    expect_hits(trace(scene),
+                [](std::uint32_t x, std::uint32_t y) { return y >= 8 && y < 12 && x < 8 ? hit(3, x / 4) : miss; });
 }
 
 template <class F>
@@ -397,8 +436,8 @@ TEST_F(AccelerationStructureTest, CompactedCopiesTraceTheSame) {
     vkrc::AccelerationStructure squares, triangle;
     {
         vkrc_test::OneShotCommands s(queue);
-        squares = vkrc::build_bottom_level(
-            s.cmd, squares_info(in, VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR));
+        squares =
+            vkrc::build_bottom_level(s.cmd, squares_info(in, VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR));
         triangle = vkrc::build_bottom_level(s.cmd, triangle_info(in));
         s.run(queue);
     }
@@ -446,7 +485,15 @@ TEST_F(AccelerationStructureTest, DescriptorWriteKeepsTheStructureAlive) {
     const VkAccelerationStructureKHR raw = scene.vk();
     set.write_acceleration_structures(0, std::span(&raw, 1));
     EXPECT_EQ(scene.use_count(), before + 1) << "the raw write replaced the wrapper's reference";
+    // Through an update template, whose entry the set reads the structure out of.
+    auto update = vkrc::DescriptorUpdateTemplate::create(
+        device, {.entries = {{0, 0, 1, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 0, sizeof(raw)}},
+                 .descriptor_set_layout = set_layout});
+    auto other = pool.allocate(set_layout);
+    other.update_with_template(update, &raw);
+    EXPECT_EQ(scene.use_count(), before + 2);
     set.reset();
+    other.reset();
     EXPECT_EQ(scene.use_count(), before);
 }
 
@@ -479,18 +526,21 @@ TEST_F(AccelerationStructureTest, MisusedStructuresAreRefused) {
     vkrc::AccelerationStructure squares;
     auto scene = build_scene(in, &squares);
     vkrc_test::OneShotCommands s(queue);
-    EXPECT_NE(usage_error_of([&] { vkrc::update_bottom_level(s.cmd, squares, squares_info(in)); })
-                  .find("was not built with ALLOW_UPDATE"),
+    EXPECT_NE(usage_error_of([&] {
+                  vkrc::update_bottom_level(s.cmd, squares, squares_info(in));
+              }).find("was not built with ALLOW_UPDATE"),
               std::string::npos);
     vkrc::TopLevelBuildInfo info;
     info.instances = {{.bottom_level = scene}};
-    EXPECT_NE(usage_error_of([&] { vkrc::build_top_level(s.cmd, info); })
-                  .find("instances[0].bottom_level is not a bottom-level structure"),
+    EXPECT_NE(usage_error_of([&] {
+                  vkrc::build_top_level(s.cmd, info);
+              }).find("instances[0].bottom_level is not a bottom-level structure"),
               std::string::npos);
     info.instances = {{.bottom_level = squares, .custom_index = 1u << 24}};
     EXPECT_NE(usage_error_of([&] { vkrc::build_top_level(s.cmd, info); }).find("exceeds 24 bits"), std::string::npos);
-    EXPECT_NE(usage_error_of([&] { vkrc::rebuild_top_level(s.cmd, squares, scene_info(squares, squares)); })
-                  .find("the structure is not a top level"),
+    EXPECT_NE(usage_error_of([&] {
+                  vkrc::rebuild_top_level(s.cmd, squares, scene_info(squares, squares));
+              }).find("the structure is not a top level"),
               std::string::npos);
     auto set = pool.allocate(set_layout);
     EXPECT_NE(usage_error_of([&] { set.write_acceleration_structure(0, squares); }).find("is a bottom level"),
