@@ -34,8 +34,10 @@ VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
 void require_support(const detail::Caller& caller, const Device& device) {
     caller.require(device.extension_enabled(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) &&
                        device.fn().vkCreateAccelerationStructureKHR != nullptr,
-                   "acceleration structures need VK_KHR_acceleration_structure enabled on the device (with its "
-                   "accelerationStructure feature)");
+                   "acceleration structures need VK_KHR_acceleration_structure enabled on the device (set "
+                   "DeviceCreateInfo::acceleration_structure_features.accelerationStructure)");
+    caller.require(device.state()->enabled_features.acceleration_structure.accelerationStructure,
+                   "acceleration structures need the accelerationStructure feature enabled");
     caller.require(device.state()->enabled_features.vulkan12.bufferDeviceAddress,
                    "acceleration structures need the bufferDeviceAddress feature enabled");
 }

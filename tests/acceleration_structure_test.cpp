@@ -153,29 +153,17 @@ protected:
     void SetUp() override {
         VulkanTest::SetUp();
         if (HasFatalFailure() || IsSkipped()) return;
-        for (const char* ext : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                                VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME}) {
-            if (!physical_device.supports_extension(ext)) GTEST_SKIP() << "the device lacks " << ext;
-        }
-        VkPhysicalDeviceRayQueryFeaturesKHR ray_query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
-        VkPhysicalDeviceAccelerationStructureFeaturesKHR structures{
-            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &ray_query};
-        VkPhysicalDeviceFeatures2 all{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &structures};
-        physical_device.fn().vkGetPhysicalDeviceFeatures2(physical_device.vk(), &all);
-        const auto missing = vkrc_test::missing_features(
-            {{"accelerationStructure", structures.accelerationStructure},
-             {"rayQuery", ray_query.rayQuery},
-             {"bufferDeviceAddress", vkrc_test::supported_features(physical_device).v12.bufferDeviceAddress}});
-        if (!missing.empty()) GTEST_SKIP() << "the device lacks " << missing;
-        ray_query_features = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR, nullptr, VK_TRUE};
-        structure_features = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR,
-                              &ray_query_features};
-        structure_features.accelerationStructure = VK_TRUE;
+        // What the device lacks, as select() would name it.
+        vkrc::DeviceRequirements wanted = vkrc_test::test_device_requirements();
+        wanted.required_features.acceleration_structure.accelerationStructure = VK_TRUE;
+        wanted.required_features.ray_query.rayQuery = VK_TRUE;
+        wanted.required_features.vulkan12.bufferDeviceAddress = VK_TRUE;
+        const auto unmet = physical_device.unmet_requirements(wanted);
+        if (!unmet.empty()) GTEST_SKIP() << "the device " << unmet[0].c_str();
         vkrc::DeviceCreateInfo info;
-        info.enabled_extension_names = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                                        VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+        info.acceleration_structure_features.accelerationStructure = VK_TRUE;  // enables the extensions
+        info.ray_query_features.rayQuery = VK_TRUE;
         info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
-        info.next = &structure_features;
         device = vkrc::Device::create(physical_device, info);
         queue = device.default_queue();
         make_tracer();
@@ -249,8 +237,6 @@ protected:
         return read_hits();
     }
 
-    VkPhysicalDeviceRayQueryFeaturesKHR ray_query_features{};
-    VkPhysicalDeviceAccelerationStructureFeaturesKHR structure_features{};
     vkrc::DescriptorSetLayout set_layout;
     vkrc::PipelineLayout layout;
     vkrc::ComputePipeline pipeline;
@@ -548,10 +534,42 @@ TEST_F(AccelerationStructureTest, MisusedStructuresAreRefused) {
     s.run(queue);
 }
 
-// The fixture's plain device, made without VK_KHR_acceleration_structure:
-// the builds say what is missing.
+// Devices without what acceleration structures need: the builds say what is missing.
 using AccelerationStructureRefusal = VulkanTest;
 
+// The extension enabled without its accelerationStructure feature: refused, naming the feature.
+TEST_F(AccelerationStructureRefusal, WithoutTheFeatureBuildsAreRefused) {
+    if (!physical_device.features().acceleration_structure.accelerationStructure)
+        GTEST_SKIP() << "the device lacks accelerationStructure";
+    vkrc::DeviceCreateInfo info;
+    info.enabled_extension_names = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                    VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+    info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
+    device = vkrc::Device::create(physical_device, info);
+    queue = device.default_queue();
+    vkrc_test::OneShotCommands s(queue);
+    const std::string message = usage_error_of([&] { vkrc::build_top_level(s.cmd, {}); });
+    EXPECT_NE(message.find("vkrc::build_top_level: acceleration structures need the accelerationStructure feature "
+                           "enabled"),
+              std::string::npos)
+        << message;
+    s.run(queue);
+}
+
+// select() reads the extensions' features and names a missing one.
+TEST_F(AccelerationStructureRefusal, RequirementsNameTheMissingFeature) {
+    vkrc::DeviceRequirements wanted = vkrc_test::test_device_requirements();
+    wanted.required_features.acceleration_structure.accelerationStructureHostCommands = VK_TRUE;
+    const auto unmet = physical_device.unmet_requirements(wanted);
+    if (physical_device.features().acceleration_structure.accelerationStructureHostCommands) {
+        EXPECT_TRUE(unmet.empty());
+        return;
+    }
+    ASSERT_EQ(unmet.size(), 1u);
+    EXPECT_STREQ(unmet[0].c_str(), "lacks feature accelerationStructureHostCommands (VK_KHR_acceleration_structure)");
+}
+
+// The fixture's plain device, made without VK_KHR_acceleration_structure.
 TEST_F(AccelerationStructureRefusal, WithoutTheExtensionBuildsAreRefused) {
     vkrc_test::OneShotCommands s(queue);
     const std::string message = usage_error_of([&] { vkrc::build_bottom_level(s.cmd, {}); });

@@ -65,6 +65,11 @@ struct DeviceCreateInfo {
     VkPhysicalDeviceVulkan11Features vulkan11_features{};
     VkPhysicalDeviceVulkan12Features vulkan12_features{};
     VkPhysicalDeviceVulkan13Features vulkan13_features{};
+    // Chained when any of their features is set, which also enables the
+    // extension (and VK_KHR_deferred_host_operations, which
+    // VK_KHR_acceleration_structure needs). Default none.
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR acceleration_structure_features{};
+    VkPhysicalDeviceRayQueryFeaturesKHR ray_query_features{};
     // Enable VK_EXT_memory_budget when the device has it (for allocator statistics). Default true.
     bool enable_memory_budget = true;
     // Chained after vkrc's feature structs (must not repeat them). Null: none.
