@@ -14,7 +14,8 @@ OUT = sys.argv[2] if len(sys.argv) > 2 else "include/vkrc/detail/function_list.i
 FEATURES = ["VK_VERSION_1_0", "VK_VERSION_1_1", "VK_VERSION_1_2", "VK_VERSION_1_3"]
 # Platform-neutral extensions vkrc itself uses; platform surface creation is
 # left to GLFW or to the application, which keeps window-system headers out.
-EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils", "VK_KHR_push_descriptor", "VK_EXT_mesh_shader"]
+EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils", "VK_KHR_push_descriptor", "VK_EXT_mesh_shader",
+              "VK_KHR_acceleration_structure"]
 GLOBAL = {"vkCreateInstance", "vkEnumerateInstanceVersion",
           "vkEnumerateInstanceLayerProperties", "vkEnumerateInstanceExtensionProperties"}
 

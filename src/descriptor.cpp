@@ -379,6 +379,7 @@ detail::DescriptorRefs refs_of(const detail::DeviceState& d, VkDescriptorType ty
 std::size_t info_size(VkDescriptorType type) noexcept {
     if (is_buffer_type(type)) return sizeof(VkDescriptorBufferInfo);
     if (is_image_type(type)) return sizeof(VkDescriptorImageInfo);
+    if (type == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) return sizeof(VkAccelerationStructureKHR);
     return sizeof(VkBufferView);
 }
 
@@ -444,9 +445,18 @@ void write_infos(const detail::DescriptorSetState* set, std::uint32_t binding, V
     w.dstArrayElement = array_element;
     w.descriptorCount = static_cast<std::uint32_t>(count);
     w.descriptorType = type;
+    // Acceleration structures go in a struct of their own, chained.
+    VkWriteDescriptorSetAccelerationStructureKHR structures{
+        VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
     if (is_buffer_type(type)) w.pBufferInfo = static_cast<const VkDescriptorBufferInfo*>(infos);
     else if (is_image_type(type)) w.pImageInfo = static_cast<const VkDescriptorImageInfo*>(infos);
-    else w.pTexelBufferView = static_cast<const VkBufferView*>(infos);
+    else if (type != VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR)
+        w.pTexelBufferView = static_cast<const VkBufferView*>(infos);
+    else {
+        structures.accelerationStructureCount = w.descriptorCount;
+        structures.pAccelerationStructures = static_cast<const VkAccelerationStructureKHR*>(infos);
+        w.pNext = &structures;
+    }
     update_keeping(
         s, writes, count, [&] { d.fn.vkUpdateDescriptorSets(d.device, 1, &w, 0, nullptr); }, caller);
 }
@@ -471,7 +481,33 @@ void write_texel_views(const detail::DescriptorSetState* s, std::uint32_t bindin
     write_infos(s, binding, type, array_element, views.size(), views.data(), caller);
 }
 
+void write_structures(const detail::DescriptorSetState* s, std::uint32_t binding,
+                      Span<const VkAccelerationStructureKHR> structures, std::uint32_t array_element,
+                      const detail::Caller& caller) {
+    write_infos(s, binding, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, array_element, structures.size(),
+                structures.data(), caller);
+}
+
 }  // namespace
+
+void DescriptorSet::write_acceleration_structure(std::uint32_t binding, const AccelerationStructure& structure,
+                                                 std::uint32_t array_element) const {
+    const detail::Caller caller{"vkrc::DescriptorSet::write_acceleration_structure"};
+    caller.require_handle(structure, "the AccelerationStructure");
+    caller.require(structure.device() == pool().device(), "the acceleration structure belongs to another device");
+    caller.require(structure.type() != VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
+                   "the acceleration structure is a bottom level; shaders trace top levels "
+                   "(VUID-VkWriteDescriptorSetAccelerationStructureKHR-pAccelerationStructures-03579)");
+    const VkAccelerationStructureKHR raw = structure.vk();
+    write_structures(state_.get(), binding, Span(&raw, 1), array_element, caller);
+}
+
+void DescriptorSet::write_acceleration_structures(std::uint32_t binding,
+                                                  Span<const VkAccelerationStructureKHR> structures,
+                                                  std::uint32_t array_element) const {
+    write_structures(state_.get(), binding, structures, array_element,
+                     detail::Caller{"vkrc::DescriptorSet::write_acceleration_structures"});
+}
 
 void DescriptorSet::write_buffer(std::uint32_t binding, VkDescriptorType type, const Buffer& buffer,
                                  VkDeviceSize offset, VkDeviceSize range, std::uint32_t array_element) const {

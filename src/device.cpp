@@ -373,12 +373,24 @@ bool wants_mesh_shader(const DeviceCreateInfo& info) {
     return f.taskShader || f.meshShader || f.multiviewMeshShader || f.primitiveFragmentShadingRateMeshShader ||
            f.meshShaderQueries;
 }
+// Whether info asks for any VK_KHR_acceleration_structure or VK_KHR_ray_query feature.
+bool wants_acceleration_structure(const DeviceCreateInfo& info) {
+    const auto& a = info.acceleration_structure_features;
+    return a.accelerationStructure || a.accelerationStructureCaptureReplay || a.accelerationStructureIndirectBuild ||
+           a.accelerationStructureHostCommands || a.descriptorBindingAccelerationStructureUpdateAfterBind;
+}
+bool wants_ray_query(const DeviceCreateInfo& info) { return info.ray_query_features.rayQuery != VK_FALSE; }
 
-// The extensions asked for, those whose features info sets, and those vkrc
-// enables where the device has them.
+// The extensions asked for, those the features asked for need, and those
+// vkrc enables where the device has them.
 std::vector<const char*> device_extensions(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (wants_mesh_shader(info)) detail::add_unique(extensions, VK_EXT_MESH_SHADER_EXTENSION_NAME);
+    if (wants_acceleration_structure(info)) {
+        detail::add_unique(extensions, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+        detail::add_unique(extensions, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+    }
+    if (wants_ray_query(info)) detail::add_unique(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME);
     if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
         detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
@@ -389,20 +401,34 @@ std::vector<const char*> device_extensions(const PhysicalDevice& physical, const
     return extensions;
 }
 
+// Puts an extension's feature struct at the head of chain when it is wanted.
+template <class Features>
+void chain_if(bool wanted, Features& features, void*& chain) {
+    if (!wanted) return;
+    features.pNext = chain;
+    chain = &features;
+}
+
 // The features asked for, plus those vkrc needs, chained for vkCreateDevice.
 // Its members point at each other, so it is made in place and never copied.
 struct FeatureChain {
     explicit FeatureChain(const DeviceCreateInfo& info)
         : mesh(info.mesh_shader_features),
+          ray_query(info.ray_query_features),
+          structures(info.acceleration_structure_features),
           f13(info.vulkan13_features),
           f12(info.vulkan12_features),
           f11(info.vulkan11_features) {
-        // An extension's struct only when some feature of it is asked for:
-        // chained, it would need the extension enabled.
+        // The extensions' structs only when asked for: a device without them must not see them.
+        void* extension_chain = const_cast<void*>(info.next);
         mesh.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT;
-        mesh.pNext = const_cast<void*>(info.next);
+        ray_query.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+        structures.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+        chain_if(wants_mesh_shader(info), mesh, extension_chain);
+        chain_if(wants_ray_query(info), ray_query, extension_chain);
+        chain_if(wants_acceleration_structure(info), structures, extension_chain);
         f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        f13.pNext = wants_mesh_shader(info) ? &mesh : const_cast<void*>(info.next);
+        f13.pNext = extension_chain;
         f13.synchronization2 = VK_TRUE;
         f13.dynamicRendering = VK_TRUE;
         // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
@@ -425,11 +451,16 @@ struct FeatureChain {
         d.vulkan12 = f12;
         d.vulkan13 = f13;
         d.mesh_shader = mesh;
-        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = d.mesh_shader.pNext = nullptr;
+        d.acceleration_structure = structures;
+        d.ray_query = ray_query;
+        d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
+        d.mesh_shader.pNext = d.acceleration_structure.pNext = d.ray_query.pNext = nullptr;
         return d;
     }
 
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh;
+    VkPhysicalDeviceRayQueryFeaturesKHR ray_query;
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR structures;
     VkPhysicalDeviceVulkan13Features f13;
     VkPhysicalDeviceVulkan12Features f12;
     VkPhysicalDeviceVulkan11Features f11;

@@ -36,6 +36,25 @@ void read_features(const InstanceFunctions& f, VkPhysicalDevice raw, std::uint32
     out.vulkan11.pNext = out.vulkan12.pNext = out.vulkan13.pNext = nullptr;
 }
 
+// The ray tracing extensions' features, for a device that offers them
+// (vkGetPhysicalDeviceFeatures2 is core from Vulkan 1.1).
+void read_extension_features(const InstanceFunctions& f, VkPhysicalDevice raw, std::uint32_t version,
+                             const List<Text>& extensions, DeviceFeatures& out) {
+    if (version < VK_API_VERSION_1_1) return;
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    if (detail::contains(extensions, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME)) {
+        out.acceleration_structure.pNext = features.pNext;
+        features.pNext = &out.acceleration_structure;
+    }
+    if (detail::contains(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME)) {
+        out.ray_query.pNext = features.pNext;
+        features.pNext = &out.ray_query;
+    }
+    if (!features.pNext) return;
+    f.vkGetPhysicalDeviceFeatures2(raw, &features);
+    out.acceleration_structure.pNext = out.ray_query.pNext = nullptr;
+}
+
 }  // namespace
 
 namespace detail {
@@ -214,6 +233,7 @@ List<PhysicalDevice> Instance::physical_devices() const {
                                                              "vkEnumerateDeviceExtensionProperties", raw, nullptr);
         for (const auto& e : exts) s.extensions.push_back(e.extensionName);
         read_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.extensions, s.features);
+        read_extension_features(f, raw, std::min(s.properties.apiVersion, api_version()), s.extensions, s.features);
         s.default_queue_family = device.find_queue_family(VK_QUEUE_GRAPHICS_BIT | VK_QUEUE_COMPUTE_BIT);
         devices.push_back(std::move(device));
     }

@@ -19,6 +19,16 @@ void add_missing_features(const DeviceFeatures& want, const DeviceFeatures& have
 #define VKRC_FEATURE(group, version, name) \
   if (want.group.name && !have.group.name) reasons.push_back("lacks feature " #name " (" version ")");
 #include "feature_names.inl"
+#define VKRC_EXTENSION_FEATURE(group, extension, name) \
+  if (want.group.name && !have.group.name) reasons.push_back("lacks feature " #name " (" extension ")");
+    VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure", accelerationStructure)
+    VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure", accelerationStructureCaptureReplay)
+    VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure", accelerationStructureIndirectBuild)
+    VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure", accelerationStructureHostCommands)
+    VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure",
+                           descriptorBindingAccelerationStructureUpdateAfterBind)
+    VKRC_EXTENSION_FEATURE(ray_query, "VK_KHR_ray_query", rayQuery)
+#undef VKRC_EXTENSION_FEATURE
 }
 
 std::string version_string(std::uint32_t v) {

@@ -460,6 +460,34 @@ public:
                                        flags | VK_QUERY_RESULT_64_BIT);
     }
 
+    // Acceleration structures (VK_KHR_acceleration_structure, enabled on the
+    // device: the functions are called as loaded). The builds as given,
+    // ranges[i] holding infos[i]'s geometryCount ranges; build_bottom_level
+    // and build_top_level (vkrc/acceleration_structure.hpp) fill them in.
+    void build_acceleration_structures(Span<const VkAccelerationStructureBuildGeometryInfoKHR> infos,
+                                       const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) const
+        VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::build_acceleration_structures");
+        fn_->vkCmdBuildAccelerationStructuresKHR(cmd_, static_cast<std::uint32_t>(infos.size()), infos.data(), ranges);
+    }
+    // mode CLONE or COMPACT (dst made with the size the compacted-size query gave).
+    void copy_acceleration_structure(Raw<VkAccelerationStructureKHR> src, Raw<VkAccelerationStructureKHR> dst,
+                                     VkCopyAccelerationStructureModeKHR mode) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_acceleration_structure");
+        const VkCopyAccelerationStructureInfoKHR info{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR, nullptr,
+                                                      src, dst, mode};
+        fn_->vkCmdCopyAccelerationStructureKHR(cmd_, &info);
+    }
+    // Writes a property of each structure (e.g. ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR)
+    // into consecutive queries of pool from first_query (reset them first).
+    void write_acceleration_structures_properties(Span<const VkAccelerationStructureKHR> structures,
+                                                  VkQueryType query_type, Raw<VkQueryPool> pool,
+                                                  std::uint32_t first_query) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_acceleration_structures_properties");
+        fn_->vkCmdWriteAccelerationStructuresPropertiesKHR(cmd_, static_cast<std::uint32_t>(structures.size()),
+                                                           structures.data(), query_type, pool, first_query);
+    }
+
     // Debug-utils labels around and between commands, shown by debuggers and
     // capture tools. No-ops when the instance has not enabled
     // VK_EXT_debug_utils, so they may stay in release code. name is copied.

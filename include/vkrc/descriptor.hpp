@@ -1,6 +1,7 @@
 // Descriptor set layouts, descriptor pools and the sets they own.
 #pragma once
 
+#include "vkrc/acceleration_structure.hpp"
 #include "vkrc/detail/pool_free_list.hpp"
 #include "vkrc/resource.hpp"
 
@@ -154,6 +155,13 @@ public:
                            std::uint32_t array_element = 0) const;
     void write_buffer_views(std::uint32_t binding, VkDescriptorType type, Span<const VkBufferView> views,
                             std::uint32_t array_element = 0) const;
+    // ACCELERATION_STRUCTURE_KHR descriptors (VkWriteDescriptorSetAccelerationStructureKHR
+    // chained by vkrc), checked as write_buffer / write_buffers are. A top
+    // level written keeps its bottom levels alive through its own references.
+    void write_acceleration_structure(std::uint32_t binding, const AccelerationStructure& structure,
+                                      std::uint32_t array_element = 0) const;
+    void write_acceleration_structures(std::uint32_t binding, Span<const VkAccelerationStructureKHR> structures,
+                                       std::uint32_t array_element = 0) const;
     // vkUpdateDescriptorSetWithTemplate: data is laid out as the template's
     // entries say (read during the call). The template's type must be
     // DESCRIPTOR_SET and its layout this set's, and each entry must lie in

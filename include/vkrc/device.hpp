@@ -68,6 +68,11 @@ struct DeviceCreateInfo {
     // With any feature set, vkrc chains it and enables VK_EXT_mesh_shader
     // (mesh and task shaders: GraphicsPipelineBuilder, draw_mesh_tasks).
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh_shader_features{};
+    // Chained when any of their features is set, which also enables the
+    // extension (and VK_KHR_deferred_host_operations, which
+    // VK_KHR_acceleration_structure needs). Default none.
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR acceleration_structure_features{};
+    VkPhysicalDeviceRayQueryFeaturesKHR ray_query_features{};
     // Enable VK_EXT_memory_budget when the device has it (for allocator statistics). Default true.
     bool enable_memory_budget = true;
     // Chained after vkrc's feature structs (must not repeat them). Null: none.

@@ -109,9 +109,9 @@ constexpr T with_type(VkStructureType type) noexcept {
 }
 }  // namespace detail
 
-// The Vulkan 1.0-1.3 feature structs and those of the extensions vkrc wraps,
-// unchained: the sTypes are set and every pNext is null, so copies are safe
-// (vkrc chains them when it queries).
+// The Vulkan 1.0-1.3 feature structs and those of the extensions vkrc wraps
+// (mesh shading, ray tracing), unchained: the sTypes are set and every pNext
+// is null, so copies are safe (vkrc chains them when it queries).
 struct DeviceFeatures {
     VkPhysicalDeviceFeatures core{};
     VkPhysicalDeviceVulkan11Features vulkan11 =
@@ -123,6 +123,13 @@ struct DeviceFeatures {
     // VK_EXT_mesh_shader (taskShader, meshShader): read only from a device that offers the extension.
     VkPhysicalDeviceMeshShaderFeaturesEXT mesh_shader = detail::with_type<VkPhysicalDeviceMeshShaderFeaturesEXT>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT);
+    // VK_KHR_acceleration_structure's and VK_KHR_ray_query's: read only where
+    // the device offers the extension (all VK_FALSE otherwise).
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR acceleration_structure =
+        detail::with_type<VkPhysicalDeviceAccelerationStructureFeaturesKHR>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
+    VkPhysicalDeviceRayQueryFeaturesKHR ray_query = detail::with_type<VkPhysicalDeviceRayQueryFeaturesKHR>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
 };
 
 // What a device must offer to be chosen. Every unmet item is reported.

@@ -1,6 +1,7 @@
 // The whole of vkrc. Each object family also has its own header.
 #pragma once
 
+#include "vkrc/acceleration_structure.hpp"
 #include "vkrc/access.hpp"
 #include "vkrc/barrier.hpp"
 #include "vkrc/bindless.hpp"

@@ -10,7 +10,7 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-// What a descriptor slot can refer to; acceleration structures join when vkrc wraps them.
+// What a descriptor slot can refer to.
 enum class DescribedKind : std::uint8_t { buffer, buffer_view, image_view, sampler, acceleration_structure };
 inline constexpr std::size_t described_kind_count = 5;
 
