@@ -209,6 +209,20 @@ const Device& build_device(const detail::Caller& caller, const CommandBuffer& cm
     return device;
 }
 
+// The command buffer's device, after build_device's checks and those of the
+// structure a call works on: not empty, of that device and, unless type is
+// VK_ACCELERATION_STRUCTURE_TYPE_MAX_ENUM_KHR, of that level.
+const Device& structure_device(const detail::Caller& caller, const CommandBuffer& cmd,
+                               const AccelerationStructure& structure, VkAccelerationStructureTypeKHR type) {
+    const Device& device = build_device(caller, cmd);
+    caller.require_handle(structure, "the AccelerationStructure");
+    caller.require(structure.device() == device, "the structure belongs to another device");
+    caller.require(type == VK_ACCELERATION_STRUCTURE_TYPE_MAX_ENUM_KHR || structure.type() == type,
+                   "the structure is not a ",
+                   type == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR ? "top level" : "bottom level");
+    return device;
+}
+
 // One build of geometries into dst (from src when updating): sizes, scratch,
 // the recorded call. dst null: makes the structure of type with a buffer of
 // its own. Returns dst (or what it made).
@@ -266,11 +280,7 @@ AccelerationStructure build_bottom_level(const CommandBuffer& cmd, const BottomL
 void update_bottom_level(const CommandBuffer& cmd, const AccelerationStructure& bottom_level,
                          const BottomLevelBuildInfo& info) {
     const detail::Caller caller{"vkrc::update_bottom_level"};
-    const Device& device = build_device(caller, cmd);
-    caller.require_handle(bottom_level, "the AccelerationStructure");
-    caller.require(bottom_level.device() == device, "the structure belongs to another device");
-    caller.require(bottom_level.type() == VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR,
-                   "the structure is not a bottom level");
+    const Device& device = structure_device(caller, cmd, bottom_level, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
     caller.require(bottom_level.build_flags() & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR,
                    "the structure was not built with ALLOW_UPDATE (VUID-VkAccelerationStructureBuildGeometryInfoKHR-"
                    "mode-04631)");
@@ -356,20 +366,14 @@ AccelerationStructure build_top_level(const CommandBuffer& cmd, const TopLevelBu
 void rebuild_top_level(const CommandBuffer& cmd, const AccelerationStructure& top_level,
                        const TopLevelBuildInfo& info) {
     const detail::Caller caller{"vkrc::rebuild_top_level"};
-    const Device& device = build_device(caller, cmd);
-    caller.require_handle(top_level, "the AccelerationStructure");
-    caller.require(top_level.device() == device, "the structure belongs to another device");
-    caller.require(top_level.type() == VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR,
-                   "the structure is not a top level");
+    structure_device(caller, cmd, top_level, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR);
     record_top_level(caller, cmd, top_level, info);
 }
 
 AccelerationStructure compact(const CommandBuffer& cmd, const AccelerationStructure& source,
                               VkDeviceSize compacted_size, const SharedAllocator& allocator) {
     const detail::Caller caller{"vkrc::compact"};
-    const Device& device = build_device(caller, cmd);
-    caller.require_handle(source, "the AccelerationStructure");
-    caller.require(source.device() == device, "the structure belongs to another device");
+    const Device& device = structure_device(caller, cmd, source, VK_ACCELERATION_STRUCTURE_TYPE_MAX_ENUM_KHR);
     caller.require(source.build_flags() & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR,
                    "the structure was not built with ALLOW_COMPACTION (VUID-VkCopyAccelerationStructureInfoKHR-src-"
                    "03411)");
@@ -385,6 +389,23 @@ AccelerationStructure compact(const CommandBuffer& cmd, const AccelerationStruct
     LockGuard lock(d.mutex);
     d.bottom_levels.swap(bottom);
     return dst;
+}
+
+// The accessors, out of line: none is on a per-frame path.
+VkAccelerationStructureTypeKHR AccelerationStructure::type() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::AccelerationStructure::type").type;
+}
+VkDeviceSize AccelerationStructure::size() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::AccelerationStructure::size").size;
+}
+VkDeviceAddress AccelerationStructure::device_address() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::AccelerationStructure::device_address").device_address;
+}
+const Buffer& AccelerationStructure::buffer() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::AccelerationStructure::buffer").buffer;
+}
+VkBuildAccelerationStructureFlagsKHR AccelerationStructure::build_flags() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::AccelerationStructure::build_flags").build_flags;
 }
 
 VKRC_END_NAMESPACE

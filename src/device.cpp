@@ -409,61 +409,54 @@ void chain_if(bool wanted, Features& features, void*& chain) {
     chain = &features;
 }
 
+// features, given features: the user's struct with its sType and an
+// empty pNext kept (a caller's struct may have neither set).
+template <class Features>
+void copy_features(Features& features, const Features& given) {
+    const VkStructureType type = features.sType;
+    features = given;
+    features.sType = type;
+    features.pNext = nullptr;
+}
+
 // The features asked for, plus those vkrc needs, chained for vkCreateDevice.
 // Its members point at each other, so it is made in place and never copied.
 struct FeatureChain {
-    explicit FeatureChain(const DeviceCreateInfo& info)
-        : mesh(info.mesh_shader_features),
-          ray_query(info.ray_query_features),
-          structures(info.acceleration_structure_features),
-          f13(info.vulkan13_features),
-          f12(info.vulkan12_features),
-          f11(info.vulkan11_features) {
-        // The extensions' structs only when asked for: a device without them must not see them.
-        void* extension_chain = const_cast<void*>(info.next);
-        mesh.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT;
-        ray_query.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
-        structures.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
-        chain_if(wants_mesh_shader(info), mesh, extension_chain);
-        chain_if(wants_ray_query(info), ray_query, extension_chain);
-        chain_if(wants_acceleration_structure(info), structures, extension_chain);
-        f13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
-        f13.pNext = extension_chain;
-        f13.synchronization2 = VK_TRUE;
-        f13.dynamicRendering = VK_TRUE;
+    explicit FeatureChain(const DeviceCreateInfo& info) {
+        copy_features(chained.vulkan11, info.vulkan11_features);
+        copy_features(chained.vulkan12, info.vulkan12_features);
+        copy_features(chained.vulkan13, info.vulkan13_features);
+        copy_features(chained.mesh_shader, info.mesh_shader_features);
+        copy_features(chained.acceleration_structure, info.acceleration_structure_features);
+        copy_features(chained.ray_query, info.ray_query_features);
+        chained.vulkan13.synchronization2 = VK_TRUE;
+        chained.vulkan13.dynamicRendering = VK_TRUE;
         // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
-        f13.maintenance4 = VK_TRUE;
-        f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
-        f12.pNext = &f13;
-        f12.timelineSemaphore = VK_TRUE;
-        f11.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES;
-        f11.pNext = &f12;
-        features.pNext = &f11;
+        chained.vulkan13.maintenance4 = VK_TRUE;
+        chained.vulkan12.timelineSemaphore = VK_TRUE;
+        // The extensions' structs only when asked for: a device without them must not see them.
+        void* extensions = const_cast<void*>(info.next);
+        chain_if(wants_mesh_shader(info), chained.mesh_shader, extensions);
+        chain_if(wants_ray_query(info), chained.ray_query, extensions);
+        chain_if(wants_acceleration_structure(info), chained.acceleration_structure, extensions);
+        chained.vulkan13.pNext = extensions;
+        chained.vulkan12.pNext = &chained.vulkan13;
+        chained.vulkan11.pNext = &chained.vulkan12;
+        features.pNext = &chained.vulkan11;
         features.features = info.enabled_features;
     }
     FeatureChain(const FeatureChain&) = delete;
     FeatureChain& operator=(const FeatureChain&) = delete;
     // What the chain enables, unchained.
     DeviceFeatures enabled() const {
-        DeviceFeatures d;
+        DeviceFeatures d = chained;
         d.core = features.features;
-        d.vulkan11 = f11;
-        d.vulkan12 = f12;
-        d.vulkan13 = f13;
-        d.mesh_shader = mesh;
-        d.acceleration_structure = structures;
-        d.ray_query = ray_query;
         d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
         d.mesh_shader.pNext = d.acceleration_structure.pNext = d.ray_query.pNext = nullptr;
         return d;
     }
 
-    VkPhysicalDeviceMeshShaderFeaturesEXT mesh;
-    VkPhysicalDeviceRayQueryFeaturesKHR ray_query;
-    VkPhysicalDeviceAccelerationStructureFeaturesKHR structures;
-    VkPhysicalDeviceVulkan13Features f13;
-    VkPhysicalDeviceVulkan12Features f12;
-    VkPhysicalDeviceVulkan11Features f11;
+    DeviceFeatures chained;
     VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
 };
 

@@ -353,4 +353,12 @@ GraphicsPipelineBuilder& GraphicsPipelineBuilder::rendering(Span<const VkFormat>
     return *this;
 }
 
+VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Framebuffer::extent").extent; }
+const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::Framebuffer::render_pass").render_pass;
+}
+bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
+    return live("vkrc::PipelineCache::loaded_from_file").loaded_from_file;
+}
+
 VKRC_END_NAMESPACE

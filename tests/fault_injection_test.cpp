@@ -378,7 +378,11 @@ TEST(FaultInjection, EveryFailableCallOfPresentationFailsCleanly) {
 // but that no scenario above calls (so no failure is ever injected into
 // them), with the reason each is acceptable. Any other fails the test below.
 const std::map<std::string, std::string>& never_injected_allowed() {
-    static const std::map<std::string, std::string> allowed = {};
+    static const std::map<std::string, std::string> allowed = {
+        {"vkCreateAccelerationStructureKHR",
+         "acceleration structures came after the scenarios were written; their failure paths are covered by "
+         "AccelerationStructureTest's refusals only, and a ray-tracing scenario is the next one to add"},
+    };
     return allowed;
 }
 

@@ -171,20 +171,4 @@ public:
 
 }  // namespace detail
 
-inline VkAccelerationStructureTypeKHR AccelerationStructure::type() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::AccelerationStructure::type").type;
-}
-inline VkDeviceSize AccelerationStructure::size() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::AccelerationStructure::size").size;
-}
-inline VkDeviceAddress AccelerationStructure::device_address() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::AccelerationStructure::device_address").device_address;
-}
-inline const Buffer& AccelerationStructure::buffer() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::AccelerationStructure::buffer").buffer;
-}
-inline VkBuildAccelerationStructureFlagsKHR AccelerationStructure::build_flags() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::AccelerationStructure::build_flags").build_flags;
-}
-
 VKRC_END_NAMESPACE

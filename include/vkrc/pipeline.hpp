@@ -490,15 +490,7 @@ public:
 
 }  // namespace detail
 
-inline VkExtent2D Framebuffer::extent() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::Framebuffer::extent").extent;
-}
-inline const RenderPass& Framebuffer::render_pass() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::Framebuffer::render_pass").render_pass;
-}
-inline bool PipelineCache::loaded_from_file() const VKRC_UNCHECKED_NOEXCEPT {
-    return live("vkrc::PipelineCache::loaded_from_file").loaded_from_file;
-}
+// Pipeline's accessors stay inline: bind_descriptor_set records with them.
 inline VkPipelineBindPoint Pipeline::bind_point() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Pipeline::bind_point").bind_point;
 }

@@ -73,17 +73,16 @@ namespace detail {
 // index loop rather than span iterators, because each closure type and
 // iterator instantiation costs every includer's compile (bench/header_cost).
 inline VkRenderingAttachmentInfo rendering_attachment_info(const RenderingAttachment& a) noexcept {
-    VkRenderingAttachmentInfo r{};
-    r.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO;
-    r.imageView = a.image_view;
-    r.imageLayout = a.image_layout;
-    r.loadOp = a.load_op;
-    r.storeOp = a.store_op;
-    r.clearValue = a.clear_value;
-    r.resolveMode = a.resolve_mode;
-    r.resolveImageView = a.resolve_image_view;
-    r.resolveImageLayout = a.resolve_image_layout;
-    return r;
+    return {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .pNext = nullptr,
+            .imageView = a.image_view,
+            .imageLayout = a.image_layout,
+            .resolveMode = a.resolve_mode,
+            .resolveImageView = a.resolve_image_view,
+            .resolveImageLayout = a.resolve_image_layout,
+            .loadOp = a.load_op,
+            .storeOp = a.store_op,
+            .clearValue = a.clear_value};
 }
 }  // namespace detail
 
