@@ -73,6 +73,46 @@ vkrc::Image uint_texture(const vkrc::Device& device, const vkrc::CommandBuffer& 
                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
+// shaders/bindless.comp bound to a variable-count set of 64 textures whose
+// output buffer and sampler are written; the textures are the test's.
+struct BindlessCompute {
+    explicit BindlessCompute(const vkrc::Device& device)
+        : set_layout(bindless_layout(device)),
+          pipeline(vkrc::ComputePipeline::create(vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}}),
+                                                 vkrc::ShaderModule::create(device, vkrc_shaders::bindless_comp))),
+          pool(bindless_pool(device)),
+          set(pool.allocate(set_layout, 64)),
+          out(vkrc::Buffer::create(device, {.size = 8 * sizeof(std::uint32_t),
+                                            .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                            .memory = {.usage = vkrc::MemoryUsage::readback}})) {
+        const auto nearest = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                                            .min_filter = VK_FILTER_NEAREST,
+                                                            .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST});
+        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
+        set.write_image(1, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED, nearest);
+    }
+    // Binds the set and dispatches, then makes the output visible to the host.
+    void record(const vkrc::CommandBuffer& cmd) const {
+        cmd.bind_pipeline(pipeline);
+        cmd.bind_descriptor_set(pipeline, 0, set);
+        cmd.dispatch(1);
+        const auto to_host = vkrc_test::compute_to_host();
+        cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    }
+    // What each of the 8 invocations read.
+    std::vector<std::uint32_t> results() const {
+        std::vector<std::uint32_t> data(8);
+        out.allocation().read(0, std::span(data));
+        return data;
+    }
+
+    vkrc::DescriptorSetLayout set_layout;
+    vkrc::ComputePipeline pipeline;
+    vkrc::DescriptorPool pool;
+    vkrc::DescriptorSet set;
+    vkrc::Buffer out;
+};
+
 // A variable-count set of 64 textures, 8 of them written in one call at
 // array element 10 after the set was bound (update after bind); the shader
 // picks them with a non-uniform index.
@@ -81,20 +121,7 @@ TEST_F(VulkanTest, BindlessArrayIndexedNonUniformly) {
         GTEST_SKIP() << "the device lacks descriptor indexing features: " << missing;
     device = bindless_device(physical_device);
     queue = device.default_queue();
-    auto set_layout = bindless_layout(device);
-    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
-    auto pipeline =
-        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::bindless_comp));
-    auto pool = bindless_pool(device);
-    auto set = pool.allocate(set_layout, 64);
-    auto out = vkrc::Buffer::create(device, {.size = 8 * sizeof(std::uint32_t),
-                                             .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                             .memory = {.usage = vkrc::MemoryUsage::readback}});
-    auto nearest = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
-                                                  .min_filter = VK_FILTER_NEAREST,
-                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST});
-    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
-    set.write_image(1, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED, nearest);
+    const BindlessCompute compute(device);
 
     vkrc_test::OneShotCommands s(queue);
     std::vector<vkrc::Image> textures;
@@ -103,20 +130,15 @@ TEST_F(VulkanTest, BindlessArrayIndexedNonUniformly) {
         textures.push_back(uint_texture(device, s.cmd, 100 + k));
         views.push_back(vkrc::ImageView::create(textures.back()));
     }
-    s.cmd.bind_pipeline(pipeline);
-    s.cmd.bind_descriptor_set(pipeline, 0, set);
-    s.cmd.dispatch(1);
-    const auto to_host = vkrc_test::compute_to_host();
-    s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    compute.record(s.cmd);
 
     std::vector<VkDescriptorImageInfo> infos;
     for (const auto& view : views)
         infos.push_back({VK_NULL_HANDLE, view.vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
-    set.write_images(2, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, infos, 10);
+    compute.set.write_images(2, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, infos, 10);
     s.run(queue);
 
-    std::uint32_t data[8] = {};
-    out.allocation().read(0, data, 8);
+    const auto data = compute.results();
     for (std::uint32_t i = 0; i < 8; ++i) EXPECT_EQ(data[i], 100 + (i * 3) % 8) << "invocation " << i;
 }
 
@@ -129,29 +151,12 @@ TEST_F(VulkanTest, BindlessWriteAfterEndOfObjectsDroppedBeforeSubmit) {
         GTEST_SKIP() << "the device lacks descriptor indexing features: " << missing;
     device = bindless_device(physical_device);
     queue = device.default_queue();
-    auto set_layout = bindless_layout(device);
-    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
-    auto pipeline =
-        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::bindless_comp));
-    auto pool = bindless_pool(device);
-    auto set = pool.allocate(set_layout, 64);
-    auto out = vkrc::Buffer::create(device, {.size = 8 * sizeof(std::uint32_t),
-                                             .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                             .memory = {.usage = vkrc::MemoryUsage::readback}});
-    auto nearest = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
-                                                  .min_filter = VK_FILTER_NEAREST,
-                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST});
-    set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, out);
-    set.write_image(1, VK_DESCRIPTOR_TYPE_SAMPLER, vkrc::ImageView{}, VK_IMAGE_LAYOUT_UNDEFINED, nearest);
+    const BindlessCompute compute(device);
 
     auto cmd_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = cmd_pool.allocate();
     cmd.begin();
-    cmd.bind_pipeline(pipeline);
-    cmd.bind_descriptor_set(pipeline, 0, set);
-    cmd.dispatch(1);
-    const auto to_host = vkrc_test::compute_to_host();
-    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    compute.record(cmd);
     cmd.end();
     {
         vkrc_test::OneShotCommands clear(queue);
@@ -164,7 +169,7 @@ TEST_F(VulkanTest, BindlessWriteAfterEndOfObjectsDroppedBeforeSubmit) {
             infos.push_back({VK_NULL_HANDLE, views.back().vk(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
         }
         clear.run(queue);
-        set.write_images(2, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, infos, 10);
+        compute.set.write_images(2, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, infos, 10);
     }  // the textures and their views dropped: only the set holds them
     const vkrc_test::GpuGate gate(device);
     auto fence = vkrc::Fence::create(device);
@@ -173,8 +178,7 @@ TEST_F(VulkanTest, BindlessWriteAfterEndOfObjectsDroppedBeforeSubmit) {
     gate.open();
     ASSERT_EQ(fence.wait(), VK_SUCCESS);
 
-    std::uint32_t data[8] = {};
-    out.allocation().read(0, data, 8);
+    const auto data = compute.results();
     for (std::uint32_t i = 0; i < 8; ++i) EXPECT_EQ(data[i], 200 + (i * 3) % 8) << "invocation " << i;
 }
 
