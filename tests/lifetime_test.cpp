@@ -233,13 +233,25 @@ TEST_F(VulkanTest, BufferDroppedBetweenRecordAndSubmit) {
     EXPECT_EQ(device.deferred_count(), 0u);
 }
 
-// Two logical devices of one physical device, each with work held behind its
-// own gate while its buffer, command pool and (for the second) the Device
-// handle itself are dropped (issue 33's never-tested scenario): each device's
-// deferred destruction waits for its own timeline, and the gates open in the
-// reverse order of submission.
+// The physical device for a second device: another GPU of the same name
+// when the machine has one (two NVIDIA GPUs), else the test's own (two
+// logical devices of one GPU, as on lavapipe).
+vkrc::PhysicalDevice second_physical_device(const vkrc::Instance& instance, const vkrc::PhysicalDevice& first) {
+    for (const auto& other : instance.physical_devices()) {
+        if (other.vk() != first.vk() && std::string(other.name()) == first.name()) return other;
+    }
+    return first;
+}
+
+// Two devices, each with work held behind its own gate while its buffer,
+// command pool and (for the second) the Device handle itself are dropped
+// (issue 33's never-tested scenario): each device's deferred destruction
+// waits for its own timeline, and the gates open in the reverse order of
+// submission. On two GPUs where the machine has them.
 TEST_F(VulkanTest, WorkInFlightOnTwoDevicesWithDropsOnBoth) {
-    std::optional<vkrc::Device> second = vkrc::Device::create(physical_device);
+    const vkrc::PhysicalDevice other = second_physical_device(instance, physical_device);
+    std::printf("second device: %s\n", other.vk() == physical_device.vk() ? "the same GPU" : "another GPU");
+    std::optional<vkrc::Device> second = vkrc::Device::create(other);
     struct Work {
         vkrc::Queue queue;
         vkrc::Buffer readback;
