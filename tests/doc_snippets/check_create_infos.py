@@ -39,9 +39,11 @@ def norm(text):
     return re.sub(r"\s+", "", text)
 
 
-def split_top(text, separators):
-    """Splits text at the separators that stand outside (), {}, [] and strings."""
-    parts, depth, quoted, start = [], 0, False, 0
+def top_level(text):
+    """(index, character, depth) of each character of text outside string
+    literals, depth counting the (), {} and [] open before it (a closer
+    already counted out)."""
+    depth, quoted = 0, False
     for i, c in enumerate(text):
         if c == '"':
             quoted = not quoted
@@ -51,7 +53,14 @@ def split_top(text, separators):
             depth += 1
         elif c in ")}]":
             depth -= 1
-        elif depth == 0 and c in separators:
+        yield i, c, depth
+
+
+def split_top(text, separators):
+    """Splits text at the separators that stand outside (), {}, [] and strings."""
+    parts, start = [], 0
+    for i, c, depth in top_level(text):
+        if depth == 0 and c in separators:
             parts.append((text[start:i], c))
             start = i + 1
     parts.append((text[start:], ""))
@@ -78,21 +87,11 @@ def header_structs(include_dir):
             while rest.strip():
                 # One declaration: up to ';' at depth 0, or to the '}' that
                 # ends a function's body (one not followed by ';').
-                depth, quoted, end = 0, False, None
-                for i, c in enumerate(rest):
-                    if c == '"':
-                        quoted = not quoted
-                    elif quoted:
-                        continue
-                    elif c in "({[":
-                        depth += 1
-                    elif c in ")}]":
-                        depth -= 1
-                        if (depth == 0 and c == "}" and "(" in head_of(rest[:i])
-                                and not rest[i + 1 :].lstrip().startswith((";", ","))):
-                            end = i
-                            break
-                    elif c == ";" and depth == 0:
+                end = None
+                for i, c, depth in top_level(rest):
+                    closes_body = (depth == 0 and c == "}" and "(" in head_of(rest[:i])
+                                   and not rest[i + 1 :].lstrip().startswith((";", ",")))
+                    if closes_body or (c == ";" and depth == 0):
                         end = i
                         break
                 if end is None:
