@@ -1,6 +1,7 @@
 // Adopt: objects made with the raw API enter vkrc, owned (vkrc destroys them;
 // the validation layer reports a leak at vkDestroyDevice otherwise) or
 // borrowed (their maker destroys them; a double destroy would be reported).
+#include "support/features.hpp"
 #include "support/vk_test.hpp"
 
 #include "shaders/spec_fill.comp.h"
@@ -370,27 +371,7 @@ TEST_F(VulkanTest, RawInteropRenderPassByRawHandle) {
     auto readback = vkrc::Buffer::create(
         device,
         {.size = 64, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
-    VkAttachmentDescription attachment{0,
-                                       VK_FORMAT_R8G8B8A8_UNORM,
-                                       VK_SAMPLE_COUNT_1_BIT,
-                                       VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                       VK_ATTACHMENT_STORE_OP_STORE,
-                                       VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                                       VK_ATTACHMENT_STORE_OP_DONT_CARE,
-                                       VK_IMAGE_LAYOUT_UNDEFINED,
-                                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    // The store and the layout transition are done before the copy reads.
-    VkSubpassDependency to_copy{0,
-                                VK_SUBPASS_EXTERNAL,
-                                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                                VK_ACCESS_TRANSFER_READ_BIT,
-                                0};
-    auto pass = vkrc::RenderPass::create(
-        device, {.attachments = {attachment},
-                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
-                 .dependencies = {to_copy}});
+    auto pass = vkrc_test::clear_to_copy_render_pass(device, VK_FORMAT_R8G8B8A8_UNORM);
     auto framebuffer =
         vkrc::Framebuffer::create(device, {.render_pass = pass, .attachments = {view}, .width = 4, .height = 4});
     const VkRenderPass raw_pass = pass.vk();

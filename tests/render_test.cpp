@@ -1,6 +1,7 @@
 // End-to-end GPU work through vkrc: compute writes, rendering with a render
 // pass and with dynamic rendering, read back and compared exactly; and
 // dropping every object right after submitting work that uses it.
+#include "support/features.hpp"
 #include "support/vk_test.hpp"
 
 #include "shaders/fill_pattern.comp.h"
@@ -138,27 +139,7 @@ TEST_F(VulkanTest, TriangleThroughARenderPass) {
     auto image =
         attachment_image(device, color_format, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     auto pixels = readback_buffer(device, size * size * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
-    VkAttachmentDescription color{0,
-                                  color_format,
-                                  VK_SAMPLE_COUNT_1_BIT,
-                                  VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                  VK_ATTACHMENT_STORE_OP_STORE,
-                                  VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                                  VK_ATTACHMENT_STORE_OP_DONT_CARE,
-                                  VK_IMAGE_LAYOUT_UNDEFINED,
-                                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    // The copy after the pass waits for the attachment writes.
-    VkSubpassDependency to_copy{0,
-                                VK_SUBPASS_EXTERNAL,
-                                VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                                VK_ACCESS_TRANSFER_READ_BIT,
-                                0};
-    auto render_pass = vkrc::RenderPass::create(
-        device, {.attachments = {color},
-                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
-                 .dependencies = {to_copy}});
+    auto render_pass = vkrc_test::clear_to_copy_render_pass(device, color_format);
     auto framebuffer = vkrc::Framebuffer::create(
         device,
         {.render_pass = render_pass, .attachments = {vkrc::ImageView::create(image)}, .width = size, .height = size});

@@ -191,27 +191,7 @@ ScenarioResult run_render_pass_scenario(const vkrc::InstanceCreateInfo& info) {
     auto c = make_context(info);
     const auto& device = c.device;
     constexpr std::uint32_t side = 4;
-    const VkAttachmentDescription color{0,
-                                        VK_FORMAT_R8G8B8A8_UNORM,
-                                        VK_SAMPLE_COUNT_1_BIT,
-                                        VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                        VK_ATTACHMENT_STORE_OP_STORE,
-                                        VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                                        VK_ATTACHMENT_STORE_OP_DONT_CARE,
-                                        VK_IMAGE_LAYOUT_UNDEFINED,
-                                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
-    // The copy after the pass waits for its writes and final transition.
-    const VkSubpassDependency to_copy{0,
-                                      VK_SUBPASS_EXTERNAL,
-                                      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                                      VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                      VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                                      VK_ACCESS_TRANSFER_READ_BIT,
-                                      0};
-    auto render_pass = vkrc::RenderPass::create(
-        device, {.attachments = {color},
-                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
-                 .dependencies = {to_copy}});
+    auto render_pass = vkrc_test::clear_to_copy_render_pass(device, VK_FORMAT_R8G8B8A8_UNORM);
     auto image =
         vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
                                      .extent = {side, side, 1},

@@ -60,6 +60,32 @@ struct OneShotCommands {
     }
 };
 
+// A one-subpass render pass over one colour attachment of format: cleared,
+// stored and left in TRANSFER_SRC_OPTIMAL, its writes and final transition
+// made visible to a copy after the pass.
+inline vkrc::RenderPass clear_to_copy_render_pass(const vkrc::Device& device, VkFormat format) {
+    const VkAttachmentDescription color{0,
+                                        format,
+                                        VK_SAMPLE_COUNT_1_BIT,
+                                        VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                        VK_ATTACHMENT_STORE_OP_STORE,
+                                        VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                        VK_ATTACHMENT_STORE_OP_DONT_CARE,
+                                        VK_IMAGE_LAYOUT_UNDEFINED,
+                                        VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL};
+    const VkSubpassDependency to_copy{0,
+                                      VK_SUBPASS_EXTERNAL,
+                                      VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                                      VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                      VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                                      VK_ACCESS_TRANSFER_READ_BIT,
+                                      0};
+    return vkrc::RenderPass::create(
+        device, {.attachments = {color},
+                 .subpasses = {{.color_attachments = {{0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL}}}},
+                 .dependencies = {to_copy}});
+}
+
 // A barrier making compute shader writes visible to host reads.
 inline VkMemoryBarrier2 compute_to_host() {
     return vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
