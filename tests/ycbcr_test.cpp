@@ -50,13 +50,7 @@ protected:
 TEST_F(YcbcrTest, YcbcrConversionWithSamplerAndImageView) {
     auto conversion = nv12_conversion(device);
     EXPECT_EQ(conversion.format(), nv12);
-    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
-                                                  .min_filter = VK_FILTER_NEAREST,
-                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-                                                  .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .ycbcr_conversion = conversion});
+    auto sampler = vkrc_test::ycbcr_sampler(device, conversion);
     auto image =
         vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
     auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});
@@ -95,16 +89,6 @@ TEST_F(YcbcrTest, YcbcrAdoptedConversion) {
                  vkrc::UsageError);
 }
 
-vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcrConversion& conversion) {
-    return vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
-                                          .min_filter = VK_FILTER_NEAREST,
-                                          .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-                                          .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                          .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                          .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                          .ycbcr_conversion = conversion});
-}
-
 // Shaders reach a Y'CbCr sampler only as an immutable sampler of a set layout,
 // which keeps it (and so the conversion) alive. A 4x4 NV12 image of Y' 16,
 // Cb 128, Cr 240 (BT.709, narrow range: Y 0, Cb 0, Cr 0.5) samples as
@@ -116,7 +100,7 @@ TEST_F(YcbcrTest, YcbcrSamplerImmutableInASetLayout) {
         device, {.bindings = {{.binding = 0,
                                .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT,
-                               .immutable_samplers = {ycbcr_sampler(device, conversion)}},
+                               .immutable_samplers = {vkrc_test::ycbcr_sampler(device, conversion)}},
                               {.binding = 1,
                                .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                .stage_flags = VK_SHADER_STAGE_COMPUTE_BIT}}});
@@ -190,7 +174,7 @@ TEST_F(YcbcrTest, YcbcrMisuseIsAUsageError) {
     auto other = vkrc::Device::create(physical_device, info);
     EXPECT_THROW(vkrc::Sampler::create(device, {.ycbcr_conversion = nv12_conversion(other)}), vkrc::UsageError)
         << "a conversion of another device";
-    auto sampler = ycbcr_sampler(device, nv12_conversion(device));
+    auto sampler = vkrc_test::ycbcr_sampler(device, nv12_conversion(device));
     EXPECT_THROW(vkrc::DescriptorSetLayout::create(
                      device, {.bindings = {{.binding = 0,
                                             .descriptor_type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,

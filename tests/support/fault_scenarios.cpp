@@ -67,13 +67,7 @@ bool use_ycbcr(const vkrc::PhysicalDevice& physical, const vkrc::Device& device)
                                           : VK_CHROMA_LOCATION_COSITED_EVEN;
     auto conversion = vkrc::SamplerYcbcrConversion::create(
         device, {.format = nv12, .x_chroma_offset = location, .y_chroma_offset = location});
-    auto sampler = vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
-                                                  .min_filter = VK_FILTER_NEAREST,
-                                                  .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-                                                  .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-                                                  .ycbcr_conversion = conversion});
+    auto sampler = vkrc_test::ycbcr_sampler(device, conversion);
     auto image =
         vkrc::Image::create(device, {.format = nv12, .extent = {4, 4, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT});
     auto view = vkrc::ImageView::create(image, {.ycbcr_conversion = conversion});

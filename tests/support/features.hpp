@@ -86,6 +86,18 @@ inline vkrc::RenderPass clear_to_copy_render_pass(const vkrc::Device& device, Vk
                  .dependencies = {to_copy}});
 }
 
+// A nearest, edge-clamped sampler through conversion (Y'CbCr samplers must
+// clamp to edge).
+inline vkrc::Sampler ycbcr_sampler(const vkrc::Device& device, const vkrc::SamplerYcbcrConversion& conversion) {
+    return vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST,
+                                          .min_filter = VK_FILTER_NEAREST,
+                                          .mipmap_mode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                                          .address_mode_u = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_v = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .address_mode_w = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                                          .ycbcr_conversion = conversion});
+}
+
 // A barrier making compute shader writes visible to host reads.
 inline VkMemoryBarrier2 compute_to_host() {
     return vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
