@@ -646,9 +646,19 @@ def upload_ratio(rows, upload, a, b):
     return median(ratios), ratios[0], ratios[-1]
 
 
+def upload_ratios_by_process(rows, upload, a, b):
+    """{process: [ratio of each of its blocks]}, as upload_ratios pairs them."""
+    get = {(x["process"], x["block"], x["variant"]): float(x["gb_per_s"]) for x in rows if x["upload"] == upload}
+    by_process = {}
+    for (p, k, v) in get:
+        if v == a and (p, k, b) in get:
+            by_process.setdefault(p, []).append(get[(p, k, a)] / get[(p, k, b)])
+    return by_process
+
+
 def upload_goal(rows, upload, a, b, goal):
-    """'median [95 % CI]: verdict' of a ratio goal over the blocks of every process."""
-    m, low, high = median_ci(upload_ratios(rows, upload, a, b))
+    """'median [95 % CI]: verdict' of a ratio goal, the interval bootstrapped over processes."""
+    m, low, high = process_bootstrap(upload_ratios_by_process(rows, upload, a, b))
     return f"{m:.3f} [{low:.3f}, {high:.3f}]", verdict(low, high, goal)
 
 
@@ -687,8 +697,8 @@ def upload_section(pattern, pending):
                        (f" {aa[0]:.3f} [{aa[1]:.3f}, {aa[2]:.3f}] |" if control else ""))
         raw = [upload_goal(rows, u, "vkrc-stream", "raw-stream", UPLOAD_RAW_GOAL) for u in uploads]
         small = upload_goal(rows, uploads[0], "vkrc-stream", "vkrc-blocking", UPLOAD_BLOCKING_GOAL)
-        out += ["", "Goals (the median ratio of the blocks with its 95 % confidence interval, order statistics over "
-                "the blocks of every process; met or not met only when the interval clears the goal): vkrc-stream "
+        out += ["", "Goals (the median ratio of the blocks with its 95 % interval, bootstrapped over the processes "
+                "and their blocks; met or not met only when the interval clears the goal): vkrc-stream "
                 f"at least {UPLOAD_RAW_GOAL}x raw-stream's throughput ("
                 f"{'; '.join(f'{u}: {text} {v}' for u, (text, v) in zip(uploads, raw))}: "
                 f"**{overall_verdict([v for _, v in raw])}**); at least {UPLOAD_BLOCKING_GOAL:.0f}x vkrc-blocking "
@@ -701,34 +711,68 @@ CONTENTION_GOAL_THREADS = 8
 CONTENTION_GOAL_CASE = "alloc-pool"
 
 
-def median_ci(values, confidence=0.95):
-    """The median and a distribution-free confidence interval for it: the order statistics k and n + 1 - k
-    (1-based) with k the largest rank whose binomial tail P(Bin(n, 1/2) < k) stays within (1 - confidence) / 2.
-    Below 6 values no such k exists and the interval is the whole range."""
-    v = sorted(values)
-    n = len(v)
-    k, tail = 0, 0.0
-    while True:
-        tail += math.comb(n, k) / 2 ** n
-        if tail > (1 - confidence) / 2:
-            break
-        k += 1
-    k = max(k, 1)
-    return median(v), v[k - 1], v[n - k]
+def splitmix64(state):
+    """One step of SplitMix64: (next state, output). The bootstrap's generator, so that the intervals do
+    not depend on the Python version's random module."""
+    state = (state + 0x9E3779B97F4A7C15) & 0xFFFFFFFFFFFFFFFF
+    z = state
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & 0xFFFFFFFFFFFFFFFF
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & 0xFFFFFFFFFFFFFFFF
+    return state, z ^ (z >> 31)
+
+
+def quantile(sorted_values, q):
+    """Linear interpolation between the order statistics (as bench/teapot's harness/stats.cpp)."""
+    position = q * (len(sorted_values) - 1)
+    below = math.floor(position)
+    above = min(below + 1, len(sorted_values) - 1)
+    return sorted_values[below] + (sorted_values[above] - sorted_values[below]) * (position - below)
+
+
+def process_bootstrap(by_process, resamples=2000, seed=0x7EA907):
+    """The median of every block's value and its 95 % interval from the two-level percentile bootstrap of
+    bench/teapot (harness/stats.cpp, block_bootstrap_ratio): processes resampled with replacement, then
+    blocks within each chosen process, so that the spread between processes widens the interval (pooling
+    the blocks as if independent would not). by_process: {process: [value of each block]}."""
+    runs = [sorted(v) for _, v in sorted(by_process.items()) if v]
+    pooled = sorted(x for run in runs for x in run)
+    if not pooled:
+        return 0.0, 0.0, 0.0
+    state, medians = seed, []
+    for _ in range(resamples):
+        sample = []
+        for _ in runs:
+            state, z = splitmix64(state)
+            run = runs[z % len(runs)]
+            for _ in run:
+                state, z = splitmix64(state)
+                sample.append(run[z % len(run)])
+        sample.sort()
+        medians.append(quantile(sample, 0.5))
+    medians.sort()
+    return quantile(pooled, 0.5), quantile(medians, 0.025), quantile(medians, 0.975)
 
 
 def contention_runs(pattern):
     return sorted(results(pattern, "ops_per_second"), key=lambda r: r["path"])
 
 
-def contention_ratios(rows, case, threads, repeat="1"):
-    """Per (process, block): the rate at threads (repeat) over the first thread count's (repeat 1)
-    of the same block; the counts of a block run back to back."""
+def contention_ratios_by_process(rows, case, threads, repeat="1"):
+    """{process: [per block: the rate at threads (repeat) over the first thread count's (repeat 1) of the
+    same block]}; the counts of a block run back to back."""
     first = rows[0]["threads"]
     get = {(x["process"], x["block"], x["threads"], x["repeat"]): float(x["ops_per_second"])
            for x in rows if x["case"] == case}
-    return sorted(get[(p, b, t, rep)] / get[(p, b, first, "1")] for (p, b, t, rep) in get
-                  if t == threads and rep == repeat and get.get((p, b, first, "1")))
+    by_process = {}
+    for (p, b, t, rep) in get:
+        if t == threads and rep == repeat and get.get((p, b, first, "1")):
+            by_process.setdefault(p, []).append(get[(p, b, t, rep)] / get[(p, b, first, "1")])
+    return by_process
+
+
+def contention_ratios(rows, case, threads, repeat="1"):
+    """Every block's ratio (contention_ratios_by_process), sorted."""
+    return sorted(x for v in contention_ratios_by_process(rows, case, threads, repeat).values() for x in v)
 
 
 def host_cpus(r):
@@ -742,13 +786,14 @@ def interval(values, digits=2):
 
 def contention_goal(r):
     rows = r["rows"]
-    ratios = contention_ratios(rows, CONTENTION_GOAL_CASE, str(CONTENTION_GOAL_THREADS))
+    by_process = contention_ratios_by_process(rows, CONTENTION_GOAL_CASE, str(CONTENTION_GOAL_THREADS))
+    ratios = sorted(x for v in by_process.values() for x in v)
     if not ratios:
         return f"not measured ({CONTENTION_GOAL_THREADS} threads or {CONTENTION_GOAL_CASE} missing)"
-    m, low, high = median_ci(ratios)
+    m, low, high = process_bootstrap(by_process)
     text = (f"{CONTENTION_GOAL_CASE} at {CONTENTION_GOAL_THREADS} threads: {m:.2f}x the 1-thread rate (95 % "
-            f"confidence interval of the median over the blocks [{low:.2f}, {high:.2f}]; range {ratios[0]:.2f} to "
-            f"{ratios[-1]:.2f})")
+            f"interval bootstrapped over the {len(by_process)} processes [{low:.2f}, {high:.2f}]; blocks range "
+            f"{ratios[0]:.2f} to {ratios[-1]:.2f})")
     cpus = host_cpus(r)
     v = verdict(low, high, CONTENTION_GOAL)
     verdict_text = v + (" (the interval straddles the goal)" if v == "not resolved" else "")
