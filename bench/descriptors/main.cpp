@@ -160,7 +160,8 @@ int main(int argc, char** argv) {
     if (csv) std::fprintf(csv, "case,reps,blocks,ns_per_op_median,ns_per_op_min\n");
     for (auto& c : cases) {
         std::sort(c.ns.begin(), c.ns.end());
-        const double median = c.ns[c.ns.size() / 2];
+        const std::size_t n = c.ns.size();  // an even count's median is the mean of the middle two
+        const double median = n % 2 ? c.ns[n / 2] : (c.ns[n / 2 - 1] + c.ns[n / 2]) / 2;
         std::printf("%-16s %12.0f ns per operation (median of %d blocks, min %.0f)\n", c.name, median, o.blocks,
                     c.ns.front());
         if (csv) std::fprintf(csv, "%s,%d,%d,%.1f,%.1f\n", c.name, o.reps, o.blocks, median, c.ns.front());
