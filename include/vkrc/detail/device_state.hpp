@@ -10,7 +10,6 @@
 #include "vkrc/detail/object_registry.hpp"
 
 #include <cstdint>
-#include <type_traits>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -358,11 +357,18 @@ inline void await(const Queue& queue, std::uint64_t number) { queue.device().sta
 // tickets (stream.cpp). Throws DeviceLostError on device loss.
 std::uint64_t submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits);
 
+// Whether a handle type is a pointer (std::is_pointer_v without <type_traits>,
+// which would be most of what a translation unit including vkrc parses).
+template <class T>
+inline constexpr bool is_pointer = false;
+template <class T>
+inline constexpr bool is_pointer<T*> = true;
+
 // Converts any Vulkan handle to the word stored in a DeferredAction.
 // (Pointers on 64-bit targets; non-dispatchable handles are 64-bit integers elsewhere.)
 template <class VkHandle>
 std::uint64_t handle_bits(VkHandle handle) noexcept {
-    if constexpr (std::is_pointer_v<VkHandle>) {
+    if constexpr (is_pointer<VkHandle>) {
         return reinterpret_cast<std::uintptr_t>(handle);
     } else {
         return static_cast<std::uint64_t>(handle);
@@ -370,7 +376,7 @@ std::uint64_t handle_bits(VkHandle handle) noexcept {
 }
 template <class VkHandle>
 VkHandle handle_from_bits(std::uint64_t bits) noexcept {
-    if constexpr (std::is_pointer_v<VkHandle>) {
+    if constexpr (is_pointer<VkHandle>) {
         return reinterpret_cast<VkHandle>(static_cast<std::uintptr_t>(bits));
     } else {
         return static_cast<VkHandle>(bits);
