@@ -4,7 +4,10 @@
 # overrides: more processes narrow the intervals, which include their spread). Writes
 # one CSV per configuration into OUT, each headed by '# key: value' lines
 # (device, driver, date, command, git revision) that scripts/gen_bench_docs.py
-# reads; copy them into docs/results/ and run the generator.
+# reads, and beside it NAME-blocks.csv.gz (bench/teapot --blocks-csv, the same
+# header, gzip -n so that the bytes depend on the data only): every block's
+# median, from which the generator recomputes every interval. Copy both into
+# docs/results/ and run the generator.
 #
 #   bench/device_run.sh BUILD_DIR OUT [NAME]
 #
@@ -34,21 +37,27 @@ bench_start "$build" "$out"
 run() {  # run FILE-SUFFIX teapot-args...
   local suffix=$1
   shift
-  local csv="$out/tmp-$suffix.csv" log="$out/tmp-$suffix.log"
+  local csv="$out/tmp-$suffix.csv" blocks="$out/tmp-$suffix-blocks.csv" log="$out/tmp-$suffix.log"
   set -- "$@" ${EXTRA:-}
   local command="bench/teapot --runs ${RUNS:-3}${VARIANTS:+ --variants $VARIANTS} $*"
   echo "== $command" >&2
-  "$teapot" --runs "${RUNS:-3}" ${VARIANTS:+--variants "$VARIANTS"} "$@" --csv "$csv" --out-dir "$out/teapot_out-$suffix" | tee "$log"
+  "$teapot" --runs "${RUNS:-3}" ${VARIANTS:+--variants "$VARIANTS"} "$@" --csv "$csv" --blocks-csv "$blocks" --out-dir "$out/teapot_out-$suffix" | tee "$log"
   local device
   device=$(awk -F': ' '/^device: / {print $2; exit}' "$log")
   local prefix
   prefix=$(bench_prefix "$name" "$device")
+  local header
+  header=$(bench_csv_header "$device" "$command")
   {
-    bench_csv_header "$device" "$command"
+    echo "$header"
     cat "$csv"
   } >"$out/$prefix-$suffix.csv"
-  rm -f "$csv"
-  echo "wrote $out/$prefix-$suffix.csv" >&2
+  {
+    echo "$header"
+    cat "$blocks"
+  } | gzip -n -9 >"$out/$prefix-$suffix-blocks.csv.gz"
+  rm -f "$csv" "$blocks"
+  echo "wrote $out/$prefix-$suffix.csv and $out/$prefix-$suffix-blocks.csv.gz" >&2
 }
 
 # CONFIGS (environment) picks the runs: t25, t2500, threads (the

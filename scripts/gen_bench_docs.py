@@ -12,17 +12,29 @@ written and checked like the tables.
 Every generated block sits between '<!-- generated:NAME -->' and
 '<!-- end generated:NAME -->', a generated table row ends with
 '<!-- generated-row:NAME -->'; nothing else is touched.
+A teapot run with a block file beside it (<run>-blocks.csv.gz: every
+block's median, bench/teapot --blocks-csv) has its ratio intervals
+recomputed from the blocks, with bench/teapot's own bootstrap
+(process_bootstrap); runs without one keep the intervals of their summary.
   scripts/gen_bench_docs.py          rewrite the files
   scripts/gen_bench_docs.py --check  exit 1 if a file would change (ctest docs.bench_tables)
+  scripts/gen_bench_docs.py --check-blocks [SUMMARY.csv...]
+        exit 1 unless every interval of every teapot run in docs/results/ with
+        a block file (and of each SUMMARY given, a run with its block file
+        beside it) equals the one recomputed from its blocks (ctest docs.teapot_blocks)
 Python 3 standard library only."""
 import argparse
 import csv
 import glob
+import gzip
 import io
 import math
 import os
 import re
 import sys
+from bisect import bisect_right
+from itertools import accumulate
+from operator import itemgetter
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "bench"))
@@ -32,7 +44,7 @@ STAGES = ["preinit", "acquire", "uniform", "command", "submit", "present", "wait
 
 def load(path):
     meta, lines = {}, []
-    with open(path) as f:
+    with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as f:
         for line in f:
             m = re.match(r"#\s*([^:]+):\s*(.*)", line)
             if m and not lines:
@@ -119,6 +131,7 @@ def table(result):
            f"git: {m.get('git', '?')}; host: {m.get('host', '?')}. Data: `{result['path']}`.", "",
            f"    {m.get('command', '?')}", ""]
     floor = next((r["floor_ns"] for r in rows if r["stage"] != "image" and r.get("floor_ns")), "")
+    out += [block_data_note(result), ""]
     out.append(f"Floor (an empty timed region, measured in the same run): {floor} ns. "
                "*above floor* is the median minus it.")
     out.append(f"Stages marked *GPU time* ({', '.join(GPU_TIME_STAGES)}) are the CPU waiting for the GPU, which "
@@ -157,6 +170,16 @@ def table(result):
     return out
 
 
+def block_data_note(result):
+    """Which intervals a teapot table shows: recomputed from the run's block data, or its summary's."""
+    if result.get("blocks"):
+        return (f"Block data: `{result['blocks']}` (every block's median): the ratios and "
+                "intervals below are recomputed from it by the generator, with bench/teapot's bootstrap "
+                "(ctest `docs.teapot_blocks` checks that they equal the run's own).")
+    return ("Block data: none (the run predates `bench/teapot --blocks-csv`): the ratios and intervals below are "
+            "bench/teapot's summary and cannot be recomputed.")
+
+
 def threads(row):
     # Files from before issue 17 have no threads column: one recording thread.
     return int(row.get("threads") or 1)
@@ -166,12 +189,24 @@ def is_threaded(result):
     return any(threads(x) > 1 for x in result["rows"])
 
 
+LOADED = {}  # path -> load(path), teapot runs with their intervals recomputed from their blocks
+
+
+def load_result(path):
+    if path not in LOADED:
+        r = load(path)
+        if r["rows"] and "median_us" in r["rows"][0] and os.path.exists(blocks_path(path)):
+            recompute_intervals(r, blocks_path(path), STAGES)
+        LOADED[path] = r
+    return LOADED[path]
+
+
 def results(pattern, kind="median_us", threaded=False):
     # kind: a column that tells the CSV's kind (median_us: a timed run;
     # instructions_per_call: bench/instructions.sh). Timed runs with several
     # recording threads (teapot --threads) have their own tables.
     files = sorted(glob.glob(os.path.join(ROOT, "docs", "results", "*.csv")))
-    return [r for r in map(load, files)
+    return [r for r in map(load_result, files)
             if r["rows"] and kind in r["rows"][0] and re.search(pattern, r["meta"].get("device", ""), re.I)
             and (kind != "median_us" or is_threaded(r) == threaded)]
 
@@ -287,7 +322,7 @@ def threads_table(result):
                 f"frames in flight, {config[2]} uniform write(s))", "",
                 f"Device: {m.get('device', '?')}; driver: {m.get('driver', '?')}; date: {m.get('date', '?')}; "
                 f"git: {m.get('git', '?')}; host: {m.get('host', '?')}. Data: `{result['path']}`.", "",
-                f"    {m.get('command', '?')}", "",
+                f"    {m.get('command', '?')}", "", block_data_note(result), "",
                 "Command stage per frame. Speed-up: the 1-thread run's block medians over this thread count's "
                 "(block b with block b of the same run; the thread counts run one after the other), ratio: "
                 "block-wise to raw-direct at the same thread count; 95 % intervals over blocks and runs.", "",
@@ -585,7 +620,8 @@ def headline_instruction_rows(path):
 
 
 def data_cell(r):
-    return f"`{os.path.basename(r['path'])}` (git {r['meta'].get('git', '?').split()[0]})"
+    blocks = f", block data `{os.path.basename(r['blocks'])}`" if r.get("blocks") else ""
+    return f"`{os.path.basename(r['path'])}` (git {r['meta'].get('git', '?').split()[0]}{blocks})"
 
 
 def headline_time_rows(device, pattern):
@@ -729,28 +765,153 @@ def quantile(sorted_values, q):
     return sorted_values[below] + (sorted_values[above] - sorted_values[below]) * (position - below)
 
 
+BOOTSTRAP_PICKS = {}  # (block counts of the processes, resamples, seed) -> bootstrap_picks's table
+
+
+def bootstrap_picks(shape, resamples, seed):
+    """process_bootstrap's draws for processes of shape[p] blocks: per resample, how often each block (the
+    processes' blocks laid end to end) was drawn, and the sample's size. SplitMix64, one output a pick
+    (modulo the count): a process, then as many of its blocks as it has, as many processes as there are.
+    The draws depend on the shape only, so they are made once for every set of values of that shape."""
+    key = (shape, resamples, seed)
+    if key in BOOTSTRAP_PICKS:
+        return BOOTSTRAP_PICKS[key]
+    offsets = [0] + list(accumulate(shape))[:-1]
+    state, table = seed, []
+    for _ in range(resamples):
+        counts, size = [0] * sum(shape), 0
+        for _ in shape:
+            state, z = splitmix64(state)
+            run = z % len(shape)
+            size += shape[run]
+            for _ in range(shape[run]):
+                state, z = splitmix64(state)
+                counts[offsets[run] + z % shape[run]] += 1
+        table.append((counts, size))
+    BOOTSTRAP_PICKS[key] = table
+    return table
+
+
 def process_bootstrap(by_process, resamples=2000, seed=0x7EA907):
     """The median of every block's value and its 95 % interval from the two-level percentile bootstrap of
     bench/teapot (harness/stats.cpp, block_bootstrap_ratio): processes resampled with replacement, then
     blocks within each chosen process, so that the spread between processes widens the interval (pooling
-    the blocks as if independent would not). by_process: {process: [value of each block]}."""
+    the blocks as if independent would not). by_process: {process: [value of each block]}, processes in
+    key order, each one's values sorted: bench/teapot draws the same picks from the same generator
+    (bootstrap_picks), so the two agree to the last bit. Each resample's median is read off the pooled
+    values in order, weighted by how often each was drawn: the same number as sorting the sample."""
     runs = [sorted(v) for _, v in sorted(by_process.items()) if v]
-    pooled = sorted(x for run in runs for x in run)
-    if not pooled:
+    flat = [x for run in runs for x in run]
+    if not flat:
         return 0.0, 0.0, 0.0
-    state, medians = seed, []
-    for _ in range(resamples):
-        sample = []
-        for _ in runs:
-            state, z = splitmix64(state)
-            run = runs[z % len(runs)]
-            for _ in run:
-                state, z = splitmix64(state)
-                sample.append(run[z % len(run)])
-        sample.sort()
-        medians.append(quantile(sample, 0.5))
+    order = sorted(range(len(flat)), key=flat.__getitem__)
+    pooled = [flat[i] for i in order]
+    in_order = itemgetter(*order) if len(order) > 1 else (lambda counts: (counts[order[0]],))
+    medians = []
+    for counts, size in bootstrap_picks(tuple(map(len, runs)), resamples, seed):
+        below_count = list(accumulate(in_order(counts)))  # how many drawn values are pooled[0..i]
+        position = 0.5 * (size - 1)  # quantile()'s arithmetic on the sorted sample
+        below = math.floor(position)
+        low = pooled[bisect_right(below_count, below)]
+        high = pooled[bisect_right(below_count, min(below + 1, size - 1))]
+        medians.append(low + (high - low) * (position - below))
     medians.sort()
     return quantile(pooled, 0.5), quantile(medians, 0.025), quantile(medians, 0.975)
+
+
+# ---- teapot block data: the intervals recomputed -------------------------
+
+def blocks_path(path):
+    """A teapot results file's block data: docs/results/NAME.csv -> docs/results/NAME-blocks.csv.gz."""
+    return re.sub(r"\.csv$", "-blocks.csv.gz", path)
+
+
+def load_blocks(path):
+    """{(configuration, variant, stage): {process: [each block's median in block order]}} of a
+    bench/teapot --blocks-csv file (gzip, '# key: value' header lines)."""
+    blocks = {}
+    for x in load(path)["rows"]:
+        values = blocks.setdefault((x["config"], x["variant"], x["stage"]), {}).setdefault(int(x["process"]), [])
+        if int(x["block"]) != len(values):
+            sys.exit(f"{path}: block {x['block']} of process {x['process']}, {x['config']} {x['variant']} "
+                     f"{x['stage']} out of order")
+        values.append(float(x["median_us"]))
+    return blocks
+
+
+def config_tag(row):
+    """bench/teapot's config_tag of a summary row's configuration: how its block file names it."""
+    tag = f"t{row['teapots']}_f{row['frames_in_flight']}_u{row['uniform_writes']}_s{row['tessellation']}"
+    return tag + (f"_n{threads(row)}" if threads(row) != 1 else "")
+
+
+def block_ratios(blocks, numerator, denominator):
+    """{process: [numerator's block b over denominator's block b]}, paired as bench/teapot's block_pairs
+    pairs them (the same process, block b with block b; blocks over a zero left out)."""
+    theirs = blocks.get(denominator, {})
+    return {p: [a / b for a, b in zip(mine, theirs.get(p, [])) if b > 0]
+            for p, mine in blocks.get(numerator, {}).items()}
+
+
+def teapot_intervals(row, blocks, to_raw=True):
+    """{column: value as bench/teapot writes it} of every interval a summary row has, recomputed from the
+    blocks: the ratio to the reference (and the block count behind it), to raw where raw ran (unless
+    to_raw is false: no table shows it) and the speed-up over the 1-thread configuration where it ran."""
+    tag, v, s = config_tag(row), row["variant"], row["stage"]
+    out = {}
+
+    def put(columns, by_process):
+        out.update(zip(columns, (f"{x:.4f}" for x in process_bootstrap(by_process))))
+
+    to_ref = block_ratios(blocks, (tag, v, s), (tag, row["reference"], s))
+    put(("ratio_to_ref", "ref_ci_low", "ref_ci_high"), to_ref)
+    out["blocks"] = str(sum(map(len, to_ref.values())))
+    if to_raw and (tag, "raw", s) in blocks:
+        put(("ratio_to_raw", "ratio_ci_low", "ratio_ci_high"), block_ratios(blocks, (tag, v, s), (tag, "raw", s)))
+    base = re.sub(r"_n\d+$", "", tag)
+    if base != tag and (base, v, s) in blocks:
+        put(("speedup", "speedup_ci_low", "speedup_ci_high"), block_ratios(blocks, (base, v, s), (tag, v, s)))
+    return out
+
+
+def recompute_intervals(result, blocks_file, stages):
+    """A teapot run's rows of the given stages take the intervals the tables show recomputed from its
+    block data, blocks_file (result['blocks'] names it); the other rows and columns keep their summary's (the
+    bootstrap takes a tenth of a second for 16 processes of 100 blocks: what no table shows is left)."""
+    result["blocks"] = os.path.relpath(blocks_file, ROOT)
+    blocks = load_blocks(blocks_file)
+    for row in result["rows"]:
+        if row["stage"] in stages:
+            row.update(teapot_intervals(row, blocks, to_raw=False))
+
+
+def check_blocks(extra):
+    """--check-blocks: every interval of every teapot run with block data (docs/results/ and extra) against
+    the one recomputed from its blocks; the differences, or none."""
+    extra = [os.path.abspath(p) for p in extra]
+    files = sorted(glob.glob(os.path.join(ROOT, "docs", "results", "*.csv"))) + extra
+    problems, checked = [], []
+    for path in files:
+        r = load(path)
+        if not (r["rows"] and "median_us" in r["rows"][0]):
+            continue
+        if not os.path.exists(blocks_path(path)):
+            if path in extra:
+                problems.append(f"{r['path']}: no block file {os.path.basename(blocks_path(path))}")
+            continue
+        blocks, count = load_blocks(blocks_path(path)), 0
+        for row in r["rows"]:
+            if row["stage"] == "image":
+                continue
+            for column, value in teapot_intervals(row, blocks).items():
+                count += 1
+                if row[column] != value:
+                    problems.append(f"{r['path']}: {config_tag(row)} {row['variant']} {row['stage']} {column}: "
+                                    f"summary {row[column] or '(empty)'}, from the blocks {value}")
+        checked.append(f"{r['path']} ({count} values)")
+    if not checked:
+        problems.append("no teapot run with block data to check")
+    return checked, problems
 
 
 def contention_runs(pattern):
@@ -1039,7 +1200,13 @@ def check_tables(text, path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true")
+    parser.add_argument("--check-blocks", nargs="*", metavar="SUMMARY")
     args = parser.parse_args()
+    if args.check_blocks is not None:
+        checked, problems = check_blocks(args.check_blocks)
+        print("checked against their block data: " + ", ".join(checked))
+        sys.exit("\n".join(["gen_bench_docs.py --check-blocks: intervals differ from their blocks':"] + problems)
+                 if problems else 0)
     changed = []
     for name in ("docs/benchmarks.md", "README.md"):
         path = os.path.join(ROOT, name)

@@ -29,6 +29,7 @@
 #endif
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -83,6 +84,7 @@ struct Options {
     bool sweep = false;
     bool instructions = false;
     std::string csv;
+    std::string blocks_csv;  // --blocks-csv: every block's median, what the intervals come from
     std::string out_dir;
     std::optional<std::uint64_t> seed;
     // Hidden: set by the parent for each child process.
@@ -105,10 +107,12 @@ std::string default_out_dir() {
                  "usage: teapot [--frames N] [--runs N] [--seed N] [--variants a,b,...] [--teapots N]\n"
                  "              [--frames-in-flight N] [--uniform-writes N] [--tessellation N] [--sweep]\n"
                  "              [--csv PATH] [--out-dir DIR] [--size WxH] [--validation] [--window]\n"
-                 "              [--instructions] [--threads N[,N...]]\n"
+                 "              [--instructions] [--threads N[,N...]] [--blocks-csv PATH]\n"
                  "--runs N: N fresh processes (default 3), their blocks pooled; --seed fixes the shuffles\n"
                  "--out-dir: plots, frames and the CSV (default: teapot_out next to this executable);\n"
                  "           --png-dir is the old name\n"
+                 "--blocks-csv PATH: also every block's median per process, configuration, variant and\n"
+                 "          stage: the data every ratio's interval is bootstrapped from\n"
                  "--window: each variant presents to its own window through a swapchain (needs a display,\n"
                  "          e.g. tests/with_xvfb.sh); the default renders headless into a ring of images\n"
                  "--instructions: for callgrind (bench/instructions.sh): --frames calls of each stage per\n"
@@ -210,6 +214,7 @@ Options parse(int argc, char** argv) {
         else if (a == "--sweep") o.sweep = true;
         else if (a == "--instructions") o.instructions = true;
         else if (a == "--csv") o.csv = value();
+        else if (a == "--blocks-csv") o.blocks_csv = value();
         else if (a == "--out-dir" || a == "--png-dir") o.out_dir = value();
         else if (a == "--size") parse_size(a, value(), o.config);
         else if (a == "--validation") o.config.validation = true;
@@ -1088,11 +1093,16 @@ std::string stage_columns(const StageRow& row, const ConfigAnalysis& r) {
 // recording threads (the last columns, so that older files, which lack them,
 // read as 1 thread); speedup and its interval are filled for threads > 1 when
 // the 1-thread configuration ran too.
-void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& results) {
+std::ofstream open_output(const std::string& path) {
     std::filesystem::path parent = std::filesystem::path(path).parent_path();
     if (!parent.empty()) std::filesystem::create_directories(parent);
     std::ofstream out(path);
     if (!out) throw std::runtime_error("cannot write " + path);
+    return out;
+}
+
+void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& results) {
+    std::ofstream out = open_output(path);
     out << "variant,stage,teapots,frames_in_flight,uniform_writes,tessellation,frames,median_us,p5_us,p95_us,"
            "reference,ratio_to_ref,ref_ci_low,ref_ci_high,ratio_to_raw,ratio_ci_low,ratio_ci_high,floor_ns,"
            "above_floor_ns,target,verdict,runs,blocks,geometric_max_error,geometric_rms_error,geometric_max_error_px,"
@@ -1110,6 +1120,31 @@ void write_csv(const std::string& path, const std::vector<ConfigAnalysis>& resul
             out << line << errors << "," << c.threads << ",,,\n";
         }
     }
+}
+
+// --blocks-csv: one row per process (from 1), configuration (config_tag),
+// variant, stage and block (from 0, in the order run), holding the block's
+// median in microseconds as the shortest text that reads back as the same
+// double. Every ratio interval of write_csv is bootstrapped from these: a
+// variant's block b over the reference's (or raw's) block b of the same
+// process and configuration (the same round), and the speed-up the 1-thread
+// configuration's block b over the threaded one's; scripts/gen_bench_docs.py
+// recomputes them from this file.
+void write_blocks_csv(const std::string& path, const std::vector<RunData>& runs) {
+    std::ofstream out = open_output(path);
+    out << "process,config,variant,stage,block,median_us\n";
+    char number[32];
+    for (std::size_t p = 0; p < runs.size(); ++p)
+        for (const ConfigRun& r : runs[p].configs) {
+            const std::string prefix = std::to_string(p + 1) + "," + config_tag(r.config) + ",";
+            for (const VariantRun& v : r.variants)
+                for (int s = 0; s < stage_count; ++s)
+                    for (std::size_t b = 0; b < v.blocks[s].size(); ++b) {
+                        *std::to_chars(number, number + sizeof number - 1, median_of(v.blocks[s][b])).ptr = '\0';
+                        out << prefix << v.name << ',' << stage_names[s] << ',' << b << ',' << number << '\n';
+                    }
+        }
+    if (!out) throw std::runtime_error("cannot write " + path);
 }
 
 void write_plots(const std::string& dir, const ConfigAnalysis& a) {
@@ -1168,8 +1203,9 @@ void print_frame_costs(const ConfigAnalysis& a) {
                         format_ratio(row.to_ref).c_str());
 }
 
-void report(const std::vector<ConfigAnalysis>& results, const Options& options, const std::string& device,
+void report(const std::vector<ConfigAnalysis>& results, const std::vector<RunData>& runs, const Options& options,
             std::uint64_t seed) {
+    const std::string& device = runs.at(0).device;
     std::printf("device: %s\nseed: %llu (--seed %llu repeats the shuffles)\n", device.c_str(), (unsigned long long)seed,
                 (unsigned long long)seed);
     for (const ConfigAnalysis& r : results) print_table(r);
@@ -1178,6 +1214,7 @@ void report(const std::vector<ConfigAnalysis>& results, const Options& options, 
         print_threads(results);
     if (options.sweep) print_sweep(results, options);
     write_csv(options.csv, results);
+    if (!options.blocks_csv.empty()) write_blocks_csv(options.blocks_csv, runs);
     std::filesystem::create_directories(options.out_dir);
     for (const ConfigAnalysis& r : results) write_plots(options.out_dir, r);
     write_speedup_plots(options.out_dir, results);
@@ -1274,7 +1311,7 @@ int run(int argc, char** argv) {
     }
     std::vector<RunData> runs = run_processes(options, argc, argv, seed);
     std::vector<ConfigAnalysis> results = analyse(runs, options);
-    report(results, options, runs.at(0).device, seed);
+    report(results, runs, options, seed);
     return exit_status(results);
 }
 

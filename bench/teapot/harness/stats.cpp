@@ -16,6 +16,23 @@ double sorted_quantile(const std::vector<double>& sorted, double q) {
     return sorted[below] + (sorted[above] - sorted[below]) * fraction;
 }
 
+// SplitMix64 (Steele, Lea and Flood, 2014), the block bootstrap's generator:
+// scripts/gen_bench_docs.py steps the same one, so it recomputes every
+// interval from the block data bit for bit (std::mt19937_64 and its
+// distributions have no exact counterpart in Python's standard library).
+struct SplitMix64 {
+    std::uint64_t state;
+    std::uint64_t next() {
+        std::uint64_t z = state += 0x9E3779B97F4A7C15ull;
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    // An index below n: the output modulo n (the bias, under n / 2^64, is nil
+    // for block counts).
+    std::size_t pick(std::size_t n) { return std::size_t(next() % n); }
+};
+
 }  // namespace
 
 double quantile(std::span<const double> samples, double q) {
@@ -60,28 +77,30 @@ Ratio bootstrap_ratio(std::span<const double> variant, std::span<const double> r
 }
 
 Ratio block_bootstrap_ratio(const std::vector<std::vector<double>>& ratios, int resamples, std::uint64_t seed) {
+    // Each run sorted, as scripts/gen_bench_docs.py's process_bootstrap takes
+    // them: the same picks then give the same samples there.
+    std::vector<std::vector<double>> runs;
     std::vector<double> pooled;
-    std::vector<const std::vector<double>*> runs;
     for (const auto& run : ratios)
         if (!run.empty()) {
-            runs.push_back(&run);
+            runs.push_back(run);
+            std::sort(runs.back().begin(), runs.back().end());
             pooled.insert(pooled.end(), run.begin(), run.end());
         }
     if (pooled.empty()) return {};
     Ratio r;
     r.ratio = quantile(pooled, 0.5);
-    std::mt19937_64 rng(seed);
-    std::uniform_int_distribution<std::size_t> pick_run(0, runs.size() - 1);
+    SplitMix64 rng{seed};
     std::vector<double> medians, sample;
     medians.reserve(resamples);
     for (int i = 0; i < resamples; ++i) {
         sample.clear();
         for (std::size_t k = 0; k < runs.size(); ++k) {
-            const std::vector<double>& run = *runs[runs.size() > 1 ? pick_run(rng) : 0];
-            std::uniform_int_distribution<std::size_t> pick_block(0, run.size() - 1);
-            for (std::size_t b = 0; b < run.size(); ++b) sample.push_back(run[pick_block(rng)]);
+            const std::vector<double>& run = runs[rng.pick(runs.size())];
+            for (std::size_t b = 0; b < run.size(); ++b) sample.push_back(run[rng.pick(run.size())]);
         }
-        medians.push_back(quantile(sample, 0.5));
+        std::sort(sample.begin(), sample.end());
+        medians.push_back(sorted_quantile(sample, 0.5));
     }
     std::sort(medians.begin(), medians.end());
     r.low = sorted_quantile(medians, 0.025);

@@ -33,7 +33,10 @@ Ratio bootstrap_ratio(std::span<const double> variant, std::span<const double> r
 // median of all blocks' ratios; the 95% interval comes from a two-level
 // percentile bootstrap (runs resampled with replacement, then blocks within
 // each chosen run), so both block-to-block and run-to-run spread widen it.
-// Fixed seed: reproducible. Empty input gives {0, 0, 0}.
+// Fixed seed: reproducible, and with SplitMix64 and the pick order of
+// scripts/gen_bench_docs.py's process_bootstrap, which recomputes the
+// intervals from the committed block data and must agree exactly. Empty
+// input gives {0, 0, 0}.
 Ratio block_bootstrap_ratio(const std::vector<std::vector<double>>& ratios, int resamples = 2000,
                             std::uint64_t seed = 0x7ea907);
 
