@@ -13,8 +13,8 @@
 
 namespace {
 
-using raytrace::Meshlets;
 using raytrace::MeshletLimits;
+using raytrace::Meshlets;
 
 // Every meshlet within limits, its vertices distinct, and its triangles, read back through its
 // vertices, are indices (plus base_vertex) in order from the first index on.

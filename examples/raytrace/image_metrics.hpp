@@ -16,10 +16,10 @@
 namespace raytrace {
 
 struct ImageDifference {
-    std::size_t pixels = 0;                // compared
-    std::size_t differing_pixels = 0;      // with any of R, G, B different
-    int max_channel_difference = 0;        // 0..255
-    double mean_squared_error = 0;         // over every R, G and B value
+    std::size_t pixels = 0;                                    // compared
+    std::size_t differing_pixels = 0;                          // with any of R, G, B different
+    int max_channel_difference = 0;                            // 0..255
+    double mean_squared_error = 0;                             // over every R, G and B value
     double psnr_db = std::numeric_limits<double>::infinity();  // 10 log10(255^2 / MSE); infinite when equal
 };
 

@@ -2,13 +2,14 @@
 // paths, each measured against the rasterised image of the same camera. Written only against vkrc
 // (no raw Vulkan call; ctest examples.raytrace_no_raw_vulkan checks it).
 //     raytrace [--path raster|mesh] [--compare] [--frames N] [--validation]          a window
-//     raytrace --headless [--path P] [--compare] [--out FILE.png] [--frames N] [--validation]
+//     raytrace --headless [--path P] [--compare [--csv FILE]] [--out FILE.png] [--frames N] [--validation]
 // Paths: raster (a vertex shader, one indexed draw per instance) and mesh (a mesh shader over
 // meshlets of the same meshes, meshlets.hpp). --compare also draws the rasterised reference every
 // frame, into an image of its own, and reports each path's GPU time per frame (timestamps, median
 // over the frames) and the chosen path's difference from the reference (image_metrics.hpp):
 // differing pixels, max channel difference, PSNR. It exits with status 1 when the difference is
-// beyond the path's tolerance (PathInfo). The window or PNG shows the chosen path.
+// beyond the path's tolerance (PathInfo). The window or PNG shows the chosen path. With --compare,
+// --csv FILE also writes those figures as CSV, a row per path (bench/raytrace_run.sh).
 //
 // A path is a ScenePath: it draws the scene into its own image and leaves it a transfer source;
 // the frame loop times it, blits its image to the presented one and compares it. Another path
@@ -28,10 +29,13 @@
 #include "support/window_or_headless.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <array>
 #include <cstring>
 #include <memory>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -53,12 +57,15 @@ struct PathInfo {
     raytrace::ImageTolerance tolerance;
 };
 constexpr std::array<PathInfo, 2> path_infos = {{{RenderPath::raster, "raster", {}}, {RenderPath::mesh, "mesh", {}}}};
-const PathInfo& info_of(RenderPath path) { return path_infos[std::size_t(path)]; }
+const PathInfo& info_of(RenderPath path) {
+    return *std::find_if(path_infos.begin(), path_infos.end(), [&](const PathInfo& p) { return p.path == path; });
+}
 
 // The raytrace example's own options, beside those of window_or_headless.hpp.
 struct PathOptions {
     RenderPath path = RenderPath::raster;
     bool compare = false;
+    std::string csv_file;  // empty: none
 };
 
 // shaders/raytrace_scene.glsl's push constants: an instance.
@@ -88,7 +95,8 @@ public:
     GraphicsPath(const vkrc::Queue& queue, const Scene& scene, const vkrc::Buffer& uniforms, bool mesh_shading)
         : device_(queue.device()), mesh_shading_(mesh_shading) {
         const auto& g = scene.geometry;
-        const VkShaderStageFlags geometry_stage = mesh_shading ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT;
+        const VkShaderStageFlags geometry_stage =
+            mesh_shading ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT;
         stages_ = geometry_stage | VK_SHADER_STAGE_FRAGMENT_BIT;
         vkrc::DescriptorSetLayoutCreateInfo set_info{.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages_}}};
         const VkBufferUsageFlags vertex_usage =
@@ -136,9 +144,12 @@ public:
             device_, {.set_layouts = {set_layout}, .push_constant_ranges = {{stages_, 0, sizeof(InstanceConstants)}}});
         vkrc::GraphicsPipelineBuilder builder(layout_);
         if (mesh_shading) {
-            builder.shader(VK_SHADER_STAGE_MESH_BIT_EXT, vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_mesh_mesh));
+            builder.shader(VK_SHADER_STAGE_MESH_BIT_EXT,
+                           vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_mesh_mesh));
         } else {
-            builder.shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_raster_vert))
+            builder
+                .shader(VK_SHADER_STAGE_VERTEX_BIT,
+                        vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_raster_vert))
                 .vertex_binding(0, sizeof(glm::vec3))  // positions
                 .vertex_binding(1, sizeof(glm::vec3))  // normals
                 .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0)
@@ -156,13 +167,12 @@ public:
     void resize(VkExtent2D extent) override {
         extent_ = extent;
         const VkExtent3D e{extent.width, extent.height, 1};
-        colour_ = vkrc::Image::create(device_, {.format = colour_format,
-                                                .extent = e,
-                                                .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT |
-                                                         VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
-        depth_ = vkrc::Image::create(device_, {.format = depth_format,
-                                               .extent = e,
-                                               .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT});
+        colour_ = vkrc::Image::create(device_,
+                                      {.format = colour_format,
+                                       .extent = e,
+                                       .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+        depth_ = vkrc::Image::create(
+            device_, {.format = depth_format, .extent = e, .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT});
         colour_view_ = vkrc::ImageView::create(colour_);
         depth_view_ = vkrc::ImageView::create(depth_);
     }
@@ -196,7 +206,8 @@ public:
             else cmd.draw_indexed(d.mesh.index_count, 1, d.mesh.first_index, d.mesh.vertex_offset);
         }
         cmd.end_rendering();
-        cmd.pipeline_barrier({}, {}, std::array{vkrc::image_barrier(colour_, use::colour_attachment_write, use::transfer_src)});
+        cmd.pipeline_barrier({}, {},
+                             std::array{vkrc::image_barrier(colour_, use::colour_attachment_write, use::transfer_src)});
     }
 
     const vkrc::Image& output() const override { return colour_; }
@@ -224,8 +235,8 @@ private:
 std::unique_ptr<ScenePath> make_path(RenderPath path, const vkrc::Queue& queue, const Scene& scene,
                                      const vkrc::Buffer& uniforms) {
     switch (path) {
-    case RenderPath::raster: return std::make_unique<GraphicsPath>(queue, scene, uniforms, false);
-    case RenderPath::mesh: return std::make_unique<GraphicsPath>(queue, scene, uniforms, true);
+        case RenderPath::raster: return std::make_unique<GraphicsPath>(queue, scene, uniforms, false);
+        case RenderPath::mesh: return std::make_unique<GraphicsPath>(queue, scene, uniforms, true);
     }
     throw std::logic_error("unknown render path");
 }
@@ -271,9 +282,7 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
     constexpr VkImageUsageFlags presented_usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     if (options.headless)
         headless = vkrc::HeadlessPresenter::create(
-            queue, {.extent = {480, 270},
-                    .format = colour_format,
-                    .image_usage = presented_usage});
+            queue, {.extent = {480, 270}, .format = colour_format, .image_usage = presented_usage});
     else
         swapchain = vkrc::Swapchain::create(  // unorm, as the paths' images: the blit copies the values
             queue, window.surface,
@@ -382,7 +391,8 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
                         chosen.compare && p == 0 ? " (reference)" : "", median(path_ms[p]), path_ms[p].size());
     }
     if (options.headless) vkrc_examples::save_last_frame(headless, options.out_file);
-    if (!chosen.compare || extent.width == 0) return 0;
+    if (!chosen.compare) return 0;
+    if (extent.width == 0) throw std::runtime_error("--compare: no frame was drawn, nothing to compare");
     auto pixels = [&](const ScenePath& p) {
         const auto bytes = vkrc::download_image(queue, p.output(), use::transfer_src.layout);
         return std::vector<std::uint8_t>(reinterpret_cast<const std::uint8_t*>(bytes.data()),
@@ -391,10 +401,26 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
     const auto d = raytrace::compare_images(pixels(*paths[0]), pixels(*paths[1]));
     const auto& tolerance = info_of(chosen.path).tolerance;
     const bool matches = raytrace::within(d, tolerance);
-    std::printf("%s against raster: %zu of %zu pixels differ, max channel difference %d, PSNR %.2f dB: %s "
-                "(tolerance: %zu pixels, %d per channel)\n",
-                info_of(chosen.path).name, d.differing_pixels, d.pixels, d.max_channel_difference, d.psnr_db,
-                matches ? "matches" : "DOES NOT MATCH", tolerance.differing_pixels, tolerance.max_channel_difference);
+    std::printf(
+        "%s against raster: %zu of %zu pixels differ, max channel difference %d, PSNR %.2f dB: %s "
+        "(tolerance: %zu pixels, %d per channel)\n",
+        info_of(chosen.path).name, d.differing_pixels, d.pixels, d.max_channel_difference, d.psnr_db,
+        matches ? "matches" : "DOES NOT MATCH", tolerance.differing_pixels, tolerance.max_channel_difference);
+    if (!chosen.csv_file.empty()) {
+        // The reference's row: its difference from itself.
+        const std::array<raytrace::ImageDifference, 2> differences{raytrace::ImageDifference{.pixels = d.pixels}, d};
+        std::ofstream csv(chosen.csv_file);
+        csv << "path,width,height,frames,median_ms,differing_pixels,max_channel_difference,psnr_db\n";
+        for (std::size_t p = 0; p < paths.size(); ++p) {
+            csv << info_of(drawn[p]).name << ',' << extent.width << ',' << extent.height << ',' << path_ms[p].size()
+                << ',';
+            if (!path_ms[p].empty()) csv << median(path_ms[p]);  // empty without timestamps
+            csv << ',' << differences[p].differing_pixels << ',' << differences[p].max_channel_difference << ','
+                << differences[p].psnr_db << '\n';
+        }
+        if (!csv) throw std::runtime_error("cannot write " + chosen.csv_file);
+        std::printf("wrote %s\n", chosen.csv_file.c_str());
+    }
     return matches ? 0 : 1;
 }
 
@@ -407,6 +433,8 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i) {
         if (std::strcmp(argv[i], "--compare") == 0) {
             chosen.compare = true;
+        } else if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
+            chosen.csv_file = argv[++i];
         } else if (std::strcmp(argv[i], "--path") == 0) {
             const auto known = std::find_if(path_infos.begin(), path_infos.end(), [&](const PathInfo& p) {
                 return i + 1 < argc && std::string_view(argv[i + 1]) == p.name;
@@ -423,7 +451,12 @@ int main(int argc, char** argv) {
             rest.push_back(argv[i]);
         }
     }
+    if (!chosen.csv_file.empty() && !chosen.compare) {
+        std::fprintf(stderr, "%s: --csv writes what --compare measures: add --compare\n", argv[0]);
+        return 2;
+    }
     return vkrc_examples::run_example(
         int(rest.size()), rest.data(), "raytrace",
-        [&](const vkrc_examples::WindowOrHeadless& o) { return run(o, chosen); }, " [--path raster|mesh] [--compare]");
+        [&](const vkrc_examples::WindowOrHeadless& o) { return run(o, chosen); },
+        " [--path raster|mesh] [--compare [--csv FILE]]");
 }

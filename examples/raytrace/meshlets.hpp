@@ -66,7 +66,8 @@ std::uint32_t append_meshlets(std::span<const Index> indices, Meshlets& out, std
     std::vector<std::uint32_t> local;
     Meshlet m{std::uint32_t(out.vertices.size()), 0, std::uint32_t(out.triangles.size()), 0};
     auto close = [&] {
-        for (std::uint32_t i = 0; i < m.vertex_count; ++i) local[out.vertices[m.vertex_offset + i] - base_vertex] = none;
+        for (std::uint32_t i = 0; i < m.vertex_count; ++i)
+            local[out.vertices[m.vertex_offset + i] - base_vertex] = none;
         out.meshlets.push_back(m);
         m = {std::uint32_t(out.vertices.size()), 0, std::uint32_t(out.triangles.size()), 0};
     };

@@ -22,7 +22,8 @@ inline constexpr std::array<int, renderer::teapots.size()> teapot_levels = {16, 
 inline constexpr std::array<glm::vec4, 3> colours = {{{0.55f, 0.52f, 0.45f, 1.0f},    // the ground
                                                       {0.80f, 0.25f, 0.18f, 1.0f},    // renderer texture 1's teapots
                                                       {0.20f, 0.35f, 0.80f, 1.0f}}};  // texture 2's
-inline constexpr std::array<float, 4> background = {0.45f, 0.6f, 0.9f, 1.0f};  // the clear colour and the ray tracer's miss
+// The clear colour, and what a ray tracer's miss shader returns.
+inline constexpr std::array<float, 4> background = {0.45f, 0.6f, 0.9f, 1.0f};
 
 // A mesh: indices [first_index, + index_count) of Geometry::indices, which
 // index vertices from vertex_offset of its positions and normals.
@@ -58,9 +59,10 @@ inline std::uint32_t add_mesh(Geometry& g, const teapot::Mesh& m) {
 
 inline Scene make_scene() {
     Scene s;
-    const float h = renderer::ground_half_size;  // the ground: a square in the model's z-up xy plane, as the renderer's
-    add_mesh(s.geometry,
-             {{{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}}, std::vector(4, glm::vec3(0, 0, 1)), {0, 1, 2, 0, 2, 3}, {}});
+    // The ground: the renderer's square, in the model's z-up xy plane.
+    const float h = renderer::ground_half_size;
+    const std::vector<glm::vec3> corners = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}};
+    add_mesh(s.geometry, {corners, std::vector(4, glm::vec3(0, 0, 1)), {0, 1, 2, 0, 2, 3}, {}});
     s.mesh_levels.push_back(0);
     s.instances.push_back(
         {glm::translate(glm::mat4(1.0f), glm::vec3(0.0f, 0.0f, -8.0f)) * renderer::z_up_to_y_up(), colours[0], 0});
