@@ -14,8 +14,8 @@
 // A path is a ScenePath: it draws the scene into its own image and leaves it a transfer source;
 // the frame loop times it, blits its image to the presented one and compares it. Another path
 // (a ray tracer: one bottom-level structure per mesh of scene.hpp, one instance per Instance,
-// shaders/raytrace_shading.glsl for its closest-hit) adds a RenderPath, a PathInfo and a case in
-// make_path.
+// shaders/raytrace_shading.glsl for its closest-hit) adds a RenderPath, a PathInfo, its device
+// features in require and a case in make_path.
 #include <vkrc/glfw.hpp>
 #include <vkrc/vkrc.hpp>
 
@@ -29,9 +29,9 @@
 #include "support/window_or_headless.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <array>
 #include <cstring>
+#include <fstream>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -93,75 +93,22 @@ public:
 class GraphicsPath final : public ScenePath {
 public:
     GraphicsPath(const vkrc::Queue& queue, const Scene& scene, const vkrc::Buffer& uniforms, bool mesh_shading)
-        : device_(queue.device()), mesh_shading_(mesh_shading) {
+        : device_(queue.device()),
+          mesh_shading_(mesh_shading),
+          stages_((mesh_shading ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT) |
+                  VK_SHADER_STAGE_FRAGMENT_BIT) {
         const auto& g = scene.geometry;
-        const VkShaderStageFlags geometry_stage =
-            mesh_shading ? VK_SHADER_STAGE_MESH_BIT_EXT : VK_SHADER_STAGE_VERTEX_BIT;
-        stages_ = geometry_stage | VK_SHADER_STAGE_FRAGMENT_BIT;
-        vkrc::DescriptorSetLayoutCreateInfo set_info{.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages_}}};
+        // The vertex shader reads the vertices as attributes, the mesh shader from storage buffers.
         const VkBufferUsageFlags vertex_usage =
             mesh_shading ? VK_BUFFER_USAGE_STORAGE_BUFFER_BIT : VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
         positions_ = vkrc_examples::device_buffer(queue, g.positions, vertex_usage);
         normals_ = vkrc_examples::device_buffer(queue, g.normals, vertex_usage);
         std::vector<std::uint32_t> first_meshlet(g.meshes.size()), meshlet_count(g.meshes.size());
-        if (mesh_shading) {
-            // Every mesh's meshlets, appended; a meshlet's vertices are indices into all the positions.
-            raytrace::Meshlets meshlets;
-            for (std::size_t m = 0; m < g.meshes.size(); ++m) {
-                const auto& r = g.meshes[m];
-                first_meshlet[m] = std::uint32_t(meshlets.meshlets.size());
-                meshlet_count[m] = raytrace::append_meshlets(std::span(g.indices).subspan(r.first_index, r.index_count),
-                                                             meshlets, std::uint32_t(r.vertex_offset));
-            }
-            std::printf("mesh path: %zu meshlets of at most %u vertices and %u triangles\n", meshlets.meshlets.size(),
-                        raytrace::MeshletLimits{}.max_vertices, raytrace::MeshletLimits{}.max_triangles);
-            constexpr auto storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-            meshlet_buffers_ = {vkrc_examples::device_buffer(queue, meshlets.meshlets, storage),
-                                vkrc_examples::device_buffer(queue, meshlets.vertices, storage),
-                                vkrc_examples::device_buffer(queue, meshlets.triangles, storage)};
-            for (std::uint32_t binding = 1; binding <= 5; ++binding)
-                set_info.bindings.push_back(
-                    {binding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_MESH_BIT_EXT});
-        } else {
-            indices_ = vkrc_examples::device_buffer(queue, g.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-        }
+        if (mesh_shading) load_meshlets(queue, g, first_meshlet, meshlet_count);
+        else indices_ = vkrc_examples::device_buffer(queue, g.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
         for (const auto& i : scene.instances)
             draws_.push_back({{i.world, i.colour, first_meshlet[i.mesh]}, g.meshes[i.mesh], meshlet_count[i.mesh]});
-
-        const auto set_layout = vkrc::DescriptorSetLayout::create(device_, set_info);
-        auto pool = vkrc::DescriptorPool::create(
-            device_, {.max_sets = 1,
-                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5}}});
-        set_ = pool.allocate(set_layout);
-        set_.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms);
-        if (mesh_shading) {
-            const std::array<const vkrc::Buffer*, 5> storage = {&positions_, &normals_, &meshlet_buffers_[0],
-                                                                &meshlet_buffers_[1], &meshlet_buffers_[2]};
-            for (std::uint32_t b = 0; b < storage.size(); ++b)
-                set_.write_buffer(b + 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, *storage[b]);
-        }
-        layout_ = vkrc::PipelineLayout::create(
-            device_, {.set_layouts = {set_layout}, .push_constant_ranges = {{stages_, 0, sizeof(InstanceConstants)}}});
-        vkrc::GraphicsPipelineBuilder builder(layout_);
-        if (mesh_shading) {
-            builder.shader(VK_SHADER_STAGE_MESH_BIT_EXT,
-                           vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_mesh_mesh));
-        } else {
-            builder
-                .shader(VK_SHADER_STAGE_VERTEX_BIT,
-                        vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_raster_vert))
-                .vertex_binding(0, sizeof(glm::vec3))  // positions
-                .vertex_binding(1, sizeof(glm::vec3))  // normals
-                .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0)
-                .vertex_attribute(1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0);
-        }
-        pipeline_ = builder
-                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT,
-                                vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_scene_frag))
-                        .cull_mode(VK_CULL_MODE_NONE)  // the spout and lid openings show inner faces
-                        .depth_test(true, true, VK_COMPARE_OP_LESS)
-                        .rendering(std::array{colour_format}, depth_format)
-                        .build();
+        build_pipeline(uniforms);
     }
 
     void resize(VkExtent2D extent) override {
@@ -213,6 +160,64 @@ public:
     const vkrc::Image& output() const override { return colour_; }
 
 private:
+    // Every mesh's meshlets, appended to one set of arrays (a meshlet's vertices index all the
+    // positions), into meshlet_buffers_; each mesh's first meshlet and count.
+    void load_meshlets(const vkrc::Queue& queue, const raytrace::Geometry& g, std::vector<std::uint32_t>& first,
+                       std::vector<std::uint32_t>& count) {
+        raytrace::Meshlets meshlets;
+        for (std::size_t m = 0; m < g.meshes.size(); ++m) {
+            const auto& r = g.meshes[m];
+            first[m] = std::uint32_t(meshlets.meshlets.size());
+            count[m] = raytrace::append_meshlets(std::span(g.indices).subspan(r.first_index, r.index_count), meshlets,
+                                                 std::uint32_t(r.vertex_offset));
+        }
+        std::printf("mesh path: %zu meshlets of at most %u vertices and %u triangles\n", meshlets.meshlets.size(),
+                    raytrace::MeshletLimits{}.max_vertices, raytrace::MeshletLimits{}.max_triangles);
+        constexpr auto storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+        meshlet_buffers_ = {vkrc_examples::device_buffer(queue, meshlets.meshlets, storage),
+                            vkrc_examples::device_buffer(queue, meshlets.vertices, storage),
+                            vkrc_examples::device_buffer(queue, meshlets.triangles, storage)};
+    }
+
+    // The descriptor set (binding 0: the frame's uniforms; with mesh shading, the mesh shader's
+    // buffers from binding 1, as shaders/raytrace_mesh.mesh declares them), layout and pipeline.
+    void build_pipeline(const vkrc::Buffer& uniforms) {
+        vkrc::DescriptorSetLayoutCreateInfo set_info{.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages_}}};
+        const std::array<const vkrc::Buffer*, 5> storage = {&positions_, &normals_, &meshlet_buffers_[0],
+                                                            &meshlet_buffers_[1], &meshlet_buffers_[2]};
+        for (std::uint32_t b = 0; mesh_shading_ && b < storage.size(); ++b)
+            set_info.bindings.push_back({b + 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_MESH_BIT_EXT});
+        const auto set_layout = vkrc::DescriptorSetLayout::create(device_, set_info);
+        const auto pool = vkrc::DescriptorPool::create(
+            device_, {.max_sets = 1,
+                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 5}}});
+        set_ = pool.allocate(set_layout);  // the set keeps its pool
+        set_.write_buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms);
+        for (std::uint32_t b = 0; mesh_shading_ && b < storage.size(); ++b)
+            set_.write_buffer(b + 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, *storage[b]);
+        layout_ = vkrc::PipelineLayout::create(
+            device_, {.set_layouts = {set_layout}, .push_constant_ranges = {{stages_, 0, sizeof(InstanceConstants)}}});
+        vkrc::GraphicsPipelineBuilder builder(layout_);
+        if (mesh_shading_)
+            builder.shader(VK_SHADER_STAGE_MESH_BIT_EXT,
+                           vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_mesh_mesh));
+        else
+            builder
+                .shader(VK_SHADER_STAGE_VERTEX_BIT,
+                        vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_raster_vert))
+                .vertex_binding(0, sizeof(glm::vec3))  // positions
+                .vertex_binding(1, sizeof(glm::vec3))  // normals
+                .vertex_attribute(0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0)
+                .vertex_attribute(1, 1, VK_FORMAT_R32G32B32_SFLOAT, 0);
+        pipeline_ = builder
+                        .shader(VK_SHADER_STAGE_FRAGMENT_BIT,
+                                vkrc::ShaderModule::create(device_, vkrc_shaders::raytrace_scene_frag))
+                        .cull_mode(VK_CULL_MODE_NONE)  // the spout and lid openings show inner faces
+                        .depth_test(true, true, VK_COMPARE_OP_LESS)
+                        .rendering(std::array{colour_format}, depth_format)
+                        .build();
+    }
+
     struct Draw {
         InstanceConstants constants;
         raytrace::MeshRange mesh;     // the vertex shader's
@@ -220,7 +225,7 @@ private:
     };
     vkrc::Device device_;
     bool mesh_shading_;
-    VkShaderStageFlags stages_ = 0;
+    VkShaderStageFlags stages_;  // of the push constants and the uniforms
     vkrc::Buffer positions_, normals_, indices_;
     std::array<vkrc::Buffer, 3> meshlet_buffers_;  // meshlets, their vertices, their triangles
     std::vector<Draw> draws_;
