@@ -56,14 +56,17 @@ bench_csv_header() {
   echo "# host: $(nproc) CPUs, $(uname -sr), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 }
 
-# Runs PROGRAM (BUILD/bench/KIND) PROCESSES times with ARGS, each time into a
-# CSV whose rows get a leading process column, and writes them as one results
-# file OUT/PREFIX-KIND.csv headed by bench_csv_header. Needs bench_start first.
+# Runs PROGRAM (BUILD/bench/KIND, or BUILD/$BENCH_DIR/KIND where BENCH_DIR
+# is set, e.g. examples) PROCESSES times with ARGS, each time into a CSV
+# whose rows get a leading process column, and writes them as one results
+# file OUT/PREFIX-KIND.csv (PREFIX-$BENCH_LABEL.csv where that is set)
+# headed by bench_csv_header. Needs bench_start first.
 #   bench_processes BUILD OUT NAME KIND PROCESSES ARGS...
 bench_processes() {
   local build=$1 out=$2 name=$3 kind=$4 processes=$5
   shift 5
-  local program="$build/bench/$kind" command="bench/$kind${*:+ $*} --csv FILE"
+  local dir=${BENCH_DIR:-bench}
+  local program="$build/$dir/$kind" command="$dir/$kind${*:+ $*} --csv FILE"
   [ -x "$program" ] || { echo "$kind: no $program (build the $kind target first)" >&2; exit 1; }
   local body="$out/tmp-$kind-body.csv" csv="$out/tmp-$kind.csv" log="$out/tmp-$kind.log" device="" p
   : >"$body"
@@ -79,7 +82,7 @@ bench_processes() {
   {
     bench_csv_header "$device" "$command, $processes processes (Release build)"
     cat "$body"
-  } >"$out/$prefix-$kind.csv"
+  } >"$out/$prefix-${BENCH_LABEL:-$kind}.csv"
   rm -f "$body" "$csv" "$log"
-  echo "wrote $out/$prefix-$kind.csv" >&2
+  echo "wrote $out/$prefix-${BENCH_LABEL:-$kind}.csv" >&2
 }

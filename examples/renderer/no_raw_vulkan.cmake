@@ -1,4 +1,5 @@
-# Fails when a source of examples/renderer calls Vulkan directly: a
+# Fails when a source of an example written only against vkrc (examples/renderer,
+# examples/raytrace) calls Vulkan directly: a
 # vkSomething( call or the dispatch table (.fn()). Run with -DDIR=<dir>.
 file(GLOB sources ${DIR}/*.cpp ${DIR}/*.hpp)
 if(NOT sources)
@@ -14,7 +15,7 @@ foreach(source IN LISTS sources)
   endforeach()
 endforeach()
 if(found)
-  message(FATAL_ERROR "raw Vulkan calls in the renderer example:${found}")
+  message(FATAL_ERROR "raw Vulkan calls in ${DIR}:${found}")
 endif()
 list(LENGTH sources count)
-message(STATUS "${count} sources of the renderer example make no raw Vulkan call")
+message(STATUS "${count} sources in ${DIR} make no raw Vulkan call")

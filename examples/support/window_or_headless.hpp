@@ -4,7 +4,8 @@
 //     NAME --headless [--frames N] [--validation] [--out NAME.png]
 // and, for the examples that use them (renderer): --threads N (recording
 // threads), --resize-every N (resize the window every N frames, for tests),
-// --report N (print timings every N frames).
+// --report N (print timings every N frames). An example with options of its
+// own (raytrace) takes them out of argv first and names them in extra_usage.
 // Header-only: it uses vkrc's presenter, and each example picks its policy.
 #pragma once
 
@@ -17,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <span>
 #include <string>
 
@@ -37,7 +39,8 @@ struct WindowOrHeadless {
 
 // Parses the command line and runs run(options): exit status 2 and the usage
 // on a bad argument, 1 and the message when run throws.
-inline int run_example(int argc, char** argv, const char* name, int (*run)(const WindowOrHeadless&)) {
+inline int run_example(int argc, char** argv, const char* name, const std::function<int(const WindowOrHeadless&)>& run,
+                       const char* extra_usage = "") {
     WindowOrHeadless options;
     options.out_file = std::string(name) + ".png";
     for (int i = 1; i < argc; ++i) {
@@ -56,8 +59,8 @@ inline int run_example(int argc, char** argv, const char* name, int (*run)(const
         else {
             std::fprintf(stderr,
                          "usage: %s [--headless [--out FILE.png]] [--frames N] [--validation] [--threads N] "
-                         "[--resize-every N] [--report N]\n",
-                         argv[0]);
+                         "[--resize-every N] [--report N]%s\n",
+                         argv[0], extra_usage);
             return 2;
         }
     }

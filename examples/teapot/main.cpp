@@ -9,6 +9,7 @@
 #include "scene/teapot_scene.hpp"
 #include "shaders/teapot.frag.h"
 #include "shaders/teapot.vert.h"
+#include "support/device_buffer.hpp"
 #include "support/window_or_headless.hpp"
 
 #include <array>
@@ -20,15 +21,6 @@ namespace {
 
 constexpr int teapot_count = 25;
 constexpr VkFormat depth_format = VK_FORMAT_D32_SFLOAT;  // every device can render depth into it
-
-// A buffer the GPU reads, filled once through a staging copy.
-template <typename T>
-vkrc::Buffer device_buffer(const vkrc::Queue& queue, const std::vector<T>& data, VkBufferUsageFlags usage) {
-    auto buffer = vkrc::Buffer::create(
-        queue.device(), {.size = data.size() * sizeof(T), .usage = usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT});
-    vkrc::upload_buffer(queue, buffer, 0, std::as_bytes(std::span(data)));
-    return buffer;
-}
 
 int run(const vkrc_examples::WindowOrHeadless& options) {
     // 1. Instance, device and presenter (a window's swapchain or, headless,
@@ -55,9 +47,9 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
 
     // 2. The teapot mesh (Bezier patches, 8x8 quads each), in GPU memory.
     const teapot::Mesh mesh = teapot::tessellate(teapot::newell_teapot(), 8);
-    auto positions = device_buffer(queue, mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    auto normals = device_buffer(queue, mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    auto indices = device_buffer(queue, mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    auto positions = vkrc_examples::device_buffer(queue, mesh.positions, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    auto normals = vkrc_examples::device_buffer(queue, mesh.normals, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    auto indices = vkrc_examples::device_buffer(queue, mesh.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
 
     // 3. The pipeline: the camera in a uniform buffer (set 0), each teapot's
     //    world matrix and colour in push constants, depth tested.
