@@ -34,7 +34,7 @@ RUNTIME_TABLE = ROOT / "docs" / "validation_runtime_checks.txt"
 # the instance/device extensions vkrc loads.
 AVAILABLE = {"VK_VERSION_1_0", "VK_VERSION_1_1", "VK_VERSION_1_2", "VK_VERSION_1_3",
              "VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils", "VK_EXT_memory_budget",
-             "VK_KHR_push_descriptor"}
+             "VK_KHR_push_descriptor", "VK_KHR_acceleration_structure"}
 
 # (name, regex over the rule's text or VUID): guaranteed by vkrc's types/RAII.
 STATIC_RULES = [

@@ -2,6 +2,7 @@
 
 #include "object_state.hpp"
 
+#include <cstring>
 #include <string>
 
 VKRC_BEGIN_NAMESPACE
@@ -94,11 +95,30 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     return CommandBuffer(std::move(s));
 }
 
+namespace {
+
+// The first word of a dispatchable object, which the loader-driver interface
+// reserves for the loader's dispatch table: the loader writes its device's
+// table into every command buffer allocated from that device (vkGetDeviceProcAddr
+// hands out the loader's own vkAllocateCommandBuffers for it), so two
+// handles with different words belong to different devices. Without a
+// loader both hold the driver's magic value, equal, and nothing is refused.
+const void* dispatch_word(const void* dispatchable) noexcept {
+    const void* word = nullptr;
+    std::memcpy(&word, dispatchable, sizeof word);
+    return word;
+}
+
+}  // namespace
+
 CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer command_buffer, VkCommandBufferLevel level,
                                    Ownership ownership) {
     const detail::Caller caller{"vkrc::CommandBuffer::adopt"};
     caller.require_handle(pool, "the CommandPool");
     caller.require_not_null(command_buffer, "VkCommandBuffer");
+    caller.require(dispatch_word(command_buffer) == dispatch_word(pool.device().vk()),
+                   "the VkCommandBuffer was allocated on another device than the CommandPool's (its loader dispatch "
+                   "table is not the VkDevice's)");
     caller.require(level == VK_COMMAND_BUFFER_LEVEL_PRIMARY || level == VK_COMMAND_BUFFER_LEVEL_SECONDARY, "level ",
                    static_cast<int>(level), " is neither PRIMARY nor SECONDARY");
     auto s = new_command_buffer_state(pool, level);

@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <span>
+#include <string>
 
 namespace {
 
@@ -298,6 +299,67 @@ TEST_F(VulkanTest, AdoptedCommandBufferRecordsAndIsSubmitted) {
     pool.reset();
     device.wait_idle();
     fn.vkDestroyCommandPool(device.vk(), raw_pool, nullptr);
+}
+
+// A command buffer of another device (two logical devices here, as on
+// lavapipe) is refused, in both directions, naming the problem; the same raw
+// command buffer adopted with a pool of its own device records and runs.
+TEST_F(VulkanTest, AdoptRefusesACommandBufferOfAnotherDevice) {
+    auto other = vkrc::Device::create(physical_device);
+    auto other_queue = other.default_queue();
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto other_pool = vkrc::CommandPool::create(other, {.queue_family_index = other_queue.family_index()});
+    const VkCommandBuffer raw = allocate_raw(other, other_pool.vk(), VK_COMMAND_BUFFER_LEVEL_PRIMARY);
+    const std::string refused = vkrc_test::usage_error_of(
+        [&] { vkrc::CommandBuffer::adopt(pool, raw, VK_COMMAND_BUFFER_LEVEL_PRIMARY, vkrc::Ownership::owned); });
+    EXPECT_NE(refused.find("vkrc::CommandBuffer::adopt"), std::string::npos) << refused;
+    EXPECT_NE(refused.find("allocated on another device than the CommandPool's"), std::string::npos) << refused;
+    auto mine = pool.allocate();
+    EXPECT_NE(vkrc_test::usage_error_of([&] {
+                  vkrc::CommandBuffer::adopt(other_pool, mine.vk(), VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+                                             vkrc::Ownership::borrowed);
+              }).find("another device"),
+              std::string::npos);
+
+    auto cmd = vkrc::CommandBuffer::adopt(other_pool, raw, VK_COMMAND_BUFFER_LEVEL_PRIMARY, vkrc::Ownership::owned);
+    auto target = fill_target(other);
+    cmd.begin();
+    cmd.fill_buffer(target, 0, 16, 0x5ca1ab1e);
+    const auto to_host = transfer_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    auto fence = vkrc::Fence::create(other);
+    vkrc::submit(other_queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(target.allocation().read_value<std::uint32_t>(12), 0x5ca1ab1eu);
+}
+
+// A non-dispatchable handle carries no device vkrc could read, and its value
+// is unique only within its device: a raw buffer of another device is
+// adopted without complaint (docs/guide.md says so), and the validation
+// layer reports its first use on this device, once.
+TEST_F(VulkanTest, AdoptingARawBufferOfAnotherDeviceIsReportedByTheLayerAtItsFirstUse) {
+    auto other = vkrc::Device::create(physical_device);
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = 16;
+    info.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    VkBuffer raw = VK_NULL_HANDLE;
+    ASSERT_EQ(other.fn().vkCreateBuffer(other.vk(), &info, nullptr, &raw), VK_SUCCESS);
+    {
+        auto adopted =
+            vkrc::Buffer::adopt(device, raw, info.size, info.usage, vkrc::Ownership::borrowed);  // vkrc cannot know
+        EXPECT_TRUE(log->take().empty()) << "nothing is reported before the buffer is used";
+        auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+        auto cmd = pool.allocate();
+        cmd.begin();
+        cmd.fill_buffer(adopted, 0, 16, 1);  // the layer reports it and does not pass it on
+        cmd.end();
+        EXPECT_TRUE(log->take_expected("VUID-vkCmdFillBuffer-commonparent", 1));
+        // The layer's thread-safety checker does not find the buffer among
+        // this device's objects either, at the call's start and its end.
+        EXPECT_TRUE(log->take_expected("UNASSIGNED-Threading-Info", 2));
+    }
+    other.fn().vkDestroyBuffer(other.vk(), raw, nullptr);
 }
 
 // Secondaries recorded entirely by other code run inside a vkrc primary.

@@ -1,5 +1,6 @@
 // Presentation: a GLFW window on a private Xvfb, its Swapchain re-created
-// while rendering, minimised (zero extent), and the headless presenter
+// while rendering (under the multi-thread policy also while three other
+// threads record and drop), minimised (zero extent), and the headless presenter
 // rendering the same pixels through the same frame loop; and device loss
 // reported by present or acquire.
 #include "support/fault_injection.hpp"
@@ -16,6 +17,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstring>
 #include <functional>
 #include <memory>
@@ -23,6 +25,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -374,6 +377,179 @@ TEST_F(PresentationTest, HeadlessRendersTheSamePixelsAsTheWindow) {
     EXPECT_NE(texel(extent.width / 2, extent.height / 2), texel(1, 1));
     headless_renderer.wait();
 }
+
+#if VKRC_IS_MULTI_THREAD
+// One round of a worker thread on the shared queue: an image cleared to the
+// bytes of value through a view (dynamic rendering) and a buffer filled with
+// value, both copied into readback. The view is dropped while the command
+// buffer records, the image after end(), the buffer and the command buffer
+// after the submit: vkrc holds each until the GPU is done. Whether readback
+// then holds the colour and the words.
+bool record_and_drop(const vkrc::Queue& queue, const vkrc::CommandPool& pool, const vkrc::Buffer& readback,
+                     std::uint32_t value) {
+    constexpr std::uint32_t side = 16, words = 64;
+    const auto& device = queue.device();
+    auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R8G8B8A8_UNORM,
+                                     .extent = {side, side, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    auto view = vkrc::ImageView::create(image);
+    auto buffer = vkrc::Buffer::create(
+        device, {.size = words * 4, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT});
+    vkrc_test::Rgba rgba;
+    std::memcpy(rgba.data(), &value, 4);
+    auto cmd = pool.allocate();
+    cmd.begin();
+    const auto to_attachment = vkrc::image_barrier(
+        image.vk(), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+        VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_attachment, 1));
+    vkrc::RenderingAttachment target{.image_view = view.vk()};
+    for (int c = 0; c < 4; ++c) target.clear_value.color.float32[c] = float(rgba[c]) / 255.0f;
+    cmd.begin_rendering({.render_area = {{0, 0}, {side, side}}, .color_attachments = std::span(&target, 1)});
+    cmd.end_rendering();
+    view.reset();
+    const auto to_copy =
+        vkrc::image_barrier(image.vk(), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                            VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {side, side, 1};
+    cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback, std::span(&region, 1));
+    cmd.fill_buffer(buffer, 0, words * 4, value);
+    const auto fill_to_copy = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    cmd.pipeline_barrier(std::span(&fill_to_copy, 1), {}, {});
+    const VkBufferCopy words_region{0, side * side * 4, words * 4};
+    cmd.copy_buffer(buffer, readback, std::span(&words_region, 1));
+    const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                              VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    image.reset();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    buffer.reset();
+    cmd.reset();
+    if (fence.wait() != VK_SUCCESS) return false;
+    std::vector<std::uint32_t> got(side * side + words);
+    readback.allocation().read(0, std::span(got));
+    return std::ranges::all_of(got, [value](std::uint32_t v) { return v == value; });
+}
+
+// A presented frame read back (extent's RGBA or BGRA texels): the four
+// corners are the clear colour (opaque, and corner of the first frame when
+// given), the triangle covers the centre.
+::testing::AssertionResult is_the_triangle(const vkrc::Buffer& readback, VkExtent2D extent, std::uint32_t corner) {
+    auto texel = [&](std::uint32_t x, std::uint32_t y) {
+        return readback.allocation().read_value<std::uint32_t>((VkDeviceSize{y} * extent.width + x) * 4);
+    };
+    const std::uint32_t clear = texel(0, 0);
+    if (clear >> 24 != 0xffu) return ::testing::AssertionFailure() << "the clear colour is not opaque";
+    if (corner != 0 && clear != corner) return ::testing::AssertionFailure() << "the clear colour changed";
+    for (const auto& [x, y] :
+         {std::pair{extent.width - 1, 0u}, {0u, extent.height - 1}, {extent.width - 1, extent.height - 1}}) {
+        if (texel(x, y) != clear) return ::testing::AssertionFailure() << "corner (" << x << ", " << y << ")";
+    }
+    if (texel(extent.width / 2, extent.height / 2) == clear) {
+        return ::testing::AssertionFailure() << "the triangle does not cover the centre";
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// Issue 33's never-tested scenario under the multi-thread policy: the main
+// thread resizes the window and re-creates the swapchain (the old one
+// retired, its images destroyed once their frames are done) and presents a
+// frame read back at every size, while three threads record on the same
+// device and queue from their own pools and drop the buffers, images and
+// views they made. Every presented frame shows the triangle at the new
+// extent, every worker round reads back what it recorded, the recreations
+// are counted, and nothing is left deferred. TSan runs it (`-L mt`).
+TEST_F(PresentationTest, RecreatedOnOneThreadWhileThreeOthersRecordAndDrop) {
+    vkrc_test::Watchdog watchdog("swapchain recreation while three threads record and drop", std::chrono::seconds(120));
+    auto swapchain = make_swapchain(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    Renderer renderer(queue, swapchain.format());
+    constexpr int workers = 3, min_resizes = 8, min_rounds = 3;
+    std::atomic<bool> stop{false};
+    std::array<std::atomic<int>, workers> rounds{}, wrong{};
+    std::vector<std::thread> threads;
+    // Stops and joins the workers however the main thread leaves (a failed ASSERT too).
+    struct Join {
+        Join(std::atomic<bool>& s, std::vector<std::thread>& t) : stop(s), threads(t) {}
+        Join(const Join&) = delete;
+        Join& operator=(const Join&) = delete;
+        ~Join() {
+            stop.store(true);
+            for (auto& thread : threads) thread.join();
+        }
+        std::atomic<bool>& stop;
+        std::vector<std::thread>& threads;
+    };
+    std::optional<Join> join(std::in_place, stop, threads);
+    for (int t = 0; t < workers; ++t) {
+        threads.emplace_back([&, t] {
+            auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+            auto readback = vkrc::Buffer::create(device, {.size = 16 * 16 * 4 + 64 * 4,
+                                                          .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                          .memory = {.usage = vkrc::MemoryUsage::readback}});
+            for (std::uint32_t r = 1; !stop.load(); ++r) {
+                if (!record_and_drop(queue, pool, readback, std::uint32_t(t + 1) << 24 | r)) wrong[t].fetch_add(1);
+                rounds[t].fetch_add(1);
+            }
+        });
+    }
+    auto fewest_rounds = [&] {
+        int fewest = rounds[0].load();
+        for (const auto& r : rounds) fewest = std::min(fewest, r.load());
+        return fewest;
+    };
+    int resizes = 0, recreations = 0, frames = 0;
+    std::uint32_t clear = 0;
+    // At least min_resizes, and on until every worker has done min_rounds
+    // while they went on (bounded: a worker that starves fails below).
+    for (; resizes < 200 && (resizes < min_resizes || fewest_rounds() < min_rounds); ++resizes) {
+        const int width = 160 + (resizes * 37) % 200, height = 120 + (resizes * 53) % 150;
+        glfwSetWindowSize(window.window.get(), width, height);
+        glfwPollEvents();
+        const VkSwapchainKHR old = swapchain.vk();
+        ASSERT_EQ(swapchain.recreate(), vkrc::PresentStatus::success);
+        const VkExtent2D extent = swapchain.extent();
+        EXPECT_EQ(extent.width, static_cast<std::uint32_t>(width));
+        EXPECT_EQ(extent.height, static_cast<std::uint32_t>(height));
+        // Dropped at the end of the iteration, while the workers record.
+        auto readback = vkrc::Buffer::create(device, {.size = VkDeviceSize{extent.width} * extent.height * 4,
+                                                      .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                                      .memory = {.usage = vkrc::MemoryUsage::readback}});
+        vkrc::PresentStatus status = vkrc::PresentStatus::out_of_date;
+        for (int attempt = 0; attempt < 3 && status != vkrc::PresentStatus::success; ++attempt) {
+            status = renderer.frame(swapchain, &readback);
+        }
+        ASSERT_EQ(status, vkrc::PresentStatus::success) << "resize " << resizes;
+        ASSERT_EQ(swapchain.extent().width, extent.width) << "the frame was rendered at another extent";
+        recreations += swapchain.vk() != old;
+        renderer.wait();
+        EXPECT_TRUE(is_the_triangle(readback, extent, clear))
+            << "resize " << resizes << ": " << extent.width << "x" << extent.height;
+        if (clear == 0) clear = readback.allocation().read_value<std::uint32_t>(0);
+        ++frames;
+    }
+    join.reset();
+    std::printf("%d resizes, %d recreations, %d frames; worker rounds %d, %d, %d\n", resizes, recreations, frames,
+                rounds[0].load(), rounds[1].load(), rounds[2].load());
+    EXPECT_EQ(recreations, resizes) << "each recreate() made a new swapchain";
+    EXPECT_EQ(frames, resizes);
+    for (int t = 0; t < workers; ++t) {
+        EXPECT_GE(rounds[t].load(), min_rounds) << "worker " << t;
+        EXPECT_EQ(wrong[t].load(), 0) << "worker " << t << " read back something else than it recorded";
+    }
+    EXPECT_NE(choices.back().find("replacing the previous swapchain"), std::string::npos);
+    device.wait_idle();
+    device.collect_garbage();
+    EXPECT_EQ(device.deferred_count(), 0u);
+}
+#endif
 
 // Device loss on the windowed path (issue 7): VK_ERROR_DEVICE_LOST from
 // vkQueuePresentKHR or vkAcquireNextImageKHR raises DeviceLostError and marks

@@ -5,6 +5,7 @@
 #include "support/vk_test.hpp"
 
 #include "shaders/fill_pattern.comp.h"
+#include "shaders/ray_query.comp.h"
 
 #include <algorithm>
 #include <array>
@@ -299,6 +300,133 @@ ScenarioResult run_non_coherent_scenario(const vkrc::InstanceCreateInfo& info) {
     std::array<std::uint32_t, 4> got{};
     readback.allocation().read(16, got.data(), got.size());  // invalidates
     return {readback.allocation().host_coherent(), got[0], got[1], got[2], got[3]};
+}
+
+namespace {
+
+// What acceleration structures and the ray query shader need of a device.
+vkrc::DeviceCreateInfo ray_query_device_info() {
+    vkrc::DeviceCreateInfo info;
+    info.acceleration_structure_features.accelerationStructure = VK_TRUE;
+    info.ray_query_features.rayQuery = VK_TRUE;
+    info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
+    return info;
+}
+
+bool has_ray_queries(const vkrc::PhysicalDevice& physical) {
+    auto wanted = test_device_requirements();
+    wanted.required_features.acceleration_structure.accelerationStructure = VK_TRUE;
+    wanted.required_features.ray_query.rayQuery = VK_TRUE;
+    wanted.required_features.vulkan12.bufferDeviceAddress = VK_TRUE;
+    return physical.unmet_requirements(wanted).empty();
+}
+
+// A barrier from builds and copies of structures to what reads them next (stage).
+void after_builds(const vkrc::CommandBuffer& cmd, VkPipelineStageFlags2 stage) {
+    const auto b = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                                        VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR, stage,
+                                        VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+    cmd.pipeline_barrier(std::span(&b, 1), {}, {});
+}
+
+}  // namespace
+
+bool device_has_ray_queries(const vkrc::InstanceCreateInfo& info) {
+    auto instance = vkrc::Instance::create(info);
+    return has_ray_queries(vkrc::PhysicalDevice::select(instance, test_device_requirements()));
+}
+
+ScenarioResult run_acceleration_structure_scenario(const vkrc::InstanceCreateInfo& info) {
+    Context c;
+    c.instance = vkrc::Instance::create(info);
+    c.physical = vkrc::PhysicalDevice::select(c.instance, test_device_requirements());
+    if (!has_ray_queries(c.physical)) return {};
+    c.device = vkrc::Device::create(c.physical, ray_query_device_info());
+    c.queue = c.device.default_queue();
+    faults::end_of_setup();
+    const auto& device = c.device;
+    auto commands = vkrc::CommandPool::create(device, {.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+                                                       .queue_family_index = c.queue.family_index()});
+    auto cmd = commands.allocate();
+
+    // The square [0,4]x[0,4] at z 0, two indexed triangles, built for compaction.
+    const std::array<float, 12> square{0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0};
+    const std::array<std::uint32_t, 6> indices{0, 1, 2, 0, 2, 3};
+    constexpr VkBufferUsageFlags input_usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                               VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+    auto vertices = vkrc::Buffer::create(
+        device, {.size = sizeof square, .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
+    vertices.allocation().write(0, square.data(), square.size());
+    auto index_buffer = vkrc::Buffer::create(
+        device, {.size = sizeof indices, .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
+    index_buffer.allocation().write(0, indices.data(), indices.size());
+    vkrc::BottomLevelBuildInfo bottom;
+    bottom.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
+                   VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
+    bottom.geometries = {
+        {.vertex_buffer = vertices, .max_vertex = 3, .index_buffer = index_buffer, .triangle_count = 2}};
+    auto sizes = vkrc::QueryPool::create(
+        device, {.query_type = VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, .query_count = 1});
+    cmd.begin();
+    auto square_level = vkrc::build_bottom_level(cmd, bottom);
+    after_builds(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+    cmd.reset_query_pool(sizes, 0, 1);
+    const VkAccelerationStructureKHR raw = square_level.vk();
+    cmd.write_acceleration_structures_properties(std::span(&raw, 1),
+                                                 VK_QUERY_TYPE_ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, sizes, 0);
+    cmd.end();
+    run_and_wait(c.queue, cmd);
+    std::array<std::uint64_t, 1> compacted{};
+    if (sizes.results(0, std::span(compacted)) != VK_SUCCESS) throw std::logic_error("no compacted size");
+
+    // The compacted copy, the original dropped once the copy is recorded;
+    // the scene: the copy at the origin (custom 5) and moved right by 4 (custom 7).
+    cmd.reset_commands();
+    cmd.begin();
+    after_builds(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);  // the compaction copy reads it
+    auto small = vkrc::compact(cmd, square_level, compacted[0]);
+    square_level.reset();
+    after_builds(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+    vkrc::TopLevelBuildInfo top;
+    top.instances = {
+        {.bottom_level = small, .custom_index = 5},
+        {.bottom_level = small, .transform = {{{1, 0, 0, 4}, {0, 1, 0, 0}, {0, 0, 1, 0}}}, .custom_index = 7}};
+    auto scene = vkrc::build_top_level(cmd, top);
+    small.reset();  // the scene keeps it
+
+    // Traced: one ray per pixel of 8x8, each reporting custom index << 8 | geometry (0xFFFFFFFF: a miss).
+    constexpr std::uint32_t side = 8;
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+                              {.binding = 1, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+    const std::array<std::uint32_t, 3> params{side, side, 0xFF};  // width, height, cull mask
+    auto layout = vkrc::PipelineLayout::create(
+        device,
+        {.set_layouts = {set_layout}, .push_constant_ranges = {{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof params}}});
+    auto pipeline =
+        vkrc::ComputePipeline::create(layout, vkrc::ShaderModule::create(device, vkrc_shaders::ray_query_comp));
+    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1,
+                                                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
+                                                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto hits = readback_buffer(device, side * side * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    auto set = pool.allocate(set_layout);
+    set.write_acceleration_structure(0, scene);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, hits);
+    scene.reset();  // the set keeps it
+    after_builds(cmd, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT);
+    cmd.bind_pipeline(pipeline);
+    cmd.bind_descriptor_set(pipeline, 0, set);
+    cmd.push_constants(layout, VK_SHADER_STAGE_COMPUTE_BIT, params);
+    cmd.dispatch(1, 1);
+    const auto to_host = compute_to_host();
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    run_and_wait(c.queue, cmd);
+    std::array<std::uint32_t, side * side> traced{};
+    hits.allocation().read(0, std::span(traced));
+    ScenarioResult result(traced.begin(), traced.end());
+    result.push_back(compacted[0]);
+    return result;
 }
 
 ScenarioResult run_presentation_scenario(const vkrc::InstanceCreateInfo& info, const vkrc::glfw::Window& window) {

@@ -33,6 +33,14 @@ ScenarioResult run_streaming_scenario(const vkrc::InstanceCreateInfo& info);
 // host-coherent, so that vkrc flushes and invalidates.
 ScenarioResult run_non_coherent_scenario(const vkrc::InstanceCreateInfo& info);
 
+// Acceleration structures, where the device has them and ray queries
+// (empty result otherwise): a bottom level built for compaction, its
+// compacted size queried and a compacted copy made, a top level of two
+// instances of the copy, written into a set and traced with a ray query.
+ScenarioResult run_acceleration_structure_scenario(const vkrc::InstanceCreateInfo& info);
+// Whether the device the tests select has what that scenario needs.
+bool device_has_ray_queries(const vkrc::InstanceCreateInfo& info);
+
 // A swapchain on window's surface: three frames acquired, cleared and
 // presented, a re-creation, one more frame. info must enable GLFW's
 // instance extensions.

@@ -43,6 +43,16 @@ inline std::string missing_features(std::initializer_list<std::pair<const char*,
     return out;
 }
 
+// The message of the UsageError f throws, or "(no UsageError)".
+std::string usage_error_of(auto&& f) {
+    try {
+        f();
+    } catch (const vkrc::UsageError& e) {
+        return e.what();
+    }
+    return "(no UsageError)";
+}
+
 // A primary command buffer, recording from construction; run() submits it and waits.
 struct OneShotCommands {
     vkrc::CommandPool pool;
