@@ -3,15 +3,20 @@
 // reference in double precision, on the hard cases: rays through shared
 // edges and shared vertices (watertightness), grazing rays, geometry far
 // from the origin, and overlapping triangles at equal or nearly equal t.
+// Then the randomized drop order of bottom levels, top levels and the sets
+// that hold them while traces through them are held back on the GPU.
 #include "support/acceleration_structures.hpp"
 #include "support/features.hpp"
+#include "support/wrapped_allocator.hpp"
 
 #include "shaders/ray_query_rays.comp.h"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <span>
@@ -869,6 +874,282 @@ TEST_F(RayPrecisionTest, ClosestHitAmongOverlappingTrianglesAtNearlyEqualT) {
         "times, the layer an ulp below %d times; worst |t - t_ref| %.3g of the tolerance\n",
         tally.rays, tally.wrong, went_to[0], went_to[1], went_to[2], tally.worst_t);
     EXPECT_EQ(tally.wrong, 0);
+}
+
+// ------------------------------------------------------------ drop order
+
+// Where a round drops a handle, in the order a round passes them: before
+// recording, after begin (before the build step), before the trace, after
+// the trace (before end), after end, after the gated submit, after the wait.
+enum class Slot { before_begin, before_build, before_trace, after_trace, after_end, after_submit, after_wait };
+constexpr int slots = 7;
+
+// What a round's gated command buffer does before it traces.
+enum class Work {
+    build,    // builds the bottom and top levels (and writes the set then)
+    trace,    // nothing: the levels were built, and waited for, before
+    rebuild,  // rebuilds the top level built before, with other instances
+};
+constexpr int work_kinds = 3;
+
+struct FuzzCoverage {
+    int work[work_kinds] = {};
+    int fresh_devices = 0;
+    int unwaited = 0;
+    int drops[slots] = {};
+};
+
+// A 2 x 2 grid (cells of 2) and a triangle, in 1 (at least first_used) to
+// 3 instances at distinct heights, some moved by 1 in x, custom indices
+// random; the first first_used instances are of each bottom level in turn
+// (so that the top level keeps them all).
+SceneDesc fuzz_scene(std::mt19937& rng, unsigned first_used) {
+    SceneDesc scene;
+    scene.blases = {{grid(2, 2.0)}, {Geometry{{0, 0, 0, 3, 0, 0, 0, 3, 0}, {0, 1, 2}}}};
+    const unsigned least = std::max(first_used, 1u);
+    const auto count = least + rng() % (4 - least);
+    for (unsigned k = 0; k < count; ++k) {
+        scene.instances.push_back({k < first_used ? k : rng() % 2, vkrc_test::placed(float(rng() % 2), 0, float(k)),
+                                   std::uint32_t(rng() % 1000)});
+    }
+    return scene;
+}
+
+// 25 rays straight down over [0.35, 4.15]^2, off every edge of fuzz_scene's triangles.
+std::vector<GpuRay> fuzz_rays() {
+    std::vector<GpuRay> rays;
+    for (int j = 0; j < 5; ++j) {
+        for (int i = 0; i < 5; ++i) rays.push_back(make_ray({0.35 + 0.9 * i, 0.55 + 0.9 * j, 10}, {0, 0, -1}, 100));
+    }
+    return rays;
+}
+
+// Each hit is the reference's closest (these scenes have no ties and no ray on an edge).
+::testing::AssertionResult closest_hits_match(const SceneDesc& scene, const std::vector<GpuRay>& rays,
+                                              const std::vector<GpuHit>& hits) {
+    const auto triangles = world_triangles(scene);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        const WorldTriangle* nearest = nullptr;
+        double nearest_t = 0;
+        for (const auto& tri : triangles) {
+            const PlaneHit p = plane_hit(origin_of(rays[i]), direction_of(rays[i]), tri);
+            if (p.on_boundary()) return ::testing::AssertionFailure() << "the reference finds a ray on an edge";
+            if (p.touches() && p.t > 0 && (!nearest || p.t < nearest_t)) {
+                nearest = &tri;
+                nearest_t = p.t;
+            }
+        }
+        const bool right =
+            nearest ? is(hits[i], *nearest) && std::fabs(hits[i].t - nearest_t) < 1e-5 : hits[i].committed == 0;
+        if (!right) {
+            return ::testing::AssertionFailure() << describe(rays[i], hits[i]) << " | expected "
+                                                 << (nearest ? "custom " + std::to_string(nearest->custom_index) +
+                                                                   " primitive " + std::to_string(nearest->primitive)
+                                                             : std::string("a miss"));
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// The default pool allocator, counting what it frees: a round's levels
+// come from one, so that memory the held work still needs, freed before
+// the gate opens, shows (lavapipe would trace the stale bytes unharmed).
+class CountingAllocator final : public vkrc_test::WrappedPoolAllocator {
+public:
+    void free(vkrc::DeviceView device, const vkrc::AllocationInfo& allocation) override {
+        WrappedPoolAllocator::free(device, allocation);
+        ++frees_;
+    }
+    int frees() const { return frees_; }
+
+private:
+    std::atomic<int> frees_{0};
+};
+
+// A round's completion semaphore and gate; the gate goes first, waiting for
+// the device to be idle before either is destroyed (see GpuGate).
+struct FuzzSync {
+    vkrc::Semaphore done;
+    vkrc_test::GpuGate gate;
+    explicit FuzzSync(const vkrc::Device& device) : done(vkrc::Semaphore::create_timeline(device)), gate(device) {}
+};
+
+// One round: a scene's bottom and top levels, the set that holds the top
+// level, the ray buffer, the pipeline, its layouts, the command pool, the
+// device and the queue, each held by this round's one handle and dropped at
+// a random slot no earlier than the last step that uses it, in a random
+// order; the build inputs go as soon as the build is recorded. What goes
+// after the submit goes while the GPU certainly still needs it (the gate
+// opens only after). Every round reads back the hits and checks them
+// against the reference's closest hits of the scene the work left.
+struct FuzzRound {
+    std::mt19937& rng;
+    FuzzCoverage& coverage;
+    vkrc::Device device;
+    vkrc::Queue queue;
+    Tracer tracer;
+    std::vector<vkrc::AccelerationStructure> blases;
+    vkrc::AccelerationStructure top;
+    vkrc::DescriptorPool set_pool;
+    vkrc::DescriptorSet set;
+    vkrc::Buffer rays;
+    vkrc::CommandPool pool;
+    vkrc::CommandBuffer cmd;
+    vkrc::Fence fence;
+
+    int pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); }
+
+    void run(bool wait) {
+        const FuzzSync sync(device);
+        const auto& [done, gate] = sync;
+        const auto work = static_cast<Work>(pick(work_kinds));
+        ++coverage.work[static_cast<int>(work)];
+        const auto allocator = vkrc::make_allocator<CountingAllocator>();
+        const SceneDesc built = fuzz_scene(rng, 2);
+        SceneDesc traced = built;
+        if (work == Work::rebuild) {
+            // No more instances than the first build: rebuild_top_level reuses its structure.
+            traced.instances = fuzz_scene(rng, 0).instances;
+            traced.instances.resize(std::min(traced.instances.size(), built.instances.size()));
+        }
+        if (work != Work::build) {
+            vkrc_test::OneShotCommands s(queue);
+            top = record_scene(s.cmd, built, blases, allocator);
+            s.run(queue);
+        }
+        device.collect_garbage();  // the builds' scratch and instances
+        const int frees_before = allocator->frees();
+        const std::vector<GpuRay> ray_list = fuzz_rays();
+        rays = ray_buffer(device, ray_list);
+        const vkrc::Buffer hits = hit_buffer(device, ray_list.size());  // kept: read every round
+        set_pool = make_set_pool(device, 1);
+        pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+        cmd = pool.allocate();
+        fence = vkrc::Fence::create(device);
+        const auto write_set = [&] {
+            set = set_pool.allocate(tracer.set_layout);
+            set.write_acceleration_structure(0, top);
+            set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, rays);
+            set.write_buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, hits);
+        };
+
+        struct Item {
+            std::function<void()> drop;
+            Slot slot;
+        };
+        std::vector<Item> items;
+        auto add = [&](auto& handle, Slot earliest) {
+            const auto slot = static_cast<Slot>(static_cast<int>(earliest) + pick(slots - static_cast<int>(earliest)));
+            items.push_back({[&handle] { handle = {}; }, slot});
+        };
+        // The set is written before recording, but for Work::build after its build step.
+        const Slot set_made = work == Work::build ? Slot::before_trace : Slot::before_begin;
+        // The levels: made by Work::build's step, read by Work::rebuild's, else kept by the set.
+        const Slot levels_used = work == Work::trace ? Slot::before_begin : Slot::before_trace;
+        blases.resize(built.blases.size());  // Work::build fills them in place
+        add(blases[0], levels_used);
+        add(blases[1], levels_used);
+        add(top, levels_used);
+        add(rays, set_made);
+        add(set_pool, set_made);
+        add(tracer.set_layout, set_made);
+        add(set, Slot::after_trace);
+        add(tracer.pipeline, Slot::after_trace);
+        add(tracer.layout, Slot::after_trace);
+        add(device, Slot::before_begin);
+        add(queue, Slot::before_begin);
+        add(pool, Slot::before_begin);
+        add(cmd, Slot::after_submit);  // needed to submit
+        add(fence, wait ? Slot::after_wait : Slot::after_submit);
+        std::shuffle(items.begin(), items.end(), rng);
+        for (const auto& item : items) ++coverage.drops[static_cast<int>(item.slot)];
+        auto drop_at = [&](Slot s) {
+            for (auto& item : items) {
+                if (item.slot == s) item.drop();
+            }
+        };
+
+        if (work != Work::build) write_set();
+        drop_at(Slot::before_begin);
+        cmd.begin();
+        drop_at(Slot::before_build);
+        if (work == Work::build) {
+            top = record_scene(cmd, traced, blases, allocator);
+            write_set();
+        } else if (work == Work::rebuild) {
+            // The trace that built the levels was waited for: no hazard on the top level.
+            vkrc::rebuild_top_level(cmd, top, top_level_info(traced, blases, allocator));
+        }
+        drop_at(Slot::before_trace);
+        record_trace(cmd, tracer, set, std::uint32_t(ray_list.size()));
+        drop_at(Slot::after_trace);
+        cmd.end();
+        drop_at(Slot::after_end);
+        const auto submit_queue = queue ? queue : cmd.pool().device().default_queue();
+        const auto held = gate.wait();
+        const vkrc::SemaphoreSubmit finished{done, 1};
+        vkrc::submit(
+            submit_queue,
+            {.waits = std::span(&held, 1), .command_buffers = std::span(&cmd, 1), .signals = std::span(&finished, 1)},
+            fence);
+        drop_at(Slot::after_submit);
+        EXPECT_EQ(done.value(), 0u) << "the work ran before the gate opened";
+        // Whatever of the levels' memory is gone, the held work may read: none may be.
+        EXPECT_EQ(allocator->frees(), frees_before) << "level memory freed while traces of it were held";
+        gate.open();
+        if (wait) {
+            ASSERT_EQ(fence.wait(), VK_SUCCESS);
+        } else {
+            ASSERT_EQ(done.wait(1), VK_SUCCESS);
+            ++coverage.unwaited;
+        }
+        std::vector<GpuHit> got(ray_list.size());
+        hits.allocation().read(0, got.data(), got.size());
+        ASSERT_TRUE(closest_hits_match(traced, ray_list, got)) << "work " << static_cast<int>(work);
+        drop_at(Slot::after_wait);
+    }
+};
+
+// Rounds on the fixture's device (dropping copies of its tracer) and, every
+// eighth, on a fresh device with a tracer of its own, which the round may
+// drop with everything else while its work is held. One round in four (one
+// in two of those on a fresh device) waits on the completion semaphore,
+// not the fence, which may then be dropped with the work in flight. The
+// seed comes from VKRC_TEST_SEED when set (test_seed), to replay a run.
+TEST_F(RayPrecisionTest, RandomDropsOfLevelsAndSetsWithTracesInFlight) {
+    const auto seed = vkrc_test::test_seed();
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    std::mt19937 rng(seed);
+    FuzzCoverage coverage;
+    for (int round = 0; round < 64; ++round) {
+        SCOPED_TRACE("round " + std::to_string(round));
+        FuzzRound r{rng, coverage, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+        const bool fresh = round % 8 == 7;
+        if (fresh) {
+            r.device = vkrc_test::ray_query_device(physical_device);
+            r.tracer = make_tracer(r.device);
+            ++coverage.fresh_devices;
+        } else {
+            r.device = device;
+            r.tracer = tracer;
+        }
+        r.queue = r.device.default_queue();
+        r.run(fresh ? r.pick(2) != 0 : r.pick(4) != 0);
+        if (HasFatalFailure()) return;
+        const auto messages = log->take();  // here rather than at TearDown, to name the round
+        ASSERT_TRUE(messages.empty()) << messages.front();
+    }
+    std::printf(
+        "work: build %d, trace %d, rebuild %d; fresh devices %d, unwaited %d; drops before begin %d, before "
+        "the build %d, before the trace %d, after the trace %d, after end %d, after submit %d, after wait "
+        "%d\n",
+        coverage.work[0], coverage.work[1], coverage.work[2], coverage.fresh_devices, coverage.unwaited,
+        coverage.drops[0], coverage.drops[1], coverage.drops[2], coverage.drops[3], coverage.drops[4],
+        coverage.drops[5], coverage.drops[6]);
+    for (int w : coverage.work) EXPECT_GT(w, 0);
+    for (int d : coverage.drops) EXPECT_GT(d, 0);
+    device.wait_idle();
+    EXPECT_EQ(device.deferred_count(), 0u);
 }
 
 }  // namespace
