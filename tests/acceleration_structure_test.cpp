@@ -3,6 +3,7 @@
 // and checked pixel by pixel; the top level keeping its bottom levels alive
 // after their handles are dropped, rebuilds that release the old ones, refits,
 // descriptors of acceleration structures, and the refusals.
+#include "support/acceleration_structures.hpp"
 #include "support/features.hpp"
 #include "support/vk_test.hpp"
 
@@ -15,13 +16,15 @@
 
 namespace {
 
+using vkrc_test::barrier_between_levels;
+using vkrc_test::build_input;
+using vkrc_test::built_to;
+using vkrc_test::placed;
 using vkrc_test::VulkanTest;
 
 constexpr std::uint32_t width = 16;
 constexpr std::uint32_t height = 16;
 constexpr std::uint32_t miss = 0xFFFFFFFFu;
-constexpr VkBufferUsageFlags input_usage =
-    VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
 
 struct Params {
     std::uint32_t width;
@@ -31,20 +34,6 @@ struct Params {
 
 // What the ray of pixel (x, y) reports: custom index << 8 | geometry index.
 constexpr std::uint32_t hit(std::uint32_t custom_index, std::uint32_t geometry) { return custom_index << 8 | geometry; }
-
-// A translation (and uniform scale) as a VkTransformMatrixKHR.
-VkTransformMatrixKHR placed(float x, float y, float z, float scale = 1.0f) {
-    return {{{scale, 0, 0, x}, {0, scale, 0, y}, {0, 0, scale, z}}};
-}
-
-template <class T>
-vkrc::Buffer input_buffer(const vkrc::Device& device, const std::vector<T>& values) {
-    auto buffer = vkrc::Buffer::create(
-        device,
-        {.size = values.size() * sizeof(T), .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
-    buffer.allocation().write(0, values.data(), values.size());
-    return buffer;
-}
 
 // The geometry the tests build from, kept by handles a test may drop.
 struct Inputs {
@@ -57,12 +46,12 @@ struct Inputs {
 
 Inputs make_inputs(const vkrc::Device& device) {
     Inputs in;
-    in.square = input_buffer<float>(device, {0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0});
-    in.indices32 = input_buffer<std::uint32_t>(device, {0, 1, 2, 0, 2, 3});
-    in.indices16 = input_buffer<std::uint16_t>(device, {0, 1, 2, 0, 2, 3, 0, 0});  // padded to 16 bytes
+    in.square = build_input<float>(device, {0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0});
+    in.indices32 = build_input<std::uint32_t>(device, {0, 1, 2, 0, 2, 3});
+    in.indices16 = build_input<std::uint16_t>(device, {0, 1, 2, 0, 2, 3, 0, 0});  // padded to 16 bytes
     const VkTransformMatrixKHR shift = placed(4, 0, 0);
-    in.shift_right = input_buffer<float>(device, std::vector<float>(&shift.matrix[0][0], &shift.matrix[0][0] + 12));
-    in.triangle = input_buffer<float>(device, {0, 0, 0, 4.2f, 0, 0, 0, 4.2f, 0});
+    in.shift_right = build_input<float>(device, std::vector<float>(&shift.matrix[0][0], &shift.matrix[0][0] + 12));
+    in.triangle = build_input<float>(device, {0, 0, 0, 4.2f, 0, 0, 0, 4.2f, 0});
     return in;
 }
 
@@ -136,36 +125,11 @@ void expect_hits(const std::vector<std::uint32_t>& hits, Expected expected) {
     EXPECT_EQ(wrong, 0) << "pixels wrong";
 }
 
-VkMemoryBarrier2 built_to(VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
-    return vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-                                VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR, stage, access);
-}
-
-// A barrier from bottom-level builds to the top-level build that reads them.
-void barrier_between_levels(const vkrc::CommandBuffer& cmd) {
-    const auto b = built_to(VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
-                            VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
-    cmd.pipeline_barrier(std::span(&b, 1), {}, {});
-}
-
-class AccelerationStructureTest : public VulkanTest {
+class AccelerationStructureTest : public vkrc_test::RayQueryTest {
 protected:
     void SetUp() override {
-        VulkanTest::SetUp();
+        RayQueryTest::SetUp();
         if (HasFatalFailure() || IsSkipped()) return;
-        // What the device lacks, as select() would name it.
-        vkrc::DeviceRequirements wanted = vkrc_test::test_device_requirements();
-        wanted.required_features.acceleration_structure.accelerationStructure = VK_TRUE;
-        wanted.required_features.ray_query.rayQuery = VK_TRUE;
-        wanted.required_features.vulkan12.bufferDeviceAddress = VK_TRUE;
-        const auto unmet = physical_device.unmet_requirements(wanted);
-        if (!unmet.empty()) GTEST_SKIP() << "the device " << unmet[0].c_str();
-        vkrc::DeviceCreateInfo info;
-        info.acceleration_structure_features.accelerationStructure = VK_TRUE;  // enables the extensions
-        info.ray_query_features.rayQuery = VK_TRUE;
-        info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
-        device = vkrc::Device::create(physical_device, info);
-        queue = device.default_queue();
         make_tracer();
     }
 

@@ -16,6 +16,7 @@
 #include "support/teapot_scenario.hpp"
 #include "support/vk_test.hpp"
 #include "support/watchdog.hpp"
+#include "support/wrapped_allocator.hpp"
 #include "support/xvfb.hpp"
 
 #include <algorithm>
@@ -637,7 +638,7 @@ TEST(FaultInjection, LossIsReportedWhileTheGpuIsHeldBusy) {
 // A user allocator that fails its k-th allocation in one of three ways.
 enum class AllocatorFailure { bad_alloc, vk_error, no_memory };
 
-class FailingAllocator final : public vkrc::DeviceAllocator {
+class FailingAllocator final : public vkrc_test::WrappedPoolAllocator {
 public:
     FailingAllocator(std::uint64_t fail_at, AllocatorFailure how) : fail_at_(fail_at), how_(how) {}
     vkrc::AllocationInfo allocate(vkrc::DeviceView device, const vkrc::AllocationRequest& request) override {
@@ -652,21 +653,11 @@ public:
                 }
             }
         }
-        auto info = inner_.allocate(device, request);
-        info.allocator_data = new vkrc::AllocationInfo(info);  // the inner allocator's own view
-        info.allocator = this;
-        return info;
+        return WrappedPoolAllocator::allocate(device, request);
     }
-    void free(vkrc::DeviceView device, const vkrc::AllocationInfo& allocation) override {
-        auto* inner = static_cast<vkrc::AllocationInfo*>(allocation.allocator_data);
-        inner_.free(device, *inner);
-        delete inner;
-    }
-    void release(vkrc::DeviceView device) noexcept override { inner_.release(device); }
     std::uint64_t calls() const { return calls_; }
 
 private:
-    vkrc::PoolAllocator inner_;
     std::uint64_t calls_ = 0;
     std::uint64_t fail_at_;
     AllocatorFailure how_;

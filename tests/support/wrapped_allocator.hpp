@@ -1,0 +1,29 @@
+// A test allocator around vkrc's PoolAllocator: each range it makes carries
+// the pool's own view of it, so that a subclass may fail, count or watch
+// the calls and leave the work to the pool.
+#pragma once
+
+#include <vkrc/vkrc.hpp>
+
+namespace vkrc_test {
+
+class WrappedPoolAllocator : public vkrc::DeviceAllocator {
+public:
+    vkrc::AllocationInfo allocate(vkrc::DeviceView device, const vkrc::AllocationRequest& request) override {
+        auto info = inner_.allocate(device, request);
+        info.allocator_data = new vkrc::AllocationInfo(info);  // the pool's own view
+        info.allocator = this;
+        return info;
+    }
+    void free(vkrc::DeviceView device, const vkrc::AllocationInfo& allocation) override {
+        auto* inner = static_cast<vkrc::AllocationInfo*>(allocation.allocator_data);
+        inner_.free(device, *inner);
+        delete inner;
+    }
+    void release(vkrc::DeviceView device) noexcept override { inner_.release(device); }
+
+private:
+    vkrc::PoolAllocator inner_;
+};
+
+}  // namespace vkrc_test
