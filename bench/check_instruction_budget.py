@@ -8,6 +8,10 @@ vary run to run by a few percent, so only the part outside it is compared).
       raw-direct's whole stage (driver included), at most PCT;
   absolute stages (--absolute): the extra instructions per call, at most ABS.
 
+  per frame (--total VARIANT:TARGET[:HOLD]): the extra instructions per
+      call summed over all those stages, at most TARGET (issue 32: vkrc-st
+      64, vkrc-mt 160), or held at HOLD while the target is not met.
+
 One --budget VARIANT:PCT:ABS per variant checked (the issue's targets). A
 stage that does not meet its target yet is held with --hold
 VARIANT:STAGE:EXTRA: its extra instructions per call outside the driver may
@@ -25,6 +29,8 @@ parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("csv")
 parser.add_argument("--budget", action="append", required=True, help="VARIANT:PCT:ABS, e.g. vkrc-st:1:8")
 parser.add_argument("--hold", action="append", default=[], help="VARIANT:STAGE:EXTRA (instructions per call) for a target not met yet")
+parser.add_argument("--total", action="append", default=[],
+                    help="VARIANT:TARGET[:HOLD] extra instructions per frame over all stages")
 parser.add_argument("--relative", default="command,submit,wait")
 parser.add_argument("--absolute", default="acquire,uniform,present")
 parser.add_argument("--reference", default="raw-direct")
@@ -65,6 +71,25 @@ for budget in args.budget:
                                 (f" and {extra:.1f} extra/call > the hold {hold:g}" if hold is not None else ""))
             lines.append(f"{variant:10} {stage:8} extra {extra:8.1f}/call = {value:7.2f}{unit} "
                          f"(target {target:g}) {verdict}")
+stages = [stage for stages in (args.relative, args.absolute) for stage in filter(None, stages.split(","))]
+for total in args.total:
+    variant, target, *held = total.split(":")
+    missing = [stage for stage in stages if (variant, stage) not in rows or (args.reference, stage) not in rows]
+    if missing:
+        failures.append(f"{variant} per frame: {', '.join(missing)} missing from {args.csv}")
+        continue
+    extra = sum(rows[(variant, stage)][1] - rows[(args.reference, stage)][1] for stage in stages)
+    hold = float(held[0]) if held else None
+    if extra <= float(target):
+        verdict = "ok"
+    elif hold is not None and extra <= hold:
+        verdict = f"target not met, held at {hold:g} extra/frame"
+    else:
+        verdict = "OVER"
+        failures.append(f"{variant} per frame: {extra:.1f} extra > {target}" +
+                        (f" and > the hold {hold:g}" if hold is not None else ""))
+    lines.append(f"{variant:10} frame    extra {extra:8.1f}/frame over {','.join(stages)} "
+                 f"(target {float(target):g}) {verdict}")
 print("\n".join(lines))
 if failures:
     print("instruction budget FAILED:\n  " + "\n  ".join(failures), file=sys.stderr)

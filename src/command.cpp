@@ -20,13 +20,24 @@ CommandPoolState::~CommandPoolState() {
     destroy_owned<&DeviceFunctions::vkDestroyCommandPool>(*this, device);
 }
 
+void CommandPoolState::free_pending() {
+    LockGuard lock(mutex);
+    free_ready();
+}
+
 void CommandPoolState::free_ready() {
     scratch.clear();
     pending.take_ready(*device.state(), scratch);
+    has_pending.store(!pending.empty(), __ATOMIC_RELAXED);
     if (!scratch.empty()) {
         device.fn().vkFreeCommandBuffers(device.vk(), handle, static_cast<std::uint32_t>(scratch.size()),
                                          scratch.data());
     }
+}
+
+void CommandPoolState::push_pending(VkCommandBuffer command_buffer, std::uint64_t serial) noexcept {
+    pending.push(*device.state(), command_buffer, serial);
+    has_pending.store(!pending.empty(), __ATOMIC_RELAXED);
 }
 
 CommandBufferState::~CommandBufferState() {
@@ -37,7 +48,7 @@ CommandBufferState::~CommandBufferState() {
     if (ownership == Ownership::borrowed) return;
     auto& p = *pool.state();
     LockGuard lock(p.mutex);
-    p.pending.push(device(), cmd, serial());
+    p.push_pending(cmd, serial());
 }
 
 }  // namespace detail
@@ -70,6 +81,7 @@ detail::Ref<detail::CommandBufferState> new_command_buffer_state(const CommandPo
     s->pool = pool;
     s->level = level;
     s->window.pool = pool.state();
+    s->device_state = pool.state()->device.state();
     return s;
 }
 }  // namespace
@@ -83,7 +95,7 @@ CommandBuffer CommandPool::allocate(VkCommandBufferLevel level) const {
     ai.level = level;
     ai.commandBufferCount = 1;
     LockGuard lock(p.mutex);
-    p.free_completed();
+    p.free_ready();
     check(p.device.fn().vkAllocateCommandBuffers(p.device.vk(), &ai, &s->cmd), "vkAllocateCommandBuffers");
     try {
         p.device.state()->register_window(s->window);
@@ -132,11 +144,8 @@ CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer comm
 void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
     VKRC_REQUIRE_STATE("vkrc::CommandPool::reset_commands");
     auto& p = *state_;
-    {
-        LockGuard lock(p.mutex);
-        p.free_completed();
-        check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
-    }
+    p.free_completed();
+    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
     p.device.state()->close_pool_windows(&p);
 }
 
@@ -147,15 +156,12 @@ std::size_t CommandPool::pending_free_count() const {
 }
 
 namespace {
-void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& info) {
-    auto& p = *s.pool.state();
-    LockGuard lock(p.mutex);
-    p.free_completed();
+// one_time: a ONE_TIME_SUBMIT primary, which its submit closes (a ONE_TIME
+// secondary stays open until reset, re-begin or free).
+void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& info, bool one_time) {
+    s.pool.state()->free_completed();
     check(s.fn->vkBeginCommandBuffer(s.cmd, &info), "vkBeginCommandBuffer");
-    // Only a primary's submit closes it: a ONE_TIME secondary stays open until reset, re-begin or free.
-    const bool one_time =
-        s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY && (info.flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0;
-    p.device.state()->open_window(s.window, one_time);
+    s.device().open_window(s.window, one_time);
 }
 }  // namespace
 
@@ -169,7 +175,7 @@ void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
                    "a secondary command buffer needs begin_secondary");
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = flags;
-    begin_with(*state_, info);
+    begin_with(*state_, info, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
 }
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
@@ -197,34 +203,21 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = flags;
     info.pInheritanceInfo = &inherit;
-    begin_with(*state_, info);
+    begin_with(*state_, info, false);
 }
 
 void CommandBuffer::end() const {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
-    auto& p = *state_->pool.state();
-    LockGuard lock(p.mutex);
-    check(state_->fn->vkEndCommandBuffer(state_->cmd), "vkEndCommandBuffer");
-    p.device.state()->end_window(state_->window);
+    auto& s = *state_;
+    check(s.fn->vkEndCommandBuffer(s.cmd), "vkEndCommandBuffer");
+    s.device().end_window(s.window);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_commands");
-    auto& p = *state_->pool.state();
-    {
-        LockGuard lock(p.mutex);
-        check(state_->fn->vkResetCommandBuffer(state_->cmd, flags), "vkResetCommandBuffer");
-    }
-    p.device.state()->close_window(state_->window);
+    auto& s = *state_;
+    check(s.fn->vkResetCommandBuffer(s.cmd, flags), "vkResetCommandBuffer");
+    s.device().close_window(s.window);
 }
-
-namespace detail {
-void close_submitted(Span<const CommandBuffer> command_buffers) noexcept {
-    for (const CommandBuffer& c : command_buffers) {
-        auto& s = *c.state();
-        if (s.window.one_time) s.device().close_window(s.window);
-    }
-}
-}  // namespace detail
 
 VKRC_END_NAMESPACE

@@ -580,14 +580,8 @@ bool Device::lost() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::Device::lost").lost.load(std::memory_order_relaxed);
 }
 
-namespace {
-
-// Submits with the queue's timeline signal added: into the last batch when
-// its signals fit on the stack; otherwise into one more batch, which
-// submission order still places after all the work before it. Under the
-// queue's lock.
-VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, Span<const VkSubmitInfo2> submits,
-                           VkFence fence, std::uint64_t number) noexcept {
+VkResult detail::DeviceState::submit_signalling(QueueState& q, Span<const VkSubmitInfo2> submits, VkFence fence,
+                                                std::uint64_t number) noexcept {
     q.timeline.take_signal_request();
     VkSemaphoreSubmitInfo timeline{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
     timeline.semaphore = q.semaphore;
@@ -612,9 +606,9 @@ VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, Span<c
         tail.pSignalSemaphoreInfos = &timeline;
     }
     VkResult r = VK_SUCCESS;
-    if (head > 0) r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
+    if (head > 0) r = fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(head), submits.data(), VK_NULL_HANDLE);
     const bool head_went_in = head > 0 && r == VK_SUCCESS;
-    if (r == VK_SUCCESS) r = d.fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
+    if (r == VK_SUCCESS) r = fn.vkQueueSubmit2(q.queue, 1, &tail, fence);
     if (r == VK_SUCCESS) {
         q.timeline.note_signalled(number);
     } else {
@@ -624,25 +618,8 @@ VkResult submit_signalling(detail::DeviceState& d, detail::QueueState& q, Span<c
     return r;
 }
 
-}  // namespace
-
 std::uint64_t Queue::submit(Span<const VkSubmitInfo2> submits, VkFence fence) const {
-    auto& q = *queue_;
-    auto& d = *device_.state();
-    VkResult r;
-    std::uint64_t number;
-    {
-        LockGuard lock(q.mutex);
-        number = q.timeline.next_number();
-        if (!q.timeline.signal_requested()) {
-            r = d.fn.vkQueueSubmit2(q.queue, static_cast<std::uint32_t>(submits.size()), submits.data(), fence);
-            if (r == VK_SUCCESS) q.timeline.note_submitted(number);
-        } else {
-            r = submit_signalling(d, q, submits, fence, number);
-        }
-    }
-    d.finish_call(r, "vkQueueSubmit2");
-    return number;
+    return device_.state()->submit(*queue_, submits, fence);
 }
 
 std::uint64_t detail::submit_signalled(const Queue& queue, Span<const VkSubmitInfo2> submits) {
@@ -653,7 +630,7 @@ std::uint64_t detail::submit_signalled(const Queue& queue, Span<const VkSubmitIn
     {
         LockGuard lock(q.mutex);
         number = q.timeline.next_number();
-        r = submit_signalling(d, q, submits, VK_NULL_HANDLE, number);
+        r = d.submit_signalling(q, submits, VK_NULL_HANDLE, number);
     }
     d.finish_call(r, "vkQueueSubmit2");
     return number;

@@ -28,6 +28,9 @@ PipelineState::~PipelineState() {
 }
 }  // namespace detail
 
+PipelineLayout::PipelineLayout(detail::Ref<detail::PipelineLayoutState> state) noexcept
+    : DeviceChild(std::move(state)), handle_(state_->handle) {}
+
 PipelineLayout PipelineLayout::create(const Device& device) { return create(device, PipelineLayoutCreateInfo{}); }
 
 PipelineLayout PipelineLayout::adopt(const Device& device, VkPipelineLayout layout, Ownership ownership) {

@@ -39,14 +39,17 @@ constexpr std::size_t inline_batches = 4;
     }
 }
 
-void submit_infos(const Queue& queue, Span<const VkSubmitInfo2> infos, const Fence& fence) {
+[[gnu::always_inline]] inline void submit_infos(const Queue& queue, Span<const VkSubmitInfo2> infos,
+                                                const Fence& fence) {
 #if VKRC_RUNTIME_CHECKS
     if (fence && !(fence.device() == queue.device())) {
         throw UsageError("vkrc::submit: the Fence belongs to another device than the queue");
     }
 #endif
-    const std::uint64_t number = queue.submit(infos, fence ? fence.vk() : VK_NULL_HANDLE);
-    if (fence) fence.state()->note_submitted(*queue.state(), number);
+    auto& q = *queue.state();
+    detail::FenceState* f = fence.state();
+    const std::uint64_t number = queue.device().state()->submit(q, infos, f ? f->handle : VK_NULL_HANDLE);
+    if (f) f->note_submitted(q, number);
 }
 
 // An array of n elements: on the stack up to N, on the heap beyond.

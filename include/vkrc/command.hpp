@@ -640,10 +640,6 @@ private:
 
 namespace detail {
 
-// After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
-// (OpenCommandBuffers), whose held drops then wait for that submission.
-void close_submitted(Span<const CommandBuffer> command_buffers) noexcept;
-
 class CommandBufferState final : public RefCounted {
 public:
     ~CommandBufferState() override;
@@ -654,10 +650,24 @@ public:
     VkCommandBufferLevel level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     Ownership ownership = Ownership::owned;  // borrowed (adopted): never freed by vkrc
     RecordingWindow window;                  // registered with the device's OpenCommandBuffers
-    // The device whose OpenCommandBuffers keeps window.
-    DeviceState& device() const noexcept { return *pool.state()->device.state(); }
+    // The pool's device (kept alive through pool), whose OpenCommandBuffers
+    // keeps window: one load for begin, end and submit rather than three.
+    DeviceState* device_state = nullptr;
+    DeviceState& device() const noexcept { return *device_state; }
 };
 
+}  // namespace detail
+
+namespace detail {
+// After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
+// (OpenCommandBuffers), whose held drops then wait for that submission.
+// Inline: a frame's submit closes one command buffer.
+inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept {
+    for (const CommandBuffer& c : command_buffers) {
+        auto& s = *c.state();
+        if (s.window.one_time) s.device().close_window(s.window);
+    }
+}
 }  // namespace detail
 
 inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {

@@ -27,10 +27,10 @@ class CommandBuffer;
 
 // A command pool, externally synchronised as Vulkan requires: record into the
 // command buffers of one pool from one thread at a time (use a pool per
-// thread). Under the multi-thread policy the pool's lock is taken by
-// allocate, reset, begin and end (never per recorded command), so that the
-// frees vkrc does on its own when a command buffer is dropped (on any thread)
-// never race with them.
+// thread). A command buffer dropped on any thread goes onto the pool's list
+// of pending frees under the pool's lock; allocate, reset and begin free the
+// completed ones (on the pool's thread, under that lock), and take the lock
+// only when the list is not empty (never per recorded command).
 class CommandPool : public DeviceChild<detail::CommandPoolState, VkCommandPool> {
 public:
     static CommandPool create(const Device& device, const CommandPoolCreateInfo& info);
@@ -60,17 +60,27 @@ class CommandPoolState final : public DeviceChildState<VkCommandPool> {
 public:
     static constexpr const char* type_name = "vkrc::CommandPool";
     ~CommandPoolState() override;
-    // Under mutex: frees the dropped command buffers the GPU is done with.
-    // Inline: a frame loop's begin and reset find nothing pending.
+    // On the pool's thread (allocate, reset, begin), not under mutex: frees
+    // the dropped command buffers the GPU is done with. Inline: a frame
+    // loop's begin and reset find nothing pending, one load and no lock.
     void free_completed() {
-        if (!pending.empty()) free_ready();
+        if (has_pending.load(__ATOMIC_RELAXED)) [[unlikely]]
+            free_pending();
     }
+    // Takes mutex and frees what is ready.
+    void free_pending();
+    // Under mutex: frees what is ready.
     void free_ready();
+    // Under mutex: a dropped command buffer joins pending.
+    void push_pending(VkCommandBuffer command_buffer, std::uint64_t serial) noexcept;
 
     std::uint32_t queue_family_index = 0;
     mutable Mutex mutex;
     PoolFreeList<VkCommandBuffer> pending;  // under mutex
     List<VkCommandBuffer> scratch;          // under mutex
+    // Whether pending is not empty: written under mutex, read without it by
+    // free_completed (a drop it misses is freed at the next one).
+    detail::Atomic<bool> has_pending{false};
 };
 
 }  // namespace detail

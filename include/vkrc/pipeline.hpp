@@ -32,6 +32,7 @@ struct PipelineLayoutCreateInfo {
 
 class PipelineLayout : public DeviceChild<detail::PipelineLayoutState, VkPipelineLayout> {
 public:
+    PipelineLayout() noexcept = default;
     static PipelineLayout create(const Device& device, const PipelineLayoutCreateInfo& info);
     static PipelineLayout create(const Device& device);  // no sets, no push constants
     // Wraps one made elsewhere from device. With Ownership::owned vkrc destroys
@@ -40,8 +41,16 @@ public:
     // checked against them.
     static PipelineLayout adopt(const Device& device, VkPipelineLayout layout, Ownership ownership);
 
+    VkPipelineLayout vk() const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::PipelineLayout::vk");
+        return handle_;
+    }
+
 private:
-    using DeviceChild::DeviceChild;
+    explicit PipelineLayout(detail::Ref<detail::PipelineLayoutState> state) noexcept;
+    // The state's handle, copied into the wrapper (as CommandBuffer's): a
+    // push_constants per draw then reads it in one load, not two.
+    VkPipelineLayout handle_ = VK_NULL_HANDLE;
 };
 
 // Mirrors VkSubpassDescription (graphics subpasses).

@@ -285,6 +285,31 @@ public:
     }
 
     // ---- Queues' timelines
+    // Queue::submit: submits under the queue's lock, signalling the queue's
+    // timeline when asked to, and returns the submission's number. Inline:
+    // vkrc::submit's frame loop reaches vkQueueSubmit2 without another call.
+    std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence) {
+        VkResult r;
+        std::uint64_t number;
+        {
+            LockGuard lock(queue.mutex);
+            number = queue.timeline.next_number();
+            if (!queue.timeline.signal_requested()) [[likely]] {
+                r = fn.vkQueueSubmit2(queue.queue, static_cast<std::uint32_t>(submits.size()), submits.data(), fence);
+                if (r == VK_SUCCESS) queue.timeline.note_submitted(number);
+            } else {
+                r = submit_signalling(queue, submits, fence, number);
+            }
+        }
+        finish_call(r, "vkQueueSubmit2");
+        return number;
+    }
+    // Under the queue's lock: submits with the queue's timeline signal of
+    // number added (into the last batch when its signals fit on the stack,
+    // else into one more batch, which submission order still places after all
+    // the work before it).
+    VkResult submit_signalling(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
+                               std::uint64_t number) noexcept;
     // Under the queue's lock: when submits since the last timeline signal
     // carried none, submits an empty batch that signals. value receives a
     // timeline value, signalled or on its way, that covers all work submitted
