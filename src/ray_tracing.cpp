@@ -21,11 +21,9 @@ VkPhysicalDeviceRayTracingPipelinePropertiesKHR ray_tracing_pipeline_properties(
 
 namespace {
 
-constexpr VkShaderStageFlags ray_tracing_stages = VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR |
-                                                  VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR |
-                                                  VK_SHADER_STAGE_ANY_HIT_BIT_KHR |
-                                                  VK_SHADER_STAGE_INTERSECTION_BIT_KHR |
-                                                  VK_SHADER_STAGE_CALLABLE_BIT_KHR;
+constexpr VkShaderStageFlags ray_tracing_stages =
+    VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_MISS_BIT_KHR | VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR |
+    VK_SHADER_STAGE_ANY_HIT_BIT_KHR | VK_SHADER_STAGE_INTERSECTION_BIT_KHR | VK_SHADER_STAGE_CALLABLE_BIT_KHR;
 
 // What a ray tracing pipeline needs of the device: the extension (its
 // commands are loaded only then) and its rayTracingPipeline feature.
@@ -38,7 +36,8 @@ void require_support(const detail::Caller& caller, const Device& device) {
                    "ray tracing pipelines need the rayTracingPipeline feature enabled");
 }
 
-void check_stages(const detail::Caller& caller, const PipelineLayout& layout, const RayTracingPipelineCreateInfo& info) {
+void check_stages(const detail::Caller& caller, const PipelineLayout& layout,
+                  const RayTracingPipelineCreateInfo& info) {
     caller.require(!info.stages.empty(), "stages is empty");
     for (std::size_t i = 0; i < info.stages.size(); ++i) {
         const RayTracingShaderStage& s = info.stages[i];
@@ -49,10 +48,10 @@ void check_stages(const detail::Caller& caller, const PipelineLayout& layout, co
         caller.require(s.module.device() == layout.device(), "stages[", i,
                        "].module belongs to another device than the pipeline layout");
         for (const auto& e : s.specialization.map_entries) {
-            caller.require(e.offset <= s.specialization.data.size() &&
-                               e.size <= s.specialization.data.size() - e.offset,
-                           "stages[", i, "]: specialization constant ", e.constantID, " lies outside the data (",
-                           s.specialization.data.size(), " bytes)");
+            caller.require(
+                e.offset <= s.specialization.data.size() && e.size <= s.specialization.data.size() - e.offset,
+                "stages[", i, "]: specialization constant ", e.constantID, " lies outside the data (",
+                s.specialization.data.size(), " bytes)");
         }
     }
 }
@@ -170,9 +169,8 @@ RayTracingPipeline RayTracingPipeline::create(const PipelineLayout& layout, cons
     s->bind_point = VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR;
     s->group_regions = std::move(regions);
     s->max_ray_recursion_depth = info.max_ray_recursion_depth;
-    check(device.fn().vkCreateRayTracingPipelinesKHR(device.vk(), VK_NULL_HANDLE,
-                                                     info.cache ? info.cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr,
-                                                     &s->handle),
+    check(device.fn().vkCreateRayTracingPipelinesKHR(
+              device.vk(), VK_NULL_HANDLE, info.cache ? info.cache.vk() : VK_NULL_HANDLE, 1, &ci, nullptr, &s->handle),
           "vkCreateRayTracingPipelinesKHR");
     return RayTracingPipeline(std::move(s));
 }
@@ -223,8 +221,7 @@ VkDeviceSize checked_stride(const detail::Caller& caller, const detail::RayTraci
         caller.require(group < pipeline.group_regions.size(), name, "[", i, "]: group ", group, " is out of range (",
                        pipeline.group_regions.size(), " groups)");
         caller.require(pipeline.group_regions[group] == region, name, "[", i, "]: group ", group, " is a ",
-                       region_names[static_cast<int>(pipeline.group_regions[group])], " group, not a ", name,
-                       " group");
+                       region_names[static_cast<int>(pipeline.group_regions[group])], " group, not a ", name, " group");
         largest = std::max<VkDeviceSize>(largest, props.shaderGroupHandleSize + records[i].data.size());
     }
     const VkDeviceSize stride = align_up(largest, props.shaderGroupHandleAlignment);
