@@ -172,10 +172,16 @@ void check_triangles(const detail::Caller& caller, const Device& device, const T
     }
 }
 
-VkAccelerationStructureGeometryKHR triangles_of(const TriangleGeometry& g) {
+// A geometry of type with flags, its data for the caller to fill in.
+VkAccelerationStructureGeometryKHR geometry_of(VkGeometryTypeKHR type, VkGeometryFlagsKHR flags) {
     VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-    geometry.flags = g.flags;
+    geometry.geometryType = type;
+    geometry.flags = flags;
+    return geometry;
+}
+
+VkAccelerationStructureGeometryKHR triangles_of(const TriangleGeometry& g) {
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_TRIANGLES_KHR, g.flags);
     auto& t = geometry.geometry.triangles;
     t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
     t.vertexFormat = g.vertex_format;
@@ -203,9 +209,7 @@ void check_aabbs(const detail::Caller& caller, const Device& device, const AabbG
 }
 
 VkAccelerationStructureGeometryKHR aabbs_of(const AabbGeometry& g) {
-    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
-    geometry.flags = g.flags;
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_AABBS_KHR, g.flags);
     auto& a = geometry.geometry.aabbs;
     a.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
     a.data.deviceAddress = g.buffer.device_address() + g.offset;
@@ -374,8 +378,7 @@ AccelerationStructure record_top_level(const detail::Caller& caller, const Comma
                                           VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
                                           MemoryUsage::upload, info.allocator, 16, address);
     instances.allocation().write(address - instances.device_address(), records.data(), records.size());
-    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_INSTANCES_KHR, 0);
     geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
     geometry.geometry.instances.data.deviceAddress = address;
     const auto count = static_cast<std::uint32_t>(records.size());

@@ -25,6 +25,7 @@
 
 namespace {
 
+using vkrc_test::usage_error_of;
 using vkrc_test::VulkanTest;
 using OneShot = vkrc_test::OneShotCommands;
 
@@ -110,16 +111,6 @@ void expect_results(const std::vector<std::uint32_t>& results, Expected expected
     EXPECT_EQ(wrong, 0) << "pixels wrong";
 }
 
-template <class F>
-std::string usage_error_of(F&& f) {
-    try {
-        f();
-    } catch (const vkrc::UsageError& e) {
-        return e.what();
-    }
-    return "(no UsageError)";
-}
-
 // The stages of the scene's pipeline, in this order, and its groups.
 enum Stage : std::uint32_t { raygen, scene_miss, shadow_miss, closest_hit, any_hit, intersection, callable };
 enum Group : std::uint32_t { raygen_group, miss_group, shadow_group, triangles_group, spheres_group, callable_group };
@@ -173,10 +164,10 @@ protected:
         pool = vkrc::DescriptorPool::create(device, {.max_sets = 4,
                                                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 4},
                                                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4}}});
-        results = vkrc::Buffer::create(device, {.size = side * side * 4,
-                                                .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                                .memory = {.usage = vkrc::MemoryUsage::readback}});
+        results = vkrc::Buffer::create(device,
+                                       {.size = side * side * 4,
+                                        .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                        .memory = {.usage = vkrc::MemoryUsage::readback}});
     }
 
     vkrc::ShaderModule module(std::span<const std::uint32_t> code) const {
@@ -252,7 +243,11 @@ protected:
         OneShot s(queue);
         vkrc::BottomLevelBuildInfo quads;
         quads.geometries = {
-            {.vertex_buffer = vertex_buffer, .max_vertex = 7, .index_buffer = index_buffer, .triangle_count = 2, .flags = 0},
+            {.vertex_buffer = vertex_buffer,
+             .max_vertex = 7,
+             .index_buffer = index_buffer,
+             .triangle_count = 2,
+             .flags = 0},
             {.vertex_buffer = vertex_buffer,
              .max_vertex = 7,
              .index_buffer = index_buffer,
@@ -348,9 +343,8 @@ TEST_F(RayTracingTest, TracedSceneMatchesTheExpectedHitsShadowsAndRecords) {
     EXPECT_EQ(pipeline.group_region(callable_group), vkrc::ShaderGroupRegion::callable);
     EXPECT_EQ(pipeline.max_ray_recursion_depth(), 2u);
     const auto table = make_table(pipeline);
-    expect_results(trace(scene.top_level, pipeline, table), [](std::uint32_t x, std::uint32_t y) {
-        return expected_value(x, y);
-    });
+    expect_results(trace(scene.top_level, pipeline, table),
+                   [](std::uint32_t x, std::uint32_t y) { return expected_value(x, y); });
 }
 
 // The layout follows the device's handle size and alignments; raygen's size is its stride.
@@ -413,7 +407,8 @@ TEST_F(RayTracingTest, IndirectTraceReadsItsDimensionsFromABuffer) {
     record_trace(s.cmd, pipeline, set,
                  [&](const vkrc::CommandBuffer& cmd) { cmd.trace_rays_indirect(table, indirect.device_address()); });
     s.run(queue);
-    expect_results(read_results(), [](std::uint32_t x, std::uint32_t y) { return expected_value(x, y); }, side / 2);
+    expect_results(
+        read_results(), [](std::uint32_t x, std::uint32_t y) { return expected_value(x, y); }, side / 2);
 }
 
 // The table, the pipeline, the top level and its bottom levels, and the set,
@@ -459,26 +454,30 @@ TEST_F(RayTracingTest, BadPipelinesAreRefused) {
     EXPECT_EQ(refusal([](auto& i) { i.groups[1].general_shader = 9; }),
               who + "groups[1].general_shader 9 is out of range (7 stages)");
     EXPECT_EQ(refusal([](auto& i) { i.groups[3].closest_hit_shader = scene_miss; }),
-              who + "groups[3].closest_hit_shader is stages[1], a VK_SHADER_STAGE_MISS_BIT_KHR shader; it must be a "
-                    "CLOSEST_HIT shader");
+              who +
+                  "groups[3].closest_hit_shader is stages[1], a VK_SHADER_STAGE_MISS_BIT_KHR shader; it must be a "
+                  "CLOSEST_HIT shader");
     EXPECT_EQ(refusal([](auto& i) { i.groups[0].closest_hit_shader = closest_hit; }),
-              who + "groups[0] (VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR) has a closest_hit_shader, which its "
-                    "type does not take (VK_SHADER_UNUSED_KHR)");
+              who +
+                  "groups[0] (VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR) has a closest_hit_shader, which its "
+                  "type does not take (VK_SHADER_UNUSED_KHR)");
     EXPECT_EQ(refusal([](auto& i) { i.groups[4].intersection_shader = VK_SHADER_UNUSED_KHR; }),
               who + "groups[4] is PROCEDURAL_HIT_GROUP without an intersection_shader");
     EXPECT_EQ(refusal([](auto& i) { i.groups[5].general_shader = any_hit; }),
-              who + "groups[5].general_shader is stages[4], a VK_SHADER_STAGE_ANY_HIT_BIT_KHR shader; it must be a "
-                    "RAYGEN, MISS or CALLABLE shader");
+              who +
+                  "groups[5].general_shader is stages[4], a VK_SHADER_STAGE_ANY_HIT_BIT_KHR shader; it must be a "
+                  "RAYGEN, MISS or CALLABLE shader");
     EXPECT_EQ(refusal([](auto& i) { i.stages[callable].stage = VK_SHADER_STAGE_COMPUTE_BIT; }),
-              who + "stages[6].stage 0x20 is not one ray tracing stage (RAYGEN, MISS, CLOSEST_HIT, ANY_HIT, "
-                    "INTERSECTION or CALLABLE)");
+              who +
+                  "stages[6].stage 0x20 is not one ray tracing stage (RAYGEN, MISS, CLOSEST_HIT, ANY_HIT, "
+                  "INTERSECTION or CALLABLE)");
     EXPECT_EQ(refusal([](auto& i) { i.groups.clear(); }), who + "groups is empty");
     EXPECT_EQ(refusal([](auto& i) { i.flags = VK_PIPELINE_CREATE_LIBRARY_BIT_KHR; }),
               who + "flags has LIBRARY_BIT_KHR: pipeline libraries are not supported");
     const std::uint32_t max = vkrc::ray_tracing_pipeline_properties(physical_device).maxRayRecursionDepth;
     EXPECT_EQ(refusal([&](auto& i) { i.max_ray_recursion_depth = max + 1; }),
-              who + "max_ray_recursion_depth " + std::to_string(max + 1) + " exceeds the device's maxRayRecursionDepth " +
-                  std::to_string(max));
+              who + "max_ray_recursion_depth " + std::to_string(max + 1) +
+                  " exceeds the device's maxRayRecursionDepth " + std::to_string(max));
 }
 
 TEST_F(RayTracingTest, BadTablesAreRefused) {
@@ -514,7 +513,8 @@ TEST_F(RayTracingTest, BadBoxGeometryIsRefused) {
     vkrc::BottomLevelBuildInfo info;
     info.geometries = {{.vertex_buffer = vertices, .max_vertex = 2, .triangle_count = 1}};
     info.aabbs = {{.buffer = boxes, .count = 1}};
-    EXPECT_EQ(refusal(info), who + "geometries and aabbs are both set; a bottom level holds triangles or boxes, not both");
+    EXPECT_EQ(refusal(info),
+              who + "geometries and aabbs are both set; a bottom level holds triangles or boxes, not both");
     info.geometries.clear();
     info.aabbs[0].count = 2;
     EXPECT_EQ(refusal(info), who + "aabbs[0]: 2 boxes at stride 24 from offset 0 need 48 bytes, the buffer has 24");
@@ -559,14 +559,10 @@ TEST_F(RayTracingRefusal, WithoutTheFeaturePipelinesAreRefused) {
 TEST_F(RayTracingRefusal, RequirementsNameTheMissingFeature) {
     vkrc::DeviceRequirements wanted = vkrc_test::test_device_requirements();
     wanted.required_features.ray_tracing_pipeline.rayTracingPipelineShaderGroupHandleCaptureReplayMixed = VK_TRUE;
-    const auto unmet = physical_device.unmet_requirements(wanted);
-    if (physical_device.features().ray_tracing_pipeline.rayTracingPipelineShaderGroupHandleCaptureReplayMixed) {
-        EXPECT_TRUE(unmet.empty());
-        return;
-    }
-    ASSERT_EQ(unmet.size(), 1u);
-    EXPECT_STREQ(unmet[0].c_str(),
-                 "lacks feature rayTracingPipelineShaderGroupHandleCaptureReplayMixed (VK_KHR_ray_tracing_pipeline)");
+    vkrc_test::expect_requirement_named(
+        physical_device, wanted,
+        physical_device.features().ray_tracing_pipeline.rayTracingPipelineShaderGroupHandleCaptureReplayMixed,
+        "lacks feature rayTracingPipelineShaderGroupHandleCaptureReplayMixed (VK_KHR_ray_tracing_pipeline)");
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include "support/features.hpp"
 #include "support/vk_test.hpp"
 
 #include "shaders/fill_pattern.comp.h"
@@ -11,16 +12,8 @@
 
 namespace {
 
+using vkrc_test::usage_error_of;
 using vkrc_test::VulkanTest;
-
-std::string usage_error_of(auto&& f) {
-    try {
-        f();
-    } catch (const vkrc::UsageError& e) {
-        return e.what();
-    }
-    return "(no UsageError)";
-}
 
 TEST_F(VulkanTest, ShaderModuleFromEmbeddedSpirv) {
     auto module = vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp);

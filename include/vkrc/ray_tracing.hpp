@@ -18,7 +18,7 @@ class ShaderBindingTableState;
 
 // One stage of a ray tracing pipeline (VkPipelineShaderStageCreateInfo).
 struct RayTracingShaderStage {
-    // Required: RAYGEN, MISS, CLOSEST_HIT, ANY_HIT, INTERSECTION or CALLABLE (a _KHR stage bit).
+    // Optional (default RAYGEN): RAYGEN, MISS, CLOSEST_HIT, ANY_HIT, INTERSECTION or CALLABLE (_KHR bits).
     VkShaderStageFlagBits stage = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
     // Required, of the layout's device. Kept alive by nothing after create.
     ShaderModule module{};
