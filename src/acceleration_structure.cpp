@@ -3,6 +3,7 @@
 #include "vkrc/command.hpp"
 
 #include "caller.hpp"
+#include "memory_internal.hpp"
 #include "object_state.hpp"
 
 #include <vector>
@@ -24,10 +25,6 @@ namespace {
 
 constexpr VkBufferUsageFlags input_usage =
     VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-
-VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
-    return alignment <= 1 ? value : (value + alignment - 1) / alignment * alignment;
-}
 
 // What every acceleration structure call needs of the device: the extension
 // (its commands are loaded only then) and buffer device addresses.
@@ -62,7 +59,7 @@ Buffer build_buffer(const Device& device, VkDeviceSize size, VkBufferUsageFlags 
                                             .usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                             .memory = {.usage = memory},
                                             .allocator = allocator});
-    address = align_up(buffer.device_address(), alignment);
+    address = detail::align_up(buffer.device_address(), alignment);
     return buffer;
 }
 

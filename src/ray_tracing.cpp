@@ -1,6 +1,7 @@
 #include "vkrc/ray_tracing.hpp"
 
 #include "caller.hpp"
+#include "memory_internal.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -197,10 +198,6 @@ std::uint32_t RayTracingPipeline::max_ray_recursion_depth() const VKRC_UNCHECKED
 
 namespace {
 
-VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
-    return alignment <= 1 ? value : (value + alignment - 1) / alignment * alignment;
-}
-
 constexpr const char* region_names[] = {"raygen", "miss", "hit", "callable"};
 
 // One region's records, with where they go.
@@ -224,10 +221,48 @@ VkDeviceSize checked_stride(const detail::Caller& caller, const detail::RayTraci
                        region_names[static_cast<int>(pipeline.group_regions[group])], " group, not a ", name, " group");
         largest = std::max<VkDeviceSize>(largest, props.shaderGroupHandleSize + records[i].data.size());
     }
-    const VkDeviceSize stride = align_up(largest, props.shaderGroupHandleAlignment);
+    const VkDeviceSize stride = detail::align_up(largest, props.shaderGroupHandleAlignment);
     caller.require(stride <= props.maxShaderGroupStride, name, ": a record of ", largest, " bytes (stride ", stride,
                    ") exceeds the device's maxShaderGroupStride ", props.maxShaderGroupStride);
     return stride;
+}
+
+}  // namespace
+
+namespace {
+
+// Checks the records and places the regions one after the other; returns the bytes they take.
+VkDeviceSize lay_out(const detail::Caller& caller, const detail::RayTracingPipelineState& pipeline,
+                     const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& props, RegionLayout (&regions)[4]) {
+    VkDeviceSize size = 0;
+    for (int r = 0; r < 4; ++r) {
+        regions[r].stride = checked_stride(caller, pipeline, props, ShaderGroupRegion(r), regions[r].records);
+        regions[r].offset = detail::align_up(size, props.shaderGroupBaseAlignment);
+        size = regions[r].offset + regions[r].stride * regions[r].records.size();
+    }
+    return size;
+}
+
+// The table's size bytes: each record its group's handle (read once for
+// every group) and its data.
+std::vector<std::byte> table_bytes(const RayTracingPipeline& pipeline, std::uint32_t handle_size,
+                                   const RegionLayout (&regions)[4], VkDeviceSize size) {
+    const Device& device = pipeline.layout().device();
+    const std::uint32_t group_count = pipeline.group_count();
+    std::vector<std::byte> handles(std::size_t(handle_size) * group_count);
+    check(device.fn().vkGetRayTracingShaderGroupHandlesKHR(device.vk(), pipeline.vk(), 0, group_count, handles.size(),
+                                                           handles.data()),
+          "vkGetRayTracingShaderGroupHandlesKHR");
+    std::vector<std::byte> bytes(size);
+    for (const RegionLayout& region : regions) {
+        for (std::size_t i = 0; i < region.records.size(); ++i) {
+            std::byte* record = bytes.data() + region.offset + i * region.stride;
+            std::memcpy(record, handles.data() + std::size_t(handle_size) * region.records[i].group, handle_size);
+            const auto& data = region.records[i].data;
+            if (!data.empty()) std::memcpy(record + handle_size, data.data(), data.size());
+        }
+    }
+    return bytes;
 }
 
 }  // namespace
@@ -239,45 +274,23 @@ ShaderBindingTable ShaderBindingTable::create(const RayTracingPipeline& pipeline
     const Device& device = pipeline.layout().device();
     caller.require(device.state()->enabled_features.vulkan12.bufferDeviceAddress,
                    "shader binding tables need the bufferDeviceAddress feature enabled");
-    const auto& state = static_cast<const detail::RayTracingPipelineState&>(*pipeline.state());
     const auto props = ray_tracing_pipeline_properties(device.physical_device());
     RegionLayout regions[4] = {{Span(&info.raygen, 1)}, {info.miss}, {info.hit}, {info.callable}};
-    VkDeviceSize size = 0;
-    for (int r = 0; r < 4; ++r) {
-        regions[r].stride = checked_stride(caller, state, props, ShaderGroupRegion(r), regions[r].records);
-        regions[r].offset = align_up(size, props.shaderGroupBaseAlignment);
-        size = regions[r].offset + regions[r].stride * regions[r].records.size();
-    }
-    // Every handle, read once; record i of a region copies its group's.
-    const std::uint32_t handle_size = props.shaderGroupHandleSize;
-    std::vector<std::byte> handles(std::size_t(handle_size) * state.group_regions.size());
-    check(device.fn().vkGetRayTracingShaderGroupHandlesKHR(device.vk(), pipeline.vk(), 0,
-                                                           static_cast<std::uint32_t>(state.group_regions.size()),
-                                                           handles.size(), handles.data()),
-          "vkGetRayTracingShaderGroupHandlesKHR");
-    std::vector<std::byte> bytes(size);
-    for (const RegionLayout& region : regions) {
-        for (std::size_t i = 0; i < region.records.size(); ++i) {
-            std::byte* record = bytes.data() + region.offset + i * region.stride;
-            std::memcpy(record, handles.data() + std::size_t(handle_size) * region.records[i].group, handle_size);
-            const auto& data = region.records[i].data;
-            if (!data.empty()) std::memcpy(record + handle_size, data.data(), data.size());
-        }
-    }
+    const VkDeviceSize size =
+        lay_out(caller, static_cast<const detail::RayTracingPipelineState&>(*pipeline.state()), props, regions);
+    const auto bytes = table_bytes(pipeline, props.shaderGroupHandleSize, regions, size);
     // The buffer's address aligned to shaderGroupBaseAlignment (it is made that much larger).
-    const VkDeviceSize slack = props.shaderGroupBaseAlignment > 1 ? props.shaderGroupBaseAlignment - 1 : 0;
     Buffer buffer = Buffer::create(
-        device, {.size = size + slack,
+        device, {.size = size + props.shaderGroupBaseAlignment - 1,
                  .usage = VK_BUFFER_USAGE_SHADER_BINDING_TABLE_BIT_KHR | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                  .memory = {.usage = MemoryUsage::upload},
                  .allocator = info.allocator});
-    const VkDeviceAddress start = align_up(buffer.device_address(), props.shaderGroupBaseAlignment);
+    const VkDeviceAddress start = detail::align_up(buffer.device_address(), props.shaderGroupBaseAlignment);
     buffer.allocation().write(start - buffer.device_address(), bytes.data(), bytes.size());
     detail::Ref<detail::ShaderBindingTableState> s(new detail::ShaderBindingTableState);
     for (int r = 0; r < 4; ++r) {
-        const RegionLayout& region = regions[r];
-        if (region.records.empty()) continue;  // all zero, as Vulkan takes an unused region
-        s->regions[r] = {start + region.offset, region.stride, region.stride * region.records.size()};
+        if (regions[r].records.empty()) continue;  // all zero, as Vulkan takes an unused region
+        s->regions[r] = {start + regions[r].offset, regions[r].stride, regions[r].stride * regions[r].records.size()};
     }
     s->buffer = std::move(buffer);
     s->pipeline = pipeline;
