@@ -14,10 +14,11 @@ REGISTRY = sys.argv[1] if len(sys.argv) > 1 else "/usr/share/vulkan/registry/vk.
 OUT = sys.argv[2] if len(sys.argv) > 2 else "src/enum_names.inl"
 DECLARATIONS = sys.argv[3] if len(sys.argv) > 3 else "src/enum_text.inl"
 FEATURES = ["VK_VERSION_1_0", "VK_VERSION_1_1", "VK_VERSION_1_2", "VK_VERSION_1_3"]
-EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils"]
+EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils", "VK_EXT_mesh_shader",
+              "VK_KHR_ray_tracing_pipeline"]
 ENUMS = ["VkDescriptorType", "VkFormat", "VkPhysicalDeviceType", "VkColorSpaceKHR", "VkImageLayout", "VkImageType",
          "VkImageTiling", "VkImageViewType", "VkSampleCountFlagBits", "VkSamplerAddressMode", "VkFilter",
-         "VkSamplerMipmapMode"]
+         "VkSamplerMipmapMode", "VkShaderStageFlagBits", "VkRayTracingShaderGroupTypeKHR"]
 
 root = ET.parse(REGISTRY).getroot()
 values = {e: [] for e in ENUMS}

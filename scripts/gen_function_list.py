@@ -15,7 +15,7 @@ FEATURES = ["VK_VERSION_1_0", "VK_VERSION_1_1", "VK_VERSION_1_2", "VK_VERSION_1_
 # Platform-neutral extensions vkrc itself uses; platform surface creation is
 # left to GLFW or to the application, which keeps window-system headers out.
 EXTENSIONS = ["VK_KHR_surface", "VK_KHR_swapchain", "VK_EXT_debug_utils", "VK_KHR_push_descriptor", "VK_EXT_mesh_shader",
-              "VK_KHR_acceleration_structure"]
+              "VK_KHR_acceleration_structure", "VK_KHR_ray_tracing_pipeline"]
 GLOBAL = {"vkCreateInstance", "vkEnumerateInstanceVersion",
           "vkEnumerateInstanceLayerProperties", "vkEnumerateInstanceExtensionProperties"}
 

@@ -3,6 +3,7 @@
 #include "vkrc/command.hpp"
 
 #include "caller.hpp"
+#include "memory_internal.hpp"
 #include "object_state.hpp"
 
 #include <vector>
@@ -24,10 +25,6 @@ namespace {
 
 constexpr VkBufferUsageFlags input_usage =
     VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT | VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-
-VkDeviceSize align_up(VkDeviceSize value, VkDeviceSize alignment) {
-    return alignment <= 1 ? value : (value + alignment - 1) / alignment * alignment;
-}
 
 // What every acceleration structure call needs of the device: the extension
 // (its commands are loaded only then) and buffer device addresses.
@@ -62,7 +59,7 @@ Buffer build_buffer(const Device& device, VkDeviceSize size, VkBufferUsageFlags 
                                             .usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
                                             .memory = {.usage = memory},
                                             .allocator = allocator});
-    address = align_up(buffer.device_address(), alignment);
+    address = detail::align_up(buffer.device_address(), alignment);
     return buffer;
 }
 
@@ -123,25 +120,25 @@ AccelerationStructure structure_of(const Device& device, VkAccelerationStructure
 }
 
 // The geometries of a bottom-level build, checked, in Vulkan's form.
-struct TriangleInputs {
+struct BuildInputs {
     std::vector<VkAccelerationStructureGeometryKHR> geometries;
     std::vector<VkAccelerationStructureBuildRangeInfoKHR> ranges;
     std::vector<std::uint32_t> counts;
 };
 
-// An input buffer of geometry i (what names it, e.g. "vertex_buffer"):
+// An input buffer of list[i] (what names it, e.g. "vertex_buffer"):
 // this device's, with the usage a build reads it through.
-void check_input(const detail::Caller& caller, const Device& device, const Buffer& buffer, std::size_t i,
-                 const char* what) {
-    caller.require(buffer.device() == device, "geometries[", i, "].", what, " belongs to another device");
-    caller.require((buffer.usage() & input_usage) == input_usage, "geometries[", i, "].", what,
+void check_input(const detail::Caller& caller, const Device& device, const Buffer& buffer, const char* list,
+                 std::size_t i, const char* what) {
+    caller.require(buffer.device() == device, list, "[", i, "].", what, " belongs to another device");
+    caller.require((buffer.usage() & input_usage) == input_usage, list, "[", i, "].", what,
                    " lacks SHADER_DEVICE_ADDRESS or ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY usage");
 }
 
 // One geometry's checks: buffers, counts, and that what it reads lies in its buffers.
 void check_triangles(const detail::Caller& caller, const Device& device, const TriangleGeometry& g, std::size_t i) {
     caller.require(static_cast<bool>(g.vertex_buffer), "geometries[", i, "] has no vertex_buffer");
-    check_input(caller, device, g.vertex_buffer, i, "vertex_buffer");
+    check_input(caller, device, g.vertex_buffer, "geometries", i, "vertex_buffer");
     caller.require(g.triangle_count != 0, "geometries[", i, "] has triangle_count 0");
     caller.require(g.vertex_stride != 0 && g.vertex_stride % 2 == 0 && g.vertex_stride <= UINT32_MAX, "geometries[", i,
                    "] has vertex_stride ", g.vertex_stride, "; it must be a non-zero multiple of its component size");
@@ -150,7 +147,7 @@ void check_triangles(const detail::Caller& caller, const Device& device, const T
                    " at stride ", g.vertex_stride, " from offset ", g.vertex_offset, " need ", vertex_end,
                    " bytes, the vertex_buffer has ", g.vertex_buffer.size());
     if (g.index_buffer) {
-        check_input(caller, device, g.index_buffer, i, "index_buffer");
+        check_input(caller, device, g.index_buffer, "geometries", i, "index_buffer");
         caller.require(g.index_type == VK_INDEX_TYPE_UINT16 || g.index_type == VK_INDEX_TYPE_UINT32, "geometries[", i,
                        "] has index_type ", g.index_type, "; UINT16 or UINT32 with an index_buffer");
         const VkDeviceSize index_size = g.index_type == VK_INDEX_TYPE_UINT16 ? 2 : 4;
@@ -164,7 +161,7 @@ void check_triangles(const detail::Caller& caller, const Device& device, const T
                        " vertices, max_vertex is ", g.max_vertex);
     }
     if (g.transform_buffer) {
-        check_input(caller, device, g.transform_buffer, i, "transform_buffer");
+        check_input(caller, device, g.transform_buffer, "geometries", i, "transform_buffer");
         caller.require(g.transform_offset % 16 == 0 &&
                            g.transform_offset + sizeof(VkTransformMatrixKHR) <= g.transform_buffer.size(),
                        "geometries[", i, "]: transform_offset ", g.transform_offset,
@@ -172,10 +169,16 @@ void check_triangles(const detail::Caller& caller, const Device& device, const T
     }
 }
 
-VkAccelerationStructureGeometryKHR triangles_of(const TriangleGeometry& g) {
+// A geometry of type with flags, its data for the caller to fill in.
+VkAccelerationStructureGeometryKHR geometry_of(VkGeometryTypeKHR type, VkGeometryFlagsKHR flags) {
     VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-    geometry.flags = g.flags;
+    geometry.geometryType = type;
+    geometry.flags = flags;
+    return geometry;
+}
+
+VkAccelerationStructureGeometryKHR triangles_of(const TriangleGeometry& g) {
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_TRIANGLES_KHR, g.flags);
     auto& t = geometry.geometry.triangles;
     t.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
     t.vertexFormat = g.vertex_format;
@@ -188,15 +191,49 @@ VkAccelerationStructureGeometryKHR triangles_of(const TriangleGeometry& g) {
     return geometry;
 }
 
-TriangleInputs triangle_inputs(const detail::Caller& caller, const Device& device, const BottomLevelBuildInfo& info) {
-    caller.require(!info.geometries.empty(), "geometries is empty");
-    TriangleInputs in;
+// One box geometry's checks: its buffer, count, stride and that the boxes lie in it.
+void check_aabbs(const detail::Caller& caller, const Device& device, const AabbGeometry& g, std::size_t i) {
+    caller.require(static_cast<bool>(g.buffer), "aabbs[", i, "] has no buffer");
+    check_input(caller, device, g.buffer, "aabbs", i, "buffer");
+    caller.require(g.count != 0, "aabbs[", i, "] has count 0");
+    // VUID-VkAccelerationStructureGeometryAabbsDataKHR-stride-03545 and the address's 8-byte alignment (-03714).
+    caller.require(g.stride % 8 == 0 && g.stride >= sizeof(VkAabbPositionsKHR) && g.stride <= UINT32_MAX, "aabbs[", i,
+                   "] has stride ", g.stride, "; it must be a multiple of 8, at least 24");
+    caller.require(g.offset % 8 == 0, "aabbs[", i, "] has offset ", g.offset, "; it must be a multiple of 8");
+    const VkDeviceSize end = g.offset + VkDeviceSize(g.count - 1) * g.stride + sizeof(VkAabbPositionsKHR);
+    caller.require(end <= g.buffer.size(), "aabbs[", i, "]: ", g.count, " boxes at stride ", g.stride, " from offset ",
+                   g.offset, " need ", end, " bytes, the buffer has ", g.buffer.size());
+}
+
+VkAccelerationStructureGeometryKHR aabbs_of(const AabbGeometry& g) {
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_AABBS_KHR, g.flags);
+    auto& a = geometry.geometry.aabbs;
+    a.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR;
+    a.data.deviceAddress = g.buffer.device_address() + g.offset;
+    a.stride = g.stride;
+    return geometry;
+}
+
+// The triangles or the boxes of info (a bottom level holds one kind:
+// VUID-VkAccelerationStructureBuildGeometryInfoKHR-type-03792), checked.
+BuildInputs geometry_inputs(const detail::Caller& caller, const Device& device, const BottomLevelBuildInfo& info) {
+    caller.require(!info.geometries.empty() || !info.aabbs.empty(), "geometries and aabbs are both empty");
+    caller.require(info.geometries.empty() || info.aabbs.empty(),
+                   "geometries and aabbs are both set; a bottom level holds triangles or boxes, not both");
+    BuildInputs in;
     for (std::size_t i = 0; i < info.geometries.size(); ++i) {
         const TriangleGeometry& g = info.geometries[i];
         check_triangles(caller, device, g, i);
         in.geometries.push_back(triangles_of(g));
         in.ranges.push_back({g.triangle_count, 0, 0, 0});
         in.counts.push_back(g.triangle_count);
+    }
+    for (std::size_t i = 0; i < info.aabbs.size(); ++i) {
+        const AabbGeometry& g = info.aabbs[i];
+        check_aabbs(caller, device, g, i);
+        in.geometries.push_back(aabbs_of(g));
+        in.ranges.push_back({g.count, 0, 0, 0});
+        in.counts.push_back(g.count);
     }
     return in;
 }
@@ -271,7 +308,7 @@ VkAccelerationStructureBuildGeometryInfoKHR build_info(VkAccelerationStructureTy
 AccelerationStructure build_bottom_level(const CommandBuffer& cmd, const BottomLevelBuildInfo& info) {
     const detail::Caller caller{"vkrc::build_bottom_level"};
     const Device& device = build_device(caller, cmd);
-    const TriangleInputs in = triangle_inputs(caller, device, info);
+    const BuildInputs in = geometry_inputs(caller, device, info);
     const auto build = build_info(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, info.flags, in.geometries.data(),
                                   in.geometries.size());
     return record_build(caller, cmd, build, in.counts.data(), in.ranges.data(), {}, info.allocator);
@@ -286,7 +323,7 @@ void update_bottom_level(const CommandBuffer& cmd, const AccelerationStructure& 
                    "mode-04631)");
     caller.require(info.flags == bottom_level.build_flags(), "flags ", detail::Hex{info.flags},
                    " differ from the build's ", detail::Hex{bottom_level.build_flags()});
-    const TriangleInputs in = triangle_inputs(caller, device, info);
+    const BuildInputs in = geometry_inputs(caller, device, info);
     auto build = build_info(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, info.flags, in.geometries.data(),
                             in.geometries.size());
     build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_UPDATE_KHR;
@@ -338,8 +375,7 @@ AccelerationStructure record_top_level(const detail::Caller& caller, const Comma
                                           VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR,
                                           MemoryUsage::upload, info.allocator, 16, address);
     instances.allocation().write(address - instances.device_address(), records.data(), records.size());
-    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
-    geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+    auto geometry = geometry_of(VK_GEOMETRY_TYPE_INSTANCES_KHR, 0);
     geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
     geometry.geometry.instances.data.deviceAddress = address;
     const auto count = static_cast<std::uint32_t>(records.size());

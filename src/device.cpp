@@ -380,17 +380,26 @@ bool wants_acceleration_structure(const DeviceCreateInfo& info) {
            a.accelerationStructureHostCommands || a.descriptorBindingAccelerationStructureUpdateAfterBind;
 }
 bool wants_ray_query(const DeviceCreateInfo& info) { return info.ray_query_features.rayQuery != VK_FALSE; }
+// Whether info asks for any VK_KHR_ray_tracing_pipeline feature.
+bool wants_ray_tracing_pipeline(const DeviceCreateInfo& info) {
+    const auto& r = info.ray_tracing_pipeline_features;
+    return r.rayTracingPipeline || r.rayTracingPipelineShaderGroupHandleCaptureReplay ||
+           r.rayTracingPipelineShaderGroupHandleCaptureReplayMixed || r.rayTracingPipelineTraceRaysIndirect ||
+           r.rayTraversalPrimitiveCulling;
+}
 
 // The extensions asked for, those the features asked for need, and those
 // vkrc enables where the device has them.
 std::vector<const char*> device_extensions(const PhysicalDevice& physical, const DeviceCreateInfo& info) {
     std::vector<const char*> extensions(info.enabled_extension_names.begin(), info.enabled_extension_names.end());
     if (wants_mesh_shader(info)) detail::add_unique(extensions, VK_EXT_MESH_SHADER_EXTENSION_NAME);
-    if (wants_acceleration_structure(info)) {
+    // VK_KHR_ray_tracing_pipeline depends on VK_KHR_acceleration_structure.
+    if (wants_acceleration_structure(info) || wants_ray_tracing_pipeline(info)) {
         detail::add_unique(extensions, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
         detail::add_unique(extensions, VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
     }
     if (wants_ray_query(info)) detail::add_unique(extensions, VK_KHR_RAY_QUERY_EXTENSION_NAME);
+    if (wants_ray_tracing_pipeline(info)) detail::add_unique(extensions, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
     if (info.enable_memory_budget && physical.supports_extension(VK_EXT_MEMORY_BUDGET_EXTENSION_NAME)) {
         detail::add_unique(extensions, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME);
     }
@@ -429,6 +438,7 @@ struct FeatureChain {
         copy_features(chained.mesh_shader, info.mesh_shader_features);
         copy_features(chained.acceleration_structure, info.acceleration_structure_features);
         copy_features(chained.ray_query, info.ray_query_features);
+        copy_features(chained.ray_tracing_pipeline, info.ray_tracing_pipeline_features);
         chained.vulkan13.synchronization2 = VK_TRUE;
         chained.vulkan13.dynamicRendering = VK_TRUE;
         // Required of every 1.3 device; SPIR-V for vulkan1.3 (vkrc_add_shaders) uses LocalSizeId.
@@ -438,6 +448,7 @@ struct FeatureChain {
         void* extensions = const_cast<void*>(info.next);
         chain_if(wants_mesh_shader(info), chained.mesh_shader, extensions);
         chain_if(wants_ray_query(info), chained.ray_query, extensions);
+        chain_if(wants_ray_tracing_pipeline(info), chained.ray_tracing_pipeline, extensions);
         chain_if(wants_acceleration_structure(info), chained.acceleration_structure, extensions);
         chained.vulkan13.pNext = extensions;
         chained.vulkan12.pNext = &chained.vulkan13;
@@ -452,7 +463,8 @@ struct FeatureChain {
         DeviceFeatures d = chained;
         d.core = features.features;
         d.vulkan11.pNext = d.vulkan12.pNext = d.vulkan13.pNext = nullptr;
-        d.mesh_shader.pNext = d.acceleration_structure.pNext = d.ray_query.pNext = nullptr;
+        d.mesh_shader.pNext = d.acceleration_structure.pNext = d.ray_query.pNext = d.ray_tracing_pipeline.pNext =
+            nullptr;
         return d;
     }
 

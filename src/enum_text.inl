@@ -12,3 +12,5 @@ std::string enum_text(VkSampleCountFlagBits value);
 std::string enum_text(VkSamplerAddressMode value);
 std::string enum_text(VkFilter value);
 std::string enum_text(VkSamplerMipmapMode value);
+std::string enum_text(VkShaderStageFlagBits value);
+std::string enum_text(VkRayTracingShaderGroupTypeKHR value);

@@ -50,9 +50,13 @@ void read_extension_features(const InstanceFunctions& f, VkPhysicalDevice raw, s
         out.ray_query.pNext = features.pNext;
         features.pNext = &out.ray_query;
     }
+    if (detail::contains(extensions, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME)) {
+        out.ray_tracing_pipeline.pNext = features.pNext;
+        features.pNext = &out.ray_tracing_pipeline;
+    }
     if (!features.pNext) return;
     f.vkGetPhysicalDeviceFeatures2(raw, &features);
-    out.acceleration_structure.pNext = out.ray_query.pNext = nullptr;
+    out.acceleration_structure.pNext = out.ray_query.pNext = out.ray_tracing_pipeline.pNext = nullptr;
 }
 
 }  // namespace

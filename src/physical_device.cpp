@@ -28,6 +28,13 @@ void add_missing_features(const DeviceFeatures& want, const DeviceFeatures& have
     VKRC_EXTENSION_FEATURE(acceleration_structure, "VK_KHR_acceleration_structure",
                            descriptorBindingAccelerationStructureUpdateAfterBind)
     VKRC_EXTENSION_FEATURE(ray_query, "VK_KHR_ray_query", rayQuery)
+    VKRC_EXTENSION_FEATURE(ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline", rayTracingPipeline)
+    VKRC_EXTENSION_FEATURE(ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline",
+                           rayTracingPipelineShaderGroupHandleCaptureReplay)
+    VKRC_EXTENSION_FEATURE(ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline",
+                           rayTracingPipelineShaderGroupHandleCaptureReplayMixed)
+    VKRC_EXTENSION_FEATURE(ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline", rayTracingPipelineTraceRaysIndirect)
+    VKRC_EXTENSION_FEATURE(ray_tracing_pipeline, "VK_KHR_ray_tracing_pipeline", rayTraversalPrimitiveCulling)
 #undef VKRC_EXTENSION_FEATURE
 }
 

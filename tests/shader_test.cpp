@@ -12,9 +12,8 @@
 
 namespace {
 
-using vkrc_test::VulkanTest;
-
 using vkrc_test::usage_error_of;
+using vkrc_test::VulkanTest;
 
 TEST_F(VulkanTest, ShaderModuleFromEmbeddedSpirv) {
     auto module = vkrc::ShaderModule::create(device, vkrc_shaders::fill_pattern_comp);

@@ -83,10 +83,32 @@ struct TriangleGeometry {
     VkGeometryFlagsKHR flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
 };
 
-// A bottom-level build. Every member but geometries is optional.
+// One box geometry of a bottom-level build (VkAccelerationStructureGeometryAabbsDataKHR
+// with its VkAccelerationStructureBuildRangeInfoKHR): count VkAabbPositionsKHR
+// records, for procedural hit groups whose intersection shader decides what
+// each box holds. The buffer is read as TriangleGeometry's are (same usage,
+// same lifetime).
+struct AabbGeometry {
+    // Required.
+    Buffer buffer{};
+    // Optional (default 0): a multiple of 8.
+    VkDeviceSize offset = 0;
+    // Optional (default tightly packed): a multiple of 8, at least 24.
+    VkDeviceSize stride = sizeof(VkAabbPositionsKHR);
+    // Required, non-zero.
+    std::uint32_t count = 0;
+    // Optional (default opaque): OPAQUE, NO_DUPLICATE_ANY_HIT_INVOCATION.
+    VkGeometryFlagsKHR flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+};
+
+// A bottom-level build of triangles or of boxes: exactly one of geometries
+// and aabbs is set (Vulkan builds one kind per bottom level). Every other
+// member is optional.
 struct BottomLevelBuildInfo {
-    // Required, not empty.
+    // Triangles (default none); gl_GeometryIndexEXT is the index in this list.
     List<TriangleGeometry> geometries{};
+    // Boxes (default none); gl_GeometryIndexEXT is the index in this list.
+    List<AabbGeometry> aabbs{};
     // PREFER_FAST_TRACE by default; ALLOW_UPDATE to refit later with update_bottom_level.
     VkBuildAccelerationStructureFlagsKHR flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
     // Where the structure's buffer and the scratch come from (null: the device's default).
@@ -137,7 +159,7 @@ AccelerationStructure build_top_level(const CommandBuffer& cmd, const TopLevelBu
 // are, so work in flight that traces the old build keeps them.
 void rebuild_top_level(const CommandBuffer& cmd, const AccelerationStructure& top_level, const TopLevelBuildInfo& info);
 // Refits bottom_level in place (mode UPDATE) from geometries of the same
-// shape (count, triangle counts, formats) with moved vertices; bottom_level
+// shape (kind, count, triangle or box counts, formats) with moved vertices or boxes; bottom_level
 // must have been built with ALLOW_UPDATE (UsageError otherwise).
 void update_bottom_level(const CommandBuffer& cmd, const AccelerationStructure& bottom_level,
                          const BottomLevelBuildInfo& info);

@@ -12,6 +12,7 @@
 #include "vkrc/command_pool.hpp"
 #include "vkrc/descriptor_template.hpp"
 #include "vkrc/pipeline.hpp"
+#include "vkrc/ray_tracing.hpp"
 #include "vkrc/rendering.hpp"
 #include "vkrc/sync.hpp"
 
@@ -439,6 +440,25 @@ public:
         fn_->vkCmdDrawMeshTasksIndirectCountEXT(
             cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
             stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
+    }
+
+    // Ray tracing (VK_KHR_ray_tracing_pipeline: DeviceCreateInfo::ray_tracing_pipeline_features)
+    // with a bound RayTracingPipeline: width * height * depth raygen
+    // invocations through the table's four regions, which the table holds
+    // (a drop of it while this recording is open waits, as every drop does).
+    void trace_rays(const ShaderBindingTable& table, std::uint32_t width, std::uint32_t height,
+                    std::uint32_t depth = 1) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::trace_rays");
+        const VkStridedDeviceAddressRegionKHR* r = table.regions();
+        fn_->vkCmdTraceRaysKHR(cmd_, &r[0], &r[1], &r[2], &r[3], width, height, depth);
+    }
+    // The dimensions from a VkTraceRaysIndirectCommandKHR at indirect, a
+    // device address in a buffer with INDIRECT_BUFFER usage, read at
+    // execution. Needs the rayTracingPipelineTraceRaysIndirect feature.
+    void trace_rays_indirect(const ShaderBindingTable& table, VkDeviceAddress indirect) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::trace_rays_indirect");
+        const VkStridedDeviceAddressRegionKHR* r = table.regions();
+        fn_->vkCmdTraceRaysIndirectKHR(cmd_, &r[0], &r[1], &r[2], &r[3], indirect);
     }
 
     // Occlusion and pipeline-statistics queries (reset them first, outside rendering).

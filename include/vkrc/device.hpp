@@ -73,6 +73,10 @@ struct DeviceCreateInfo {
     // VK_KHR_acceleration_structure needs). Default none.
     VkPhysicalDeviceAccelerationStructureFeaturesKHR acceleration_structure_features{};
     VkPhysicalDeviceRayQueryFeaturesKHR ray_query_features{};
+    // With any feature set, vkrc chains it and enables VK_KHR_ray_tracing_pipeline
+    // with VK_KHR_acceleration_structure, which it depends on (RayTracingPipeline,
+    // trace_rays: vkrc/ray_tracing.hpp). Default none.
+    VkPhysicalDeviceRayTracingPipelineFeaturesKHR ray_tracing_pipeline_features{};
     // Enable VK_EXT_memory_budget when the device has it (for allocator statistics). Default true.
     bool enable_memory_budget = true;
     // Chained after vkrc's feature structs (must not repeat them). Null: none.

@@ -130,6 +130,10 @@ struct DeviceFeatures {
             VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
     VkPhysicalDeviceRayQueryFeaturesKHR ray_query = detail::with_type<VkPhysicalDeviceRayQueryFeaturesKHR>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+    // VK_KHR_ray_tracing_pipeline's, likewise.
+    VkPhysicalDeviceRayTracingPipelineFeaturesKHR ray_tracing_pipeline =
+        detail::with_type<VkPhysicalDeviceRayTracingPipelineFeaturesKHR>(
+            VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR);
 };
 
 // What a device must offer to be chosen. Every unmet item is reported.

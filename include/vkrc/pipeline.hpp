@@ -489,7 +489,8 @@ public:
     bool loaded_from_file = false;
 };
 
-class PipelineState final : public VulkanObjectState<VkPipeline> {
+// Not final: a ray tracing pipeline's state adds its groups (vkrc/ray_tracing.hpp).
+class PipelineState : public VulkanObjectState<VkPipeline> {
 public:
     static constexpr const char* type_name = "vkrc::Pipeline";
     ~PipelineState() override;

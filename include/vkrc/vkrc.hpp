@@ -20,6 +20,7 @@
 #include "vkrc/mipmap.hpp"
 #include "vkrc/pipeline.hpp"
 #include "vkrc/private_data.hpp"
+#include "vkrc/ray_tracing.hpp"
 #include "vkrc/rendering.hpp"
 #include "vkrc/resource.hpp"
 #include "vkrc/shader.hpp"

@@ -103,5 +103,6 @@ extern VkDeviceSize bytes;
   [[maybe_unused]] auto& log = vkrc_snippets::log;
 
 namespace vkrc_shaders {  // vkrc_add_shaders' headers
-extern const std::span<const std::uint32_t> triangle_vert, triangle_frag, collatz_comp, cull_task, meshlets_mesh;
+extern const std::span<const std::uint32_t> triangle_vert, triangle_frag, collatz_comp, cull_task, meshlets_mesh,
+    scene_rgen, scene_rmiss, scene_rchit;
 }

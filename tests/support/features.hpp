@@ -32,6 +32,30 @@ inline SupportedFeatures supported_features(const vkrc::PhysicalDevice& physical
     return f;
 }
 
+// The message of the UsageError f throws, or "(no UsageError)".
+std::string usage_error_of(auto&& f) {
+    try {
+        f();
+    } catch (const vkrc::UsageError& e) {
+        return e.what();
+    }
+    return "(no UsageError)";
+}
+
+// unmet_requirements of wanted, which asks for one feature more than the
+// test device's defaults: nothing where the device has it (supported), else
+// exactly the reason given.
+inline void expect_requirement_named(const vkrc::PhysicalDevice& physical, const vkrc::DeviceRequirements& wanted,
+                                     bool supported, const char* reason) {
+    const auto unmet = physical.unmet_requirements(wanted);
+    if (supported) {
+        EXPECT_TRUE(unmet.empty());
+        return;
+    }
+    ASSERT_EQ(unmet.size(), 1u);
+    EXPECT_STREQ(unmet[0].c_str(), reason);
+}
+
 // The names of the features that are VK_FALSE, comma-separated; empty when all are there.
 inline std::string missing_features(std::initializer_list<std::pair<const char*, VkBool32>> features) {
     std::string out;
@@ -41,16 +65,6 @@ inline std::string missing_features(std::initializer_list<std::pair<const char*,
         out += name;
     }
     return out;
-}
-
-// The message of the UsageError f throws, or "(no UsageError)".
-std::string usage_error_of(auto&& f) {
-    try {
-        f();
-    } catch (const vkrc::UsageError& e) {
-        return e.what();
-    }
-    return "(no UsageError)";
 }
 
 // A primary command buffer, recording from construction; run() submits it and waits.
