@@ -153,9 +153,14 @@ TEST(RaytraceImageMetrics, PsnrOfKnownDifferences) {
     EXPECT_EQ(d.max_channel_difference, 6);
     EXPECT_DOUBLE_EQ(d.mean_squared_error, 3.0);
     EXPECT_NEAR(d.psnr_db, 43.3596, 1e-4);
-    EXPECT_TRUE(raytrace::within(d, {1, 6}));
-    EXPECT_FALSE(raytrace::within(d, {0, 6}));
-    EXPECT_FALSE(raytrace::within(d, {1, 5}));
+    // One pixel of four: 25%.
+    EXPECT_TRUE(raytrace::within(d, {25.0, 6, 43.0}));
+    EXPECT_FALSE(raytrace::within(d, {24.9, 6, 43.0}));
+    EXPECT_FALSE(raytrace::within(d, {25.0, 5, 43.0}));
+    EXPECT_FALSE(raytrace::within(d, {25.0, 6, 43.4}));
+    // The default tolerance takes equal images only.
+    EXPECT_TRUE(raytrace::within(same, {}));
+    EXPECT_FALSE(raytrace::within(d, {}));
 }
 
 TEST(RaytraceImageMetrics, AlphaIsNotComparedAndSizesMustAgree) {

@@ -48,13 +48,17 @@ inline ImageDifference compare_images(std::span<const std::uint8_t> a, std::span
     return d;
 }
 
-// The largest difference a render path may have from the reference and still match it.
+// The largest difference a render path may have from the reference and still match it
+// (the defaults: none). Differing pixels as a percentage of those compared, so that it holds
+// for any extent.
 struct ImageTolerance {
-    std::size_t differing_pixels = 0;
+    double differing_percent = 0;
     int max_channel_difference = 0;
+    double min_psnr_db = std::numeric_limits<double>::infinity();  // equal images have an infinite PSNR
 };
 inline bool within(const ImageDifference& d, const ImageTolerance& t) {
-    return d.differing_pixels <= t.differing_pixels && d.max_channel_difference <= t.max_channel_difference;
+    return double(d.differing_pixels) <= t.differing_percent / 100.0 * double(d.pixels) &&
+           d.max_channel_difference <= t.max_channel_difference && d.psnr_db >= t.min_psnr_db;
 }
 
 }  // namespace raytrace

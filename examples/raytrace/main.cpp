@@ -1,30 +1,38 @@
 // examples/raytrace: the teapot scene of examples/renderer (scene.hpp) drawn by one of several render
 // paths, each measured against the rasterised image of the same camera. Written only against vkrc
 // (no raw Vulkan call; ctest examples.raytrace_no_raw_vulkan checks it).
-//     raytrace [--path raster|mesh] [--compare] [--frames N] [--validation]          a window
-//     raytrace --headless [--path P] [--compare [--csv FILE]] [--out FILE.png] [--frames N] [--validation]
-// Paths: raster (a vertex shader, one indexed draw per instance) and mesh (a mesh shader over
-// meshlets of the same meshes, meshlets.hpp). --compare also draws the rasterised reference every
+//     raytrace [--path raster|mesh|raytrace] [--shadows on|off] [--compare] [--frames N] [--validation]
+//     raytrace --headless [--path P] [--shadows on|off] [--compare [--csv FILE]] [--out FILE.png] [--frames N]
+//              [--validation]
+// Paths: raster (a vertex shader, one indexed draw per instance), mesh (a mesh shader over
+// meshlets of the same meshes, meshlets.hpp) and raytrace (a ray tracing pipeline: a ray per
+// pixel, with shadow rays unless --shadows off). --compare also draws the rasterised reference every
 // frame, into an image of its own, and reports each path's GPU time per frame (timestamps, median
 // over the frames) and the chosen path's difference from the reference (image_metrics.hpp):
 // differing pixels, max channel difference, PSNR. It exits with status 1 when the difference is
 // beyond the path's tolerance (PathInfo). The window or PNG shows the chosen path. With --compare,
 // --csv FILE also writes those figures as CSV, a row per path (bench/raytrace_run.sh).
 //
+// The rasteriser has no shadows: with --compare, raytrace traces none either (--shadows off is
+// its default there, and on is refused), so that the images differ only where rays and
+// rasterisation sample differently.
+//
 // A path is a ScenePath: it draws the scene into its own image and leaves it a transfer source;
 // the frame loop times it, blits its image to the presented one and compares it. Another path
-// (a ray tracer: one bottom-level structure per mesh of scene.hpp, one instance per Instance,
-// shaders/raytrace_shading.glsl for its closest-hit) adds a RenderPath, a PathInfo, its device
-// features in require and a case in make_path.
+// adds a RenderPath, a PathInfo, its device features in require and a case in make_path.
 #include <vkrc/glfw.hpp>
 #include <vkrc/vkrc.hpp>
 
 #include "raytrace/image_metrics.hpp"
 #include "raytrace/meshlets.hpp"
 #include "raytrace/scene.hpp"
+#include "shaders/raytrace_background.rmiss.h"
+#include "shaders/raytrace_lit.rmiss.h"
 #include "shaders/raytrace_mesh.mesh.h"
+#include "shaders/raytrace_primary.rgen.h"
 #include "shaders/raytrace_raster.vert.h"
 #include "shaders/raytrace_scene.frag.h"
+#include "shaders/raytrace_surface.rchit.h"
 #include "support/device_buffer.hpp"
 #include "support/window_or_headless.hpp"
 
@@ -32,6 +40,7 @@
 #include <array>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -46,7 +55,7 @@ namespace use = vkrc::use;
 constexpr VkFormat colour_format = VK_FORMAT_R8G8B8A8_UNORM, depth_format = VK_FORMAT_D32_SFLOAT;
 constexpr std::uint32_t frames_in_flight = 2;
 
-enum class RenderPath { raster, mesh };
+enum class RenderPath { raster, mesh, raytrace };
 struct PathInfo {
     RenderPath path;
     const char* name;  // on the command line
@@ -54,9 +63,23 @@ struct PathInfo {
     // device must be deterministic); mesh transforms every vertex with the vertex shader's
     // operations (shaders/raytrace_scene.glsl) and keeps each instance's triangle order, so
     // every fragment gets the same coverage, depth and interpolated normal.
+    //
+    // raytrace (without shadows) samples each pixel centre as rasterisation does, but decides
+    // coverage by its own intersection test and interpolates the normal from the hit's
+    // barycentrics, not the rasteriser's: pixels on silhouettes and triangle edges may flip
+    // between surfaces (any channel difference there), and shaded values elsewhere may be a
+    // unit off. Measured on lavapipe (Mesa 25.0) at 480x270: 30 pixels of 129600 (0.023%)
+    // differ, by up to 72, PSNR 65.0 dB. The tolerance leaves room (20x the pixels, 20 dB) for
+    // another device's rasterisation rules, traversal and rounding: up to 0.5% of pixels, by any
+    // amount (a flipped edge pixel may show the background), PSNR at least 45 dB.
     raytrace::ImageTolerance tolerance;
 };
-constexpr std::array<PathInfo, 2> path_infos = {{{RenderPath::raster, "raster", {}}, {RenderPath::mesh, "mesh", {}}}};
+constexpr std::array<PathInfo, 3> path_infos = {
+    {{RenderPath::raster, "raster", {}},
+     {RenderPath::mesh, "mesh", {}},
+     {RenderPath::raytrace,
+      "raytrace",
+      {.differing_percent = 0.5, .max_channel_difference = 255, .min_psnr_db = 45.0}}}};
 const PathInfo& info_of(RenderPath path) {
     return *std::find_if(path_infos.begin(), path_infos.end(), [&](const PathInfo& p) { return p.path == path; });
 }
@@ -65,6 +88,7 @@ const PathInfo& info_of(RenderPath path) {
 struct PathOptions {
     RenderPath path = RenderPath::raster;
     bool compare = false;
+    bool shadows = true;   // raytrace only
     std::string csv_file;  // empty: none
 };
 
@@ -237,19 +261,197 @@ private:
     vkrc::ImageView colour_view_, depth_view_;
 };
 
+// The ray-traced path: a bottom-level structure per mesh, a top level of one instance per scene
+// instance (its custom index the instance's index), and a ray tracing pipeline whose raygen shader
+// (shaders/raytrace_primary.rgen) writes a storage image. The closest-hit shader reads the
+// instance's world matrix and colour, and its mesh's indices and normals, from storage buffers.
+class RayTracedPath final : public ScenePath {
+public:
+    RayTracedPath(const vkrc::Queue& queue, const Scene& scene, bool shadows)
+        : device_(queue.device()), shadows_(shadows) {
+        const auto& g = scene.geometry;
+        constexpr VkBufferUsageFlags build_input =
+            VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR |
+            VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+        constexpr auto storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+        positions_ = vkrc_examples::device_buffer(queue, g.positions, build_input);
+        // 32-bit: the closest-hit shader reads whole words.
+        indices_ = vkrc_examples::device_buffer(queue, std::vector<std::uint32_t>(g.indices.begin(), g.indices.end()),
+                                                build_input | storage);
+        normals_ = vkrc_examples::device_buffer(queue, g.normals, storage);
+        std::vector<InstanceRecord> records;
+        for (const auto& i : scene.instances)
+            records.push_back({i.world, i.colour, g.meshes[i.mesh].first_index, g.meshes[i.mesh].vertex_offset, {}});
+        instances_ = vkrc_examples::device_buffer(queue, records, storage);
+        build_structures(queue, scene);
+        build_pipeline();
+    }
+
+    void resize(VkExtent2D extent) override {
+        extent_ = extent;
+        image_ = vkrc::Image::create(device_, {.format = colour_format,
+                                               .extent = {extent.width, extent.height, 1},
+                                               .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+        view_ = vkrc::ImageView::create(image_);
+        set_.write_image(1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, view_, storage_write.layout);
+        // The inverse in double: the rays' ends are then as close as float allows to where the
+        // rasteriser's view_proj puts each pixel centre.
+        const auto frame = raytrace::frame_uniforms(extent.width, extent.height);
+        constants_ = {glm::mat4(glm::inverse(glm::dmat4(frame.view_proj))), frame.light_direction, shadows_ ? 1u : 0u};
+    }
+
+    void record(const vkrc::CommandBuffer& cmd) const override {
+        // After the last frame's blit from the image, whose contents are not kept.
+        cmd.pipeline_barrier({}, {},
+                             std::array{vkrc::image_barrier(image_, use::discarded(use::transfer_src), storage_write)});
+        cmd.bind_pipeline(pipeline_);
+        cmd.bind_descriptor_set(pipeline_, 0, set_);
+        cmd.push_constants(layout_, trace_stages, constants_);
+        cmd.trace_rays(table_, extent_.width, extent_.height);
+        cmd.pipeline_barrier({}, {}, std::array{vkrc::image_barrier(image_, storage_write, use::transfer_src)});
+    }
+
+    const vkrc::Image& output() const override { return image_; }
+
+private:
+    // shaders/raytrace_trace.glsl's push constants.
+    struct TraceConstants {
+        glm::mat4 inverse_view_proj;
+        glm::vec4 light_direction;
+        std::uint32_t shadows;
+    };
+    // shaders/raytrace_surface.rchit's Instance (std430: 96 bytes).
+    struct InstanceRecord {
+        glm::mat4 world;
+        glm::vec4 colour;
+        std::uint32_t first_index;
+        std::int32_t vertex_offset;
+        std::array<std::uint32_t, 2> padding;
+    };
+    static constexpr VkShaderStageFlags trace_stages =
+        VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
+    static constexpr vkrc::Use storage_write{VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR,
+                                             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL};
+
+    // The bottom levels (one per mesh) and the top level, built in one submission and waited for;
+    // its last barrier makes the top level visible to the frames' rays.
+    void build_structures(const vkrc::Queue& queue, const Scene& scene) {
+        const auto& g = scene.geometry;
+        auto pool = vkrc::CommandPool::create(device_, {.queue_family_index = queue.family_index()});
+        const auto cmd = pool.allocate();
+        cmd.begin();
+        std::vector<vkrc::AccelerationStructure> meshes;
+        for (const auto& m : g.meshes) {
+            vkrc::BottomLevelBuildInfo info;
+            info.geometries = {{.vertex_buffer = positions_,
+                                .vertex_offset = VkDeviceSize(m.vertex_offset) * sizeof(glm::vec3),
+                                .max_vertex = m.vertex_count - 1,
+                                .index_buffer = indices_,
+                                .index_offset = VkDeviceSize(m.first_index) * sizeof(std::uint32_t),
+                                .triangle_count = m.index_count / 3}};
+            meshes.push_back(vkrc::build_bottom_level(cmd, info));
+        }
+        const auto built = vkrc::memory_barrier(
+            VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+            VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+        cmd.pipeline_barrier(std::span(&built, 1), {}, {});
+        vkrc::TopLevelBuildInfo top;
+        for (std::uint32_t i = 0; i < scene.instances.size(); ++i) {
+            const auto& w = scene.instances[i].world;  // column-major; the transform is 3x4 row-major
+            VkTransformMatrixKHR transform;
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 4; ++c) transform.matrix[r][c] = w[c][r];
+            top.instances.push_back(
+                {.bottom_level = meshes[scene.instances[i].mesh], .transform = transform, .custom_index = i});
+        }
+        top_level_ = vkrc::build_top_level(cmd, top);  // keeps the bottom levels
+        const auto traced = vkrc::memory_barrier(
+            VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, VK_ACCESS_2_ACCELERATION_STRUCTURE_WRITE_BIT_KHR,
+            VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+        cmd.pipeline_barrier(std::span(&traced, 1), {}, {});
+        cmd.end();
+        auto done = vkrc::Fence::create(device_, false);
+        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, done);
+        done.wait();
+    }
+
+    // The set (binding 0: the top level; 1: the output image, written by resize; 2 to 4: the
+    // instances, indices and normals), the layout, the pipeline and its table: raygen; the
+    // background's and the lit shadow ray's misses; the one hit group every instance uses.
+    void build_pipeline() {
+        constexpr auto hit = VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR;
+        const auto set_layout = vkrc::DescriptorSetLayout::create(
+            device_, {.bindings = {{0, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1, trace_stages},
+                                   {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, VK_SHADER_STAGE_RAYGEN_BIT_KHR},
+                                   {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit},
+                                   {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit},
+                                   {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, hit}}});
+        const auto pool =
+            vkrc::DescriptorPool::create(device_, {.max_sets = 1,
+                                                   .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
+                                                                  {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+                                                                  {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}}});
+        set_ = pool.allocate(set_layout);
+        set_.write_acceleration_structure(0, top_level_);
+        set_.write_buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instances_);
+        set_.write_buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, indices_);
+        set_.write_buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, normals_);
+        layout_ = vkrc::PipelineLayout::create(
+            device_,
+            {.set_layouts = {set_layout}, .push_constant_ranges = {{trace_stages, 0, sizeof(TraceConstants)}}});
+        auto module = [&](std::span<const std::uint32_t> code) { return vkrc::ShaderModule::create(device_, code); };
+        vkrc::RayTracingPipelineCreateInfo info;
+        info.stages = {
+            {.stage = VK_SHADER_STAGE_RAYGEN_BIT_KHR, .module = module(vkrc_shaders::raytrace_primary_rgen)},
+            {.stage = VK_SHADER_STAGE_MISS_BIT_KHR, .module = module(vkrc_shaders::raytrace_background_rmiss)},
+            {.stage = VK_SHADER_STAGE_MISS_BIT_KHR, .module = module(vkrc_shaders::raytrace_lit_rmiss)},
+            {.stage = hit, .module = module(vkrc_shaders::raytrace_surface_rchit)}};
+        info.groups = {{.general_shader = 0},
+                       {.general_shader = 1},
+                       {.general_shader = 2},
+                       {.type = VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR, .closest_hit_shader = 3}};
+        info.max_ray_recursion_depth = 2;  // primary rays, and the shadow rays of their hits
+        pipeline_ = vkrc::RayTracingPipeline::create(layout_, info);
+        table_ = vkrc::ShaderBindingTable::create(
+            pipeline_,
+            {.raygen = {0}, .miss = {{1, std::as_bytes(std::span(raytrace::background))}, {2}}, .hit = {{3}}});
+    }
+
+    vkrc::Device device_;
+    bool shadows_;
+    vkrc::Buffer positions_, indices_, normals_, instances_;
+    vkrc::AccelerationStructure top_level_;
+    vkrc::DescriptorSet set_;
+    vkrc::PipelineLayout layout_;
+    vkrc::RayTracingPipeline pipeline_;
+    vkrc::ShaderBindingTable table_;
+    TraceConstants constants_{};
+    VkExtent2D extent_{};
+    vkrc::Image image_;
+    vkrc::ImageView view_;
+};
+
 std::unique_ptr<ScenePath> make_path(RenderPath path, const vkrc::Queue& queue, const Scene& scene,
-                                     const vkrc::Buffer& uniforms) {
+                                     const vkrc::Buffer& uniforms, const PathOptions& options) {
     switch (path) {
         case RenderPath::raster: return std::make_unique<GraphicsPath>(queue, scene, uniforms, false);
         case RenderPath::mesh: return std::make_unique<GraphicsPath>(queue, scene, uniforms, true);
+        case RenderPath::raytrace: return std::make_unique<RayTracedPath>(queue, scene, options.shadows);
     }
     throw std::logic_error("unknown render path");
 }
 
 // The device features each path needs, asked of the device chosen and enabled on it.
 void require(RenderPath path, vkrc::DeviceRequirements& requirements, vkrc::DeviceCreateInfo& device_info) {
-    if (path == RenderPath::mesh)
-        requirements.required_features.mesh_shader.meshShader = device_info.mesh_shader_features.meshShader = VK_TRUE;
+    auto& wanted = requirements.required_features;
+    if (path == RenderPath::mesh) wanted.mesh_shader.meshShader = device_info.mesh_shader_features.meshShader = VK_TRUE;
+    if (path == RenderPath::raytrace) {  // a ray tracing pipeline, no ray queries
+        wanted.ray_tracing_pipeline.rayTracingPipeline = device_info.ray_tracing_pipeline_features.rayTracingPipeline =
+            VK_TRUE;
+        wanted.acceleration_structure.accelerationStructure =
+            device_info.acceleration_structure_features.accelerationStructure = VK_TRUE;
+        wanted.vulkan12.bufferDeviceAddress = device_info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
+    }
 }
 
 // The median of values (not empty).
@@ -295,7 +497,10 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
                                    {VK_FORMAT_R8G8B8A8_UNORM, VK_COLOR_SPACE_SRGB_NONLINEAR_KHR}},
              .image_usage = presented_usage});
     vkrc::Presenter& presenter = options.headless ? static_cast<vkrc::Presenter&>(headless) : swapchain;
-    std::printf("device: %s; path %s%s\n", physical.name(), info_of(chosen.path).name,
+    std::printf("device: %s; path %s%s%s\n", physical.name(), info_of(chosen.path).name,
+                chosen.path != RenderPath::raytrace ? ""
+                : chosen.shadows                    ? " with shadows"
+                                                    : " without shadows",
                 chosen.compare ? ", compared with raster" : "");
 
     // 2. The scene and the paths. The frame's uniforms change only with the extent: they are
@@ -312,7 +517,7 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
                                                   .usage = VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                                   .memory = {.usage = vkrc::MemoryUsage::upload}});
     std::vector<std::unique_ptr<ScenePath>> paths;
-    for (RenderPath p : drawn) paths.push_back(make_path(p, queue, scene, uniforms));
+    for (RenderPath p : drawn) paths.push_back(make_path(p, queue, scene, uniforms, chosen));
 
     // 3. Frames in flight, each with its command buffer, fence and two timestamps per path drawn
     //    (before and after its commands), read once the frame is done.
@@ -407,10 +612,11 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
     const auto& tolerance = info_of(chosen.path).tolerance;
     const bool matches = raytrace::within(d, tolerance);
     std::printf(
-        "%s against raster: %zu of %zu pixels differ, max channel difference %d, PSNR %.2f dB: %s "
-        "(tolerance: %zu pixels, %d per channel)\n",
-        info_of(chosen.path).name, d.differing_pixels, d.pixels, d.max_channel_difference, d.psnr_db,
-        matches ? "matches" : "DOES NOT MATCH", tolerance.differing_pixels, tolerance.max_channel_difference);
+        "%s against raster: %zu of %zu pixels (%.3f%%) differ, max channel difference %d, PSNR %.2f dB: %s "
+        "(tolerance: %.3g%% of pixels, %d per channel, PSNR %.3g dB)\n",
+        info_of(chosen.path).name, d.differing_pixels, d.pixels, 100.0 * double(d.differing_pixels) / double(d.pixels),
+        d.max_channel_difference, d.psnr_db, matches ? "matches" : "DOES NOT MATCH", tolerance.differing_percent,
+        tolerance.max_channel_difference, tolerance.min_psnr_db);
     if (!chosen.csv_file.empty()) {
         // The reference's row: its difference from itself.
         const std::array<raytrace::ImageDifference, 2> differences{raytrace::ImageDifference{.pixels = d.pixels}, d};
@@ -431,12 +637,16 @@ int run(const vkrc_examples::WindowOrHeadless& options, const PathOptions& chose
 
 }  // namespace
 
-// Takes --path and --compare out of the arguments; window_or_headless.hpp parses the rest.
+// Takes --path, --shadows, --compare and --csv out of the arguments; window_or_headless.hpp
+// parses the rest.
 int main(int argc, char** argv) {
     PathOptions chosen;
     std::vector<char*> rest{argv[0]};
+    const char* shadows = nullptr;  // as given
     for (int i = 1; i < argc; ++i) {
-        if (std::strcmp(argv[i], "--compare") == 0) {
+        if (std::strcmp(argv[i], "--shadows") == 0) {
+            shadows = i + 1 < argc ? argv[++i] : "";
+        } else if (std::strcmp(argv[i], "--compare") == 0) {
             chosen.compare = true;
         } else if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) {
             chosen.csv_file = argv[++i];
@@ -460,8 +670,20 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "%s: --csv writes what --compare measures: add --compare\n", argv[0]);
         return 2;
     }
+    if (shadows) {
+        const char* refused = nullptr;
+        if (std::strcmp(shadows, "on") != 0 && std::strcmp(shadows, "off") != 0) refused = "--shadows takes on or off";
+        else if (chosen.path != RenderPath::raytrace) refused = "--shadows is for --path raytrace (raster has none)";
+        else if (chosen.compare && std::strcmp(shadows, "on") == 0)
+            refused = "--compare measures raytrace against raster, which has no shadows: use --shadows off";
+        if (refused) {
+            std::fprintf(stderr, "%s: %s\n", argv[0], refused);
+            return 2;
+        }
+    }
+    chosen.shadows = shadows ? std::strcmp(shadows, "on") == 0 : !chosen.compare;
     return vkrc_examples::run_example(
         int(rest.size()), rest.data(), "raytrace",
         [&](const vkrc_examples::WindowOrHeadless& o) { return run(o, chosen); },
-        " [--path raster|mesh] [--compare [--csv FILE]]");
+        " [--path raster|mesh|raytrace] [--shadows on|off] [--compare [--csv FILE]]");
 }
