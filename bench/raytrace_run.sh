@@ -16,7 +16,8 @@
 #   cmake --build build-release -j --target raytrace
 # NAME: the results' file prefix (default: the date and a device slug); each
 # path's file is NAME-raytrace-PATH.csv.
-# PATHS: comma-separated (default mesh). FRAMES (environment): frames per run (default 200).
+# PATHS: comma-separated (default mesh,raytrace; raytrace is compared, and so
+# timed, without shadows). FRAMES (environment): frames per run (default 200).
 set -euo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: bench/raytrace_run.sh BUILD_DIR OUT [NAME] [PROCESSES] [PATHS]" >&2
@@ -26,7 +27,7 @@ build=$1
 out=$2
 name=${3:-}
 processes=${4:-3}
-paths=${5:-mesh}
+paths=${5:-mesh,raytrace}
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
 # shellcheck source=bench/run_header.sh
 source "$source_dir/bench/run_header.sh"
