@@ -1125,7 +1125,43 @@ def descriptors_section(pending):
     return out[:-1]
 
 
+def raytrace_rows(rows, path):
+    return [x for x in rows if x["path"] == path]
+
+
+def raytrace_section(pending):
+    """examples/raytrace --compare runs (bench/raytrace_run.sh): per device and path, the GPU time per frame
+    of the path and of the rasterised reference drawn beside it in the same frames (median over the
+    processes of each process's median over its frames, [min, max] of the processes), their ratio, and the
+    path's difference from the reference image (the worst process's)."""
+    found = sorted(results("", "psnr_db"), key=lambda r: r["path"])
+    if not found:
+        return [pending]
+    out = ["| device | path | size | processes x frames | path ms per frame | raster ms per frame | "
+           "path / raster | differing pixels | max channel difference | PSNR dB | data |",
+           "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+    for r in found:
+        rows = r["rows"]
+        for path in [p for p in variants_of([{"variant": x["path"]} for x in rows]) if p != "raster"]:
+            mine, ref = raytrace_rows(rows, path), raytrace_rows(rows, "raster")
+            times = sorted(float(x["median_ms"]) for x in mine)
+            ref_times = sorted(float(x["median_ms"]) for x in ref)
+            worst = max(mine, key=lambda x: int(x["differing_pixels"]))
+            pixels = int(worst["width"]) * int(worst["height"])
+            differing = int(worst["differing_pixels"])
+            psnr = float(worst["psnr_db"])
+            out.append(f"| {r['meta'].get('device', '?')} | {path} | {worst['width']}x{worst['height']} | "
+                       f"{len(mine)} x {worst['frames']} | {median(times):.3f} [{times[0]:.3f}, {times[-1]:.3f}] | "
+                       f"{median(ref_times):.3f} [{ref_times[0]:.3f}, {ref_times[-1]:.3f}] | "
+                       f"{median(times) / median(ref_times):.2f} | {differing} of {pixels} "
+                       f"({100 * differing / pixels:.3f} %) | {worst['max_channel_difference']} | "
+                       f"{'identical' if math.isinf(psnr) else f'{psnr:.2f}'} | `{os.path.basename(r['path'])}` "
+                       f"(git {r['meta'].get('git', '?')}) |")
+    return out
+
+
 BLOCKS = {
+    "raytrace": lambda: raytrace_section("No examples/raytrace results in docs/results/ yet."),
     "descriptors": lambda: descriptors_section("No descriptor-write results in docs/results/ yet."),
     "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
     "upload-h200": lambda: upload_section(
