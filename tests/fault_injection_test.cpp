@@ -408,8 +408,10 @@ TEST(FaultInjection, EveryFailableCallOfAccelerationStructuresFailsCleanly) {
             const std::uint64_t want =
                 (x < 4 ? rt_hit_tag << 28 | 5u << 20 | primitive << 8 | shadowed : rt_miss_value) | rt_callable_bits;
             if (r[y * rt_width + x] != want) {
-                return ::testing::AssertionFailure() << "pixel (" << x << ", " << y << "): 0x" << std::hex
-                                                     << r[y * rt_width + x] << ", expected 0x" << want;
+                std::ostringstream text;  // AssertionResult takes each << apart, dropping std::hex
+                text << "pixel (" << x << ", " << y << "): 0x" << std::hex << r[y * rt_width + x] << ", expected 0x"
+                     << want;
+                return ::testing::AssertionFailure() << text.str();
             }
         }
     }
