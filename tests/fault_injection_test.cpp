@@ -7,8 +7,9 @@
 // vkDestroyInstance, LeakSanitizer reports host memory in the ASan build.
 // The scenarios: the teapot scene (tests/support/teapot_scenario.cpp), the
 // descriptor references and bindless table below, and compute, render pass,
-// streaming, non-coherent memory, acceleration structures and presentation
-// (under a private Xvfb; tests/support/fault_scenarios.cpp). A report checks that together they
+// streaming, non-coherent memory, acceleration structures, a ray tracing
+// pipeline and presentation (under a private Xvfb;
+// tests/support/fault_scenarios.cpp). A report checks that together they
 // reach every failable function vkrc calls. The same over a user allocator
 // that fails at each of its allocations.
 #include "support/fault_injection.hpp"
@@ -320,6 +321,7 @@ std::vector<NamedScenario> every_scenario(const vkrc::glfw::Window& window) {
             {"streaming", vkrc_test::run_streaming_scenario},
             {"non-coherent memory", vkrc_test::run_non_coherent_scenario},
             {"acceleration structures", vkrc_test::run_acceleration_structure_scenario},
+            {"ray tracing pipeline", vkrc_test::run_ray_tracing_pipeline_scenario},
             {"presentation", [&window](const auto& info) { run_presentation(info, window); }}};
 }
 
@@ -392,6 +394,42 @@ TEST(FaultInjection, EveryFailableCallOfAccelerationStructuresFailsCleanly) {
                            traced_the_squares, 20);
 }
 
+// The traced 16x4 (rt_scene's shaders, as tests/ray_tracing_test.cpp
+// computes them): the square's pixels x < 4 hit (custom 5, geometry 0,
+// primitive 0 below the diagonal y = x - 0.25), shadowed by the occluder in
+// rows 2 and 3; every other ray misses; each with the callable's bits.
+::testing::AssertionResult traced_the_ray_tracing_scene(const vkrc_test::ScenarioResult& r) {
+    using namespace vkrc_test;
+    if (r.size() != rt_width * rt_height) return ::testing::AssertionFailure() << r.size() << " values";
+    for (std::uint32_t y = 0; y < rt_height; ++y) {
+        for (std::uint32_t x = 0; x < rt_width; ++x) {
+            const float lx = float(x) + 0.25f, ly = float(y) + 0.5f;
+            const std::uint32_t primitive = ly < lx ? 0 : 1, shadowed = y >= 2 ? 1 : 0;
+            const std::uint64_t want =
+                (x < 4 ? rt_hit_tag << 28 | 5u << 20 | primitive << 8 | shadowed : rt_miss_value) | rt_callable_bits;
+            if (r[y * rt_width + x] != want) {
+                std::ostringstream text;  // AssertionResult takes each << apart, dropping std::hex
+                text << "pixel (" << x << ", " << y << "): 0x" << std::hex << r[y * rt_width + x] << ", expected 0x"
+                     << want;
+                return ::testing::AssertionFailure() << text.str();
+            }
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
+// A ray tracing pipeline: structure builds, shader modules, the pipeline,
+// its shader binding table (the group handles read, its buffer written), a
+// trace_rays read back.
+TEST(FaultInjection, EveryFailableCallOfARayTracingPipelineFailsCleanly) {
+    auto log = std::make_shared<vkrc_test::ValidationLog>();
+    if (!vkrc_test::device_has_ray_tracing_pipelines(vkrc_test::validated_instance_info(log))) {
+        GTEST_SKIP() << "the device lacks ray tracing pipelines";
+    }
+    inject_into_every_call("ray tracing pipeline", vkrc_test::run_ray_tracing_pipeline_scenario,
+                           traced_the_ray_tracing_scene, 20);
+}
+
 TEST(FaultInjection, EveryFailableCallOfPresentationFailsCleanly) {
     Display display;
     ASSERT_TRUE(display.window) << display.xvfb.error();
@@ -407,18 +445,17 @@ TEST(FaultInjection, EveryFailableCallOfPresentationFailsCleanly) {
 // The table's functions that return VkResult and that vkrc's sources call,
 // but that no scenario above calls (so no failure is ever injected into
 // them), with the reason each is acceptable. Any other fails the test below.
-// vkCreateAccelerationStructureKHR is reached on a device with ray queries
-// (lavapipe); elsewhere the acceleration-structure scenario cannot run.
+// vkCreateAccelerationStructureKHR is reached on a device with ray queries,
+// the ray tracing pipeline's calls on one with ray tracing pipelines (lavapipe
+// has both); elsewhere the scenario that calls them cannot run.
 std::map<std::string, std::string> never_injected_allowed(const vkrc::InstanceCreateInfo& info) {
-    std::map<std::string, std::string> allowed = {
-        {"vkCreateRayTracingPipelinesKHR",
-         "ray tracing pipelines came after the scenarios were written; RayTracingTest covers their refusals, and a "
-         "ray-tracing scenario is the next one to add"},
-        {"vkGetRayTracingShaderGroupHandlesKHR",
-         "read by ShaderBindingTable::create, which no scenario reaches yet (see vkCreateRayTracingPipelinesKHR)"},
-    };
+    std::map<std::string, std::string> allowed;
     if (!vkrc_test::device_has_ray_queries(info))
         allowed.emplace("vkCreateAccelerationStructureKHR", "the device lacks acceleration structures or ray queries");
+    if (!vkrc_test::device_has_ray_tracing_pipelines(info)) {
+        allowed.emplace("vkCreateRayTracingPipelinesKHR", "the device lacks ray tracing pipelines");
+        allowed.emplace("vkGetRayTracingShaderGroupHandlesKHR", "the device lacks ray tracing pipelines");
+    }
     return allowed;
 }
 

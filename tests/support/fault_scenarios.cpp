@@ -6,6 +6,11 @@
 
 #include "shaders/fill_pattern.comp.h"
 #include "shaders/ray_query.comp.h"
+#include "shaders/rt_scene.rcall.h"
+#include "shaders/rt_scene.rchit.h"
+#include "shaders/rt_scene.rgen.h"
+#include "shaders/rt_scene.rmiss.h"
+#include "shaders/rt_shadow.rmiss.h"
 
 #include <algorithm>
 #include <array>
@@ -321,6 +326,17 @@ bool has_ray_queries(const vkrc::PhysicalDevice& physical) {
     return physical.unmet_requirements(wanted).empty();
 }
 
+// A host-written buffer of values a structure build reads by address.
+template <class T, std::size_t N>
+vkrc::Buffer build_input(const vkrc::Device& device, const std::array<T, N>& values) {
+    constexpr VkBufferUsageFlags usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+                                         VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+    auto buffer = vkrc::Buffer::create(
+        device, {.size = sizeof values, .usage = usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
+    buffer.allocation().write(0, values.data(), values.size());
+    return buffer;
+}
+
 // A barrier from builds and copies of structures to what reads them next (stage).
 void after_builds(const vkrc::CommandBuffer& cmd, VkPipelineStageFlags2 stage) {
     const auto b = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
@@ -352,14 +368,8 @@ ScenarioResult run_acceleration_structure_scenario(const vkrc::InstanceCreateInf
     // The square [0,4]x[0,4] at z 0, two indexed triangles, built for compaction.
     const std::array<float, 12> square{0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 4, 0};
     const std::array<std::uint32_t, 6> indices{0, 1, 2, 0, 2, 3};
-    constexpr VkBufferUsageFlags input_usage = VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
-                                               VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
-    auto vertices = vkrc::Buffer::create(
-        device, {.size = sizeof square, .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
-    vertices.allocation().write(0, square.data(), square.size());
-    auto index_buffer = vkrc::Buffer::create(
-        device, {.size = sizeof indices, .usage = input_usage, .memory = {.usage = vkrc::MemoryUsage::upload}});
-    index_buffer.allocation().write(0, indices.data(), indices.size());
+    auto vertices = build_input(device, square);
+    auto index_buffer = build_input(device, indices);
     vkrc::BottomLevelBuildInfo bottom;
     bottom.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR |
                    VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR;
@@ -427,6 +437,132 @@ ScenarioResult run_acceleration_structure_scenario(const vkrc::InstanceCreateInf
     ScenarioResult result(traced.begin(), traced.end());
     result.push_back(compacted[0]);
     return result;
+}
+
+namespace {
+
+// What the ray tracing pipeline scenario needs of a device.
+vkrc::DeviceCreateInfo ray_tracing_device_info() {
+    vkrc::DeviceCreateInfo info;
+    info.ray_tracing_pipeline_features.rayTracingPipeline = VK_TRUE;  // enables the extensions
+    info.acceleration_structure_features.accelerationStructure = VK_TRUE;
+    info.vulkan12_features.bufferDeviceAddress = VK_TRUE;
+    return info;
+}
+
+bool has_ray_tracing_pipelines(const vkrc::PhysicalDevice& physical) {
+    auto wanted = test_device_requirements();
+    wanted.required_features.ray_tracing_pipeline.rayTracingPipeline = VK_TRUE;
+    wanted.required_features.acceleration_structure.accelerationStructure = VK_TRUE;
+    wanted.required_features.vulkan12.bufferDeviceAddress = VK_TRUE;
+    return physical.unmet_requirements(wanted).empty();
+}
+
+// The shaders of tests/ray_tracing_test.cpp without the any-hit and
+// intersection stages: raygen, the scene's and the shadows' misses, the
+// closest hit (which traces the shadow ray, hence depth 2) and the callable.
+vkrc::RayTracingPipeline rt_scene_pipeline(const vkrc::PipelineLayout& layout) {
+    const auto& device = layout.device();
+    auto stage = [&](VkShaderStageFlagBits bits, std::span<const std::uint32_t> code) {
+        return vkrc::RayTracingShaderStage{.stage = bits, .module = vkrc::ShaderModule::create(device, code)};
+    };
+    vkrc::RayTracingPipelineCreateInfo info;
+    info.stages = {stage(VK_SHADER_STAGE_RAYGEN_BIT_KHR, vkrc_shaders::rt_scene_rgen),
+                   stage(VK_SHADER_STAGE_MISS_BIT_KHR, vkrc_shaders::rt_scene_rmiss),
+                   stage(VK_SHADER_STAGE_MISS_BIT_KHR, vkrc_shaders::rt_shadow_rmiss),
+                   stage(VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR, vkrc_shaders::rt_scene_rchit),
+                   stage(VK_SHADER_STAGE_CALLABLE_BIT_KHR, vkrc_shaders::rt_scene_rcall)};
+    info.groups = {{.general_shader = 0},
+                   {.general_shader = 1},
+                   {.general_shader = 2},
+                   {.type = VK_RAY_TRACING_SHADER_GROUP_TYPE_TRIANGLES_HIT_GROUP_KHR, .closest_hit_shader = 3},
+                   {.general_shader = 4}};
+    info.max_ray_recursion_depth = 2;
+    return vkrc::RayTracingPipeline::create(layout, info);
+}
+
+}  // namespace
+
+bool device_has_ray_tracing_pipelines(const vkrc::InstanceCreateInfo& info) {
+    auto instance = vkrc::Instance::create(info);
+    return has_ray_tracing_pipelines(vkrc::PhysicalDevice::select(instance, test_device_requirements()));
+}
+
+ScenarioResult run_ray_tracing_pipeline_scenario(const vkrc::InstanceCreateInfo& info) {
+    Context c;
+    c.instance = vkrc::Instance::create(info);
+    c.physical = vkrc::PhysicalDevice::select(c.instance, test_device_requirements());
+    if (!has_ray_tracing_pipelines(c.physical)) return {};
+    c.device = vkrc::Device::create(c.physical, ray_tracing_device_info());
+    c.queue = c.device.default_queue();
+    faults::end_of_setup();
+    const auto& device = c.device;
+
+    // The square [0,4]x[0,4], two triangles (the first below its diagonal):
+    // seen at x + 0.25 (no pixel centre on an edge; custom 5, mask 0x01) and,
+    // doubled at z 5 over y [2,10], as the occluder only shadow rays see (mask 0x02).
+    const std::array<float, 18> square{0, 0, 0, 4, 0, 0, 4, 4, 0, 0, 0, 0, 4, 4, 0, 0, 4, 0};
+    auto vertices = build_input(device, square);
+    vkrc::BottomLevelBuildInfo bottom;
+    bottom.geometries = {{.vertex_buffer = vertices, .max_vertex = 5, .triangle_count = 2}};
+    auto commands = vkrc::CommandPool::create(device, {.queue_family_index = c.queue.family_index()});
+    auto cmd = commands.allocate();
+    cmd.begin();
+    auto square_level = vkrc::build_bottom_level(cmd, bottom);
+    after_builds(cmd, VK_PIPELINE_STAGE_2_ACCELERATION_STRUCTURE_BUILD_BIT_KHR);
+    vkrc::TopLevelBuildInfo top;
+    top.instances = {{.bottom_level = square_level,
+                      .transform = {{{1, 0, 0, 0.25f}, {0, 1, 0, 0}, {0, 0, 1, 0}}},
+                      .custom_index = 5,
+                      .mask = 0x01},
+                     {.bottom_level = square_level,
+                      .transform = {{{2, 0, 0, 0.25f}, {0, 2, 0, 2}, {0, 0, 2, 5}}},
+                      .custom_index = 13,
+                      .mask = 0x02}};
+    auto scene = vkrc::build_top_level(cmd, top);
+    square_level.reset();  // the scene keeps it
+
+    // The set rt_scene.rgen writes results[y * 16 + x] through.
+    auto set_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+                              {.binding = 1, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+    auto pool = vkrc::DescriptorPool::create(device, {.max_sets = 1,
+                                                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 1},
+                                                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    auto results = readback_buffer(device, rt_width * rt_height * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    auto set = pool.allocate(set_layout);
+    set.write_acceleration_structure(0, scene);
+    set.write_buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, results);
+    scene.reset();  // the set keeps it
+
+    // The pipeline, made last (compiling it is the slow part of a run, which
+    // a failure before it skips), and its table: the miss record's value, the
+    // hit record's tag, the callable record's bits (shaderRecordEXT of rt_scene.r*).
+    auto layout = vkrc::PipelineLayout::create(device, {.set_layouts = {set_layout}});
+    auto pipeline = rt_scene_pipeline(layout);
+    const std::array<std::uint32_t, 3> record_data{rt_miss_value, rt_hit_tag, rt_callable_bits};
+    vkrc::ShaderBindingTableCreateInfo table_info;
+    table_info.raygen = {0};
+    table_info.miss = {{1, std::as_bytes(std::span(&record_data[0], 1))}, {2}};
+    table_info.hit = {{3, std::as_bytes(std::span(&record_data[1], 1))}};
+    table_info.callable = {{4, std::as_bytes(std::span(&record_data[2], 1))}};
+    auto table = vkrc::ShaderBindingTable::create(pipeline, table_info);
+    pipeline.reset();  // the table keeps it
+
+    // Traced: rt_scene.rgen's rays over 16x4.
+    after_builds(cmd, VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR);
+    cmd.bind_pipeline(table.pipeline());
+    cmd.bind_descriptor_set(table.pipeline(), 0, set);
+    cmd.trace_rays(table, rt_width, rt_height);
+    const auto to_host =
+        vkrc::memory_barrier(VK_PIPELINE_STAGE_2_RAY_TRACING_SHADER_BIT_KHR, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+    cmd.end();
+    run_and_wait(c.queue, cmd);
+    std::array<std::uint32_t, rt_width * rt_height> traced{};
+    results.allocation().read(0, std::span(traced));
+    return ScenarioResult(traced.begin(), traced.end());
 }
 
 ScenarioResult run_presentation_scenario(const vkrc::InstanceCreateInfo& info, const vkrc::glfw::Window& window) {

@@ -41,6 +41,16 @@ ScenarioResult run_acceleration_structure_scenario(const vkrc::InstanceCreateInf
 // Whether the device the tests select has what that scenario needs.
 bool device_has_ray_queries(const vkrc::InstanceCreateInfo& info);
 
+// A ray tracing pipeline, where the device has one (empty result
+// otherwise): a bottom level of a square, a top level of two instances of
+// it, the pipeline of rt_scene's shaders, its shader binding table (miss,
+// hit and callable records carrying the rt_ values below), and a trace_rays
+// of rt_width x rt_height read back (results[y * 16 + x]).
+ScenarioResult run_ray_tracing_pipeline_scenario(const vkrc::InstanceCreateInfo& info);
+bool device_has_ray_tracing_pipelines(const vkrc::InstanceCreateInfo& info);
+inline constexpr std::uint32_t rt_width = 16, rt_height = 4;  // rt_scene.rgen's rows are 16 wide
+inline constexpr std::uint32_t rt_miss_value = 0x0FFFFFF0u, rt_hit_tag = 3, rt_callable_bits = 0x2u;
+
 // A swapchain on window's surface: three frames acquired, cleared and
 // presented, a re-creation, one more frame. info must enable GLFW's
 // instance extensions.
