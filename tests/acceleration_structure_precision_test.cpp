@@ -13,7 +13,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -951,21 +950,6 @@ std::vector<GpuRay> fuzz_rays() {
     return ::testing::AssertionSuccess();
 }
 
-// The default pool allocator, counting what it frees: a round's levels
-// come from one, so that memory the held work still needs, freed before
-// the gate opens, shows (lavapipe would trace the stale bytes unharmed).
-class CountingAllocator final : public vkrc_test::WrappedPoolAllocator {
-public:
-    void free(vkrc::DeviceView device, const vkrc::AllocationInfo& allocation) override {
-        WrappedPoolAllocator::free(device, allocation);
-        ++frees_;
-    }
-    int frees() const { return frees_; }
-
-private:
-    std::atomic<int> frees_{0};
-};
-
 // A round's completion semaphore and gate; the gate goes first, waiting for
 // the device to be idle before either is destroyed (see GpuGate).
 struct FuzzSync {
@@ -1004,7 +988,7 @@ struct FuzzRound {
         const auto& [done, gate] = sync;
         const auto work = static_cast<Work>(pick(work_kinds));
         ++coverage.work[static_cast<int>(work)];
-        const auto allocator = vkrc::make_allocator<CountingAllocator>();
+        const auto allocator = vkrc::make_allocator<vkrc_test::CountingAllocator>();
         const SceneDesc built = fuzz_scene(rng, 2);
         SceneDesc traced = built;
         if (work == Work::rebuild) {

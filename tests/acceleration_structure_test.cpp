@@ -1,13 +1,16 @@
 // Acceleration structures: bottom levels built from triangles, top levels
-// from instances of them, traced with a ray query (shaders/ray_query.comp)
-// and checked pixel by pixel; the top level keeping its bottom levels alive
+// from instances of them, traced with a ray query (shaders/ray_query.comp,
+// and from a fragment shader, shaders/ray_query.frag) and checked pixel by
+// pixel; the top level keeping its bottom levels alive
 // after their handles are dropped, rebuilds that release the old ones, refits,
 // descriptors of acceleration structures, and the refusals.
 #include "support/acceleration_structures.hpp"
 #include "support/features.hpp"
 #include "support/vk_test.hpp"
 
+#include "shaders/fullscreen.vert.h"
 #include "shaders/ray_query.comp.h"
+#include "shaders/ray_query.frag.h"
 
 #include <array>
 #include <span>
@@ -110,6 +113,14 @@ std::uint32_t expected_scene(std::uint32_t x, std::uint32_t y) {
     return miss;
 }
 
+// expected_scene's with mask 0x03, which also sees custom 13, the squares at
+// (12,12) the default mask misses.
+std::uint32_t expected_scene_both_masks(std::uint32_t x, std::uint32_t y) {
+    const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
+    if (cx > 12 && cy > 12 && cy < 16 && cx < 20) return hit(13, cx < 16 ? 0 : 1);
+    return expected_scene(x, y);
+}
+
 // Compares hits with expected(x, y) and names the first pixels that differ.
 template <class Expected>
 void expect_hits(const std::vector<std::uint32_t>& hits, Expected expected) {
@@ -146,9 +157,10 @@ protected:
         pool = vkrc::DescriptorPool::create(device, {.max_sets = 4,
                                                      .pool_sizes = {{VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, 4},
                                                                     {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4}}});
-        hits = vkrc::Buffer::create(device, {.size = width * height * 4,
-                                             .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                                             .memory = {.usage = vkrc::MemoryUsage::readback}});
+        hits = vkrc::Buffer::create(device,
+                                    {.size = width * height * 4,
+                                     .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                     .memory = {.usage = vkrc::MemoryUsage::readback}});
     }
 
     // A set whose binding 0 holds top_level (written here) and binding 1 the hits buffer.
@@ -219,12 +231,68 @@ TEST_F(AccelerationStructureTest, TracedHitsMatchTheGeometryAndTheInstanceTransf
     EXPECT_GE(scene.buffer().size(), scene.size());
     ASSERT_EQ(scene.bottom_levels().size(), 5u) << "one kept bottom level per instance";
     expect_hits(trace(scene), expected_scene);
-    // Mask 0x03 also sees custom 13, the squares at (12,12) the default mask misses.
-    expect_hits(trace(scene, 0x03), [](std::uint32_t x, std::uint32_t y) {
-        const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
-        if (cx > 12 && cy > 12 && cy < 16 && cx < 20) return hit(13, cx < 16 ? 0 : 1);
-        return expected_scene(x, y);
-    });
+    expect_hits(trace(scene, 0x03), expected_scene_both_masks);
+}
+
+// ray_query.frag traces the scene per pixel of a full-screen triangle into
+// an R32_UINT attachment (cleared to a value no pixel may keep): every
+// pixel as the compute trace's and the CPU's expectation, with either mask.
+TEST_F(AccelerationStructureTest, FragmentShaderRayQueriesMatchTheExpectedHits) {
+    const Inputs in = make_inputs(device);
+    const auto scene = build_scene(in);
+    const auto frag_layout = vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0,
+                               .descriptor_type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR,
+                               .stage_flags = VK_SHADER_STAGE_FRAGMENT_BIT}}});
+    auto set = pool.allocate(frag_layout);
+    set.write_acceleration_structure(0, scene);
+    const auto render_pass = vkrc_test::clear_to_copy_render_pass(device, VK_FORMAT_R32_UINT);
+    const auto image =
+        vkrc::Image::create(device, {.format = VK_FORMAT_R32_UINT,
+                                     .extent = {width, height, 1},
+                                     .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    const auto framebuffer = vkrc::Framebuffer::create(device, {.render_pass = render_pass,
+                                                                .attachments = {vkrc::ImageView::create(image)},
+                                                                .width = width,
+                                                                .height = height});
+    const auto pipeline =
+        vkrc::GraphicsPipelineBuilder(
+            vkrc::PipelineLayout::create(
+                device, {.set_layouts = {frag_layout},
+                         .push_constant_ranges = {{VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(std::uint32_t)}}}))
+            .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::fullscreen_vert))
+            .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device, vkrc_shaders::ray_query_frag))
+            .cull_mode(VK_CULL_MODE_NONE)  // the full-viewport triangle is clockwise
+            .render_pass(render_pass)
+            .build();
+    const auto draw = [&](std::uint32_t cull_mask) {
+        vkrc_test::OneShotCommands s(queue);
+        const auto built =
+            built_to(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_ACCELERATION_STRUCTURE_READ_BIT_KHR);
+        s.cmd.pipeline_barrier(std::span(&built, 1), {}, {});
+        VkClearValue clear{};
+        clear.color.uint32[0] = 0xC1EA4ED0u;
+        s.cmd.begin_render_pass(render_pass, framebuffer, {{0, 0}, {width, height}}, std::span(&clear, 1));
+        s.cmd.bind_pipeline(pipeline);
+        s.cmd.bind_descriptor_set(pipeline, 0, set);
+        s.cmd.push_constants(pipeline.layout(), VK_SHADER_STAGE_FRAGMENT_BIT, cull_mask);
+        s.cmd.set_viewport_and_scissor(framebuffer.extent());
+        s.cmd.draw(3);
+        s.cmd.end_render_pass();
+        VkBufferImageCopy region{};
+        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+        region.imageExtent = {width, height, 1};
+        s.cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, hits, std::span(&region, 1));
+        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+        s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        s.run(queue);
+        return read_hits();
+    };
+    const auto drawn = draw(0x01);
+    expect_hits(drawn, expected_scene);
+    EXPECT_EQ(drawn, trace(scene)) << "the fragment and compute traces differ";
+    expect_hits(draw(0x03), expected_scene_both_masks);
 }
 
 // The edge no other wrapper tracks: the top level alone keeps its bottom

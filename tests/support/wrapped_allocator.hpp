@@ -5,6 +5,8 @@
 
 #include <vkrc/vkrc.hpp>
 
+#include <atomic>
+
 namespace vkrc_test {
 
 class WrappedPoolAllocator : public vkrc::DeviceAllocator {
@@ -24,6 +26,21 @@ public:
 
 private:
     vkrc::PoolAllocator inner_;
+};
+
+// The pool, counting what it frees: objects made from one show memory that
+// held work still needs freed before the work may run (lavapipe would read
+// the stale bytes unharmed, so the results alone would not show it).
+class CountingAllocator final : public WrappedPoolAllocator {
+public:
+    void free(vkrc::DeviceView device, const vkrc::AllocationInfo& allocation) override {
+        WrappedPoolAllocator::free(device, allocation);
+        ++frees_;
+    }
+    int frees() const { return frees_; }
+
+private:
+    std::atomic<int> frees_{0};
 };
 
 }  // namespace vkrc_test
