@@ -47,6 +47,18 @@ for hold in args.hold:
     holds[(variant, stage)] = float(limit)
 
 failures, lines = [], []
+
+
+def judge(met, extra, hold, per, failure):
+    """'ok', 'target not met, held at ...' when extra is within the hold, else 'OVER' with failure recorded."""
+    if met:
+        return "ok"
+    if hold is not None and extra <= hold:
+        return f"target not met, held at {hold:g} extra/{per}"
+    failures.append(failure + (f" and {extra:.1f} extra/{per} > the hold {hold:g}" if hold is not None else ""))
+    return "OVER"
+
+
 for budget in args.budget:
     variant, pct, absolute = budget.split(":")
     for kind, stages in (("relative", args.relative), ("absolute", args.absolute)):
@@ -60,15 +72,8 @@ for budget in args.budget:
                 value, target, unit = 100 * extra / ref[0], float(pct), "% of the stage"
             else:
                 value, target, unit = extra, float(absolute), " instructions/call"
-            hold = holds.get((variant, stage))
-            if value <= target:
-                verdict = "ok"
-            elif hold is not None and extra <= hold:
-                verdict = f"target not met, held at {hold:g} extra/call"
-            else:
-                verdict = "OVER"
-                failures.append(f"{variant} {stage}: {value:.2f}{unit} > {target:g}" +
-                                (f" and {extra:.1f} extra/call > the hold {hold:g}" if hold is not None else ""))
+            verdict = judge(value <= target, extra, holds.get((variant, stage)), "call",
+                            f"{variant} {stage}: {value:.2f}{unit} > {target:g}")
             lines.append(f"{variant:10} {stage:8} extra {extra:8.1f}/call = {value:7.2f}{unit} "
                          f"(target {target:g}) {verdict}")
 stages = [stage for stages in (args.relative, args.absolute) for stage in filter(None, stages.split(","))]
@@ -79,15 +84,8 @@ for total in args.total:
         failures.append(f"{variant} per frame: {', '.join(missing)} missing from {args.csv}")
         continue
     extra = sum(rows[(variant, stage)][1] - rows[(args.reference, stage)][1] for stage in stages)
-    hold = float(held[0]) if held else None
-    if extra <= float(target):
-        verdict = "ok"
-    elif hold is not None and extra <= hold:
-        verdict = f"target not met, held at {hold:g} extra/frame"
-    else:
-        verdict = "OVER"
-        failures.append(f"{variant} per frame: {extra:.1f} extra > {target}" +
-                        (f" and > the hold {hold:g}" if hold is not None else ""))
+    verdict = judge(extra <= float(target), extra, float(held[0]) if held else None, "frame",
+                    f"{variant} per frame: {extra:.1f} extra > {target}")
     lines.append(f"{variant:10} frame    extra {extra:8.1f}/frame over {','.join(stages)} "
                  f"(target {float(target):g}) {verdict}")
 print("\n".join(lines))
