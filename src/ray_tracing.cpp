@@ -227,10 +227,6 @@ VkDeviceSize checked_stride(const detail::Caller& caller, const detail::RayTraci
     return stride;
 }
 
-}  // namespace
-
-namespace {
-
 // Checks the records and places the regions one after the other; returns the bytes they take.
 VkDeviceSize lay_out(const detail::Caller& caller, const detail::RayTracingPipelineState& pipeline,
                      const VkPhysicalDeviceRayTracingPipelinePropertiesKHR& props, RegionLayout (&regions)[4]) {
