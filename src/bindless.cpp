@@ -11,6 +11,9 @@ namespace detail {
 class BindlessTableState final : public RefCounted {
 public:
     static constexpr const char* type_name = "vkrc::BindlessTable";
+    // Unique per table in the process (serials are not): tells indices apart.
+    const std::uint64_t id = next_id.fetch_add(1, __ATOMIC_RELAXED);
+    inline static Atomic<std::uint64_t> next_id{1};
     DescriptorSetLayout layout;
     DescriptorPool pool;
     DescriptorSet set;
@@ -132,7 +135,7 @@ BindlessIndex add_slot(const detail::BindlessTableState& s, BindlessKind kind, c
     }
     a.slots[slot].live = true;
     ++a.live;
-    return {slot, kind, a.slots[slot].generation, s.serial()};
+    return {slot, kind, a.slots[slot].generation, s.id};
 }
 
 }  // namespace
@@ -212,7 +215,7 @@ void BindlessTable::remove(const BindlessIndex& index) const {
     VKRC_REQUIRE_STATE("vkrc::BindlessTable::remove");
     const detail::Caller caller{"vkrc::BindlessTable::remove"};
     auto& s = *state_;
-    caller.require(index.table == s.serial(), "the index belongs to another table");
+    caller.require(index.table == s.id, "the index belongs to another table");
     LockGuard lock(s.mutex);
     auto& a = array_of(s, index.kind);
     const char* kind = kind_name[static_cast<int>(index.kind)];

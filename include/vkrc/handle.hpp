@@ -164,17 +164,21 @@ private:
 
 namespace detail {
 
-// Creation order of every state block, process-wide: a command buffer ended
-// at counter value v may refer to objects whose serial is below v, never to
-// later ones (docs/design.md, "Dropped while recorded").
-inline Atomic<std::uint64_t> creation_counter{1};
-inline std::uint64_t current_serial() noexcept { return creation_counter.load(__ATOMIC_RELAXED); }
+// Creation epochs, process-wide: a state block takes the epoch current at
+// its construction as its serial (a load, so that threads making objects at
+// once share no written line). current_serial() moves the epoch on, so every
+// object made before it has a lower serial: a command buffer ended then may
+// refer to objects below that value only (docs/design.md, "Dropped while
+// recorded"). Serials are not unique; an object made while another thread
+// moves the epoch may get the older value, which only holds its drop longer.
+inline Atomic<std::uint64_t> creation_epoch{1};
+inline std::uint64_t current_serial() noexcept { return creation_epoch.fetch_add(1, __ATOMIC_RELAXED) + 1; }
 
 // Base of every state block. The count starts at one: the creator owns it.
 template <class Policy>
 class BasicRefCounted {
 public:
-    BasicRefCounted() noexcept : serial_(creation_counter.fetch_add(1, __ATOMIC_RELAXED)) {}
+    BasicRefCounted() noexcept : serial_(creation_epoch.load(__ATOMIC_RELAXED)) {}
     BasicRefCounted(const BasicRefCounted&) = delete;
     BasicRefCounted& operator=(const BasicRefCounted&) = delete;
 
@@ -189,7 +193,7 @@ public:
         }
     }
     std::uint32_t use_count() const noexcept { return Policy::load(refs_); }
-    // Taken at construction (creation or adoption); see creation_counter.
+    // The epoch at construction (creation or adoption); see creation_epoch.
     std::uint64_t serial() const noexcept { return serial_; }
 
 protected:
