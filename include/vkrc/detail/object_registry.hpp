@@ -32,8 +32,8 @@ public:
 
 private:
     struct Impl;
-    mutable Mutex mutex_;
-    Impl* impl_ = nullptr;  // made at the first add
+    Mutex mutex_;                  // makes impl_, once
+    Atomic<Impl*> impl_{nullptr};  // made at the first add; striped locks inside
 };
 
 }  // namespace detail
