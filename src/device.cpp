@@ -143,6 +143,12 @@ bool DeviceState::reached(Span<const std::uint64_t> snapshot) noexcept {
 // ---------------------------------------------------------------- DeferredDestructor
 
 void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept {
+    // Nothing queued and nothing pending: runs now without the lock, so
+    // threads dropping objects at once do not queue behind each other.
+    if (count_.load(__ATOMIC_ACQUIRE) == 0 && device.idle_now()) {
+        action.run(device, action.handle, action.context);
+        return;
+    }
     List<DeferredAction> ready;
     bool run_now = false;
     {
