@@ -105,28 +105,43 @@ AllocatorRegistry::AllocatorRegistry() = default;
 AllocatorRegistry::~AllocatorRegistry() = default;
 
 DeviceAllocator& AllocatorRegistry::default_allocator() {
+    if (DeviceAllocator* made = default_.load(__ATOMIC_ACQUIRE)) return *made;
     LockGuard lock(mutex_);
-    if (!default_) {
-        auto pool = make_allocator<PoolAllocator>();
-        allocators_.push_back(pool);
-        std::rotate(allocators_.begin(), allocators_.end() - 1, allocators_.end());  // the default one first
-        default_ = pool.get();
+    if (DeviceAllocator* made = default_.load(__ATOMIC_RELAXED)) return *made;
+    auto pool = make_allocator<PoolAllocator>();
+    allocators_.push_back(pool);
+    std::rotate(allocators_.begin(), allocators_.end() - 1, allocators_.end());  // the default one first
+    default_.store(pool.get(), __ATOMIC_RELEASE);
+    return *pool;
+}
+
+bool AllocatorRegistry::kept_recently(const DeviceAllocator* allocator) const noexcept {
+    const std::size_t n = recent_count_.load(__ATOMIC_ACQUIRE);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (recent_[i].load(__ATOMIC_RELAXED) == allocator) return true;
     }
-    return *default_;
+    return false;
 }
 
 void AllocatorRegistry::keep(const Ref<DeviceAllocator>& allocator) {
+    if (kept_recently(allocator.get())) return;
     LockGuard lock(mutex_);
     auto same = [&](const Ref<DeviceAllocator>& a) { return a.get() == allocator.get(); };
     if (std::find_if(allocators_.begin(), allocators_.end(), same) == allocators_.end()) {
         allocators_.push_back(allocator);
+    }
+    const std::size_t n = recent_count_.load(__ATOMIC_RELAXED);
+    if (n < recent_slots && !kept_recently(allocator.get())) {
+        recent_[n].store(allocator.get(), __ATOMIC_RELAXED);
+        recent_count_.store(n + 1, __ATOMIC_RELEASE);
     }
 }
 
 void AllocatorRegistry::release_all(DeviceState& device) noexcept {
     for (auto& a : allocators_) a->release(DeviceView(device));
     allocators_.clear();
-    default_ = nullptr;
+    recent_count_.store(0, __ATOMIC_RELAXED);
+    default_.store(nullptr, __ATOMIC_RELAXED);
 }
 
 }  // namespace detail

@@ -215,9 +215,16 @@ public:
     void release_all(DeviceState& device) noexcept;
 
 private:
+    // Whether allocator is among the first recent_slots kept: read without
+    // the lock, so that every allocation does not take it.
+    bool kept_recently(const DeviceAllocator* allocator) const noexcept;
+    static constexpr std::size_t recent_slots = 32;
+
     Mutex mutex_;
     List<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
-    DeviceAllocator* default_ = nullptr;
+    Atomic<DeviceAllocator*> default_{nullptr};
+    Atomic<const DeviceAllocator*> recent_[recent_slots];  // written under mutex_, append-only
+    Atomic<std::size_t> recent_count_{0};
 };
 
 // The device's machinery, through named operations: the other layers call
