@@ -282,7 +282,7 @@ std::uint32_t thread_number() noexcept {
 std::uint32_t resolve_shards(std::uint32_t wanted) noexcept {
 #if VKRC_IS_MULTI_THREAD
     if (wanted != 0) return wanted;
-    return std::clamp<std::uint32_t>(std::thread::hardware_concurrency(), 1, 8);
+    return std::clamp<std::uint32_t>(std::thread::hardware_concurrency(), 1, max_pool_shards);
 #else
     (void)wanted;
     return 1;  // one thread at a time gains nothing from more

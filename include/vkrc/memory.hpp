@@ -187,7 +187,8 @@ struct PoolAllocatorCreateInfo {
     std::uint32_t spare_blocks = 2;
     // Independent parts (each with its own lock, blocks and spare block) that
     // threads allocating at once spread over, so that they do not queue on
-    // one lock. 0: min(8, hardware threads) under the multi-thread policy;
+    // one lock. 0: one per hardware thread (at most max_pool_shards) under
+    // the multi-thread policy, so that each thread has a home of its own;
     // 1: one lock for everything (the least memory reserved). At most
     // max_pool_shards. The single-thread policy always has one.
     std::uint32_t shards = 0;
