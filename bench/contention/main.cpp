@@ -16,6 +16,8 @@
 //   image-*           the same four for a 64x64 RGBA8 optimal-tiling sampled image
 //   sets-free         allocate + drop one descriptor set, a FREE_DESCRIPTOR_SET pool per thread
 //   sets-reset        allocate 64 sets, drop them, reset the pool (a pool per thread; 64 ops)
+//   sets-raw          sets-free in raw Vulkan: vkAllocateDescriptorSets + vkFreeDescriptorSets
+//                     from the thread's pool (the driver's share)
 // The allocators (but the -own cases'), the set layout and the device are
 // shared by all threads, as in a program; the descriptor pools and raw memory
 // are per thread.
@@ -184,6 +186,22 @@ Step sets_reset_step(const Shared& s) {
     };
 }
 
+// sets-raw: the thread's pool is a vkrc one, used only through its raw handle.
+Step sets_raw_step(const Shared& s) {
+    return [pool = make_set_pool(s, VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT), &s] {
+        const VkDevice d = s.device.vk();
+        const VkDescriptorSetLayout layout = s.layout.vk();
+        VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+        ai.descriptorPool = pool.vk();
+        ai.descriptorSetCount = 1;
+        ai.pSetLayouts = &layout;
+        VkDescriptorSet set = VK_NULL_HANDLE;
+        vkrc::check(s.device.fn().vkAllocateDescriptorSets(d, &ai, &set), "vkAllocateDescriptorSets");
+        vkrc::check(s.device.fn().vkFreeDescriptorSets(d, pool.vk(), 1, &set), "vkFreeDescriptorSets");
+        return std::size_t{1};
+    };
+}
+
 struct Case {
     const char* name;
     // Called on the measuring thread with its index.
@@ -228,6 +246,7 @@ std::vector<Case> all_cases() {
         {"image-bound", raw(true, true)},
         {"sets-free", [](const Shared& s, unsigned) { return sets_free_step(s); }},
         {"sets-reset", [](const Shared& s, unsigned) { return sets_reset_step(s); }},
+        {"sets-raw", [](const Shared& s, unsigned) { return sets_raw_step(s); }},
     };
 }
 
