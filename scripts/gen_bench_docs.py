@@ -333,6 +333,9 @@ def threads_table(result):
                        f"{fmt_ratio(x)} |")
         control = [f"{threads(x)}: {fmt_ratio(x)}" for x in command if x["variant"] == "raw-direct-control"]
         out += ["", "A/A control (raw-direct against itself, command): " + "; ".join(control) + "."]
+        serial = amdahl_lines(command)
+        if serial:
+            out += ["", serial]
         goals = threads_goals(command, int(config[0]))
         if goals:
             out += [""] + goals
@@ -349,6 +352,40 @@ def threads_table(result):
                 "byte-identical to raw-direct's at that count, and every threaded reference frame to the 1-thread "
                 "raw-direct's.", ""]
     return out
+
+
+AMDAHL_TOLERANCE = 0.10  # the largest miss of a measured median from the fit for "the fit holds"
+
+
+def amdahl_serial(medians):
+    """s of Amdahl's t(n) = s + (t(1) - s) / n fitted by least squares to {n: median} (n = 1 included):
+    t(n) - t(1)/n = s (1 - 1/n), one unknown, so s = sum(a b) / sum(a a)."""
+    one = medians[1]
+    pairs = [(1 - 1 / n, t - one / n) for n, t in medians.items() if n > 1]
+    return sum(a * b for a, b in pairs) / sum(a * a for a, _ in pairs)
+
+
+def amdahl_lines(command):
+    """The part of the command stage that more threads do not shrink, per variant, from the medians: what
+    caps the speed-up (a fixed or serial share) where the fit holds at every count."""
+    parts = []
+    for v in ("raw-direct", "vkrc-mt"):
+        medians = {threads(x): float(x["median_us"]) for x in command if x["variant"] == v}
+        if 1 not in medians or len([n for n in medians if n > 1]) < 2:
+            continue
+        s = amdahl_serial(medians)
+        fitted = {n: s + (medians[1] - s) / n for n in medians if n > 1}
+        fit = ", ".join(f"{n}: {medians[n]:.0f} against {fitted[n]:.0f}" for n in sorted(fitted))
+        miss = max(abs(medians[n] / fitted[n] - 1) for n in fitted)
+        holds = (f"the fit holds within {100 * miss:.0f} %" if miss <= AMDAHL_TOLERANCE else
+                 f"**the fit does not hold** (a miss of {100 * miss:.0f} %): a serial part alone does not explain "
+                 "this curve")
+        parts.append(f"{v} s = {s:.0f} µs of t(1) = {medians[1]:.0f} µs (measured against fitted µs at {fit}; "
+                     f"{holds})")
+    if not parts:
+        return ""
+    return ("Serial part (Amdahl's t(n) = s + (t(1) - s) / n fitted to the medians by least squares): "
+            + "; ".join(parts) + ".")
 
 
 def threads_section(pattern, pending):
@@ -1192,6 +1229,8 @@ BLOCKS = {
     "teapot-threads-h200": lambda: threads_section(
         "H200", "**Pending:** no H200 `--threads` run is committed yet (the commands are above); committed under "
         "docs/results/, it appears here."),
+    "teapot-threads-h100": lambda: threads_section(
+        "H100", "No H100 `--threads` run is committed yet."),
     "readme-teapot": readme_row,
     "teapot-headline": headline,
     "teapot-instructions": lambda: instructions("", "No instruction counts in docs/results/ yet."),
