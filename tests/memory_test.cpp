@@ -1,4 +1,5 @@
 #include "support/vk_test.hpp"
+#include "support/wrapped_allocator.hpp"
 
 #include "../examples/allocator/arena_allocator.hpp"
 
@@ -737,6 +738,57 @@ TEST_F(PoolTest, ServesOneDeviceAtATime) {
     auto b = pool.allocate(vkrc::DeviceView(*other.state()), request(64));
     pool.free(vkrc::DeviceView(*other.state()), b);
     pool.release(vkrc::DeviceView(*other.state()));
+}
+
+// The device keeps every allocator it allocated through until teardown, so
+// that deferred frees still reach them: the first 32 are found without the
+// allocator list's lock, the rest under it. 40 allocators, each used twice
+// (found the second time), dropped by their maker before their buffers and
+// the device: each is released once, after its ranges came back.
+TEST_F(PoolTest, DeviceKeepsEveryAllocatorPastTheLockFreeOnes) {
+    struct Counts {
+        std::atomic<int> allocations{0}, frees{0}, releases{0};
+    };
+    class Counting final : public vkrc_test::WrappedPoolAllocator {
+    public:
+        explicit Counting(Counts& counts) : counts_(counts) {}
+        vkrc::AllocationInfo allocate(vkrc::DeviceView d, const vkrc::AllocationRequest& r) override {
+            ++counts_.allocations;
+            return WrappedPoolAllocator::allocate(d, r);
+        }
+        void free(vkrc::DeviceView d, const vkrc::AllocationInfo& a) override {
+            WrappedPoolAllocator::free(d, a);
+            ++counts_.frees;
+        }
+        void release(vkrc::DeviceView d) noexcept override {
+            WrappedPoolAllocator::release(d);
+            ++counts_.releases;
+        }
+
+    private:
+        Counts& counts_;
+    };
+    constexpr int allocators = 40;
+    std::vector<Counts> counts(allocators);
+    {
+        auto other = vkrc::Device::create(physical_device);
+        std::vector<vkrc::Buffer> buffers;
+        for (int i = 0; i < allocators; ++i) {
+            const vkrc::SharedAllocator a = vkrc::make_allocator<Counting>(counts[std::size_t(i)]);
+            for (int use = 0; use < 2; ++use) {
+                buffers.push_back(vkrc::Buffer::create(
+                    other, {.size = 256, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .allocator = a}));
+            }
+        }
+        buffers.clear();
+        for (const Counts& c : counts) EXPECT_EQ(c.releases.load(), 0) << "released while the device lives";
+    }
+    for (int i = 0; i < allocators; ++i) {
+        const Counts& c = counts[std::size_t(i)];
+        EXPECT_EQ(c.allocations.load(), 2) << "allocator " << i;
+        EXPECT_EQ(c.frees.load(), 2) << "allocator " << i;
+        EXPECT_EQ(c.releases.load(), 1) << "allocator " << i;
+    }
 }
 
 TEST_F(PoolTest, DefaultAllocatorIsAPool) {
