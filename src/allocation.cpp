@@ -21,7 +21,7 @@ void sync_mapped_range(const AllocationState& s, PFN_vkFlushMappedMemoryRanges D
     const MemoryRange r = mapped_range(s.info.offset, s.info.size, s.info.memory_size, s.atom, offset, size);
     if (r.size == 0) return;
     VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, s.info.memory, r.offset, r.size};
-    check((s.device->fn.*call)(s.device->device, 1, &range), name);
+    check((s.device.state()->fn.*call)(s.device.state()->device, 1, &range), name);
 }
 }  // namespace
 
@@ -37,19 +37,19 @@ void AllocationState::invalidate(VkDeviceSize offset, VkDeviceSize size) const {
 void AllocationState::on_last_release() noexcept {
     // The C++ state outlives its last handle until the GPU is done; only the
     // device reference goes now (a queued action holds no references).
-    Ref<DeviceState> d = std::move(device);
-    d->destroy_after_gpu({[](DeviceState& dev, std::uint64_t, void* context) noexcept {
-                              auto* self = static_cast<AllocationState*>(context);
-                              try {
-                                  self->allocator->free(DeviceView(dev), self->info);
-                              } catch (...) {
-                                  // Only a range from another allocator throws, and
-                                  // Allocation::create checked the range's origin.
-                              }
-                              delete self;
-                          },
-                          0, this},
-                         serial());
+    DeviceLink d = std::move(device);
+    d.state()->destroy_after_gpu({[](DeviceState& dev, std::uint64_t, void* context) noexcept {
+                                      auto* self = static_cast<AllocationState*>(context);
+                                      try {
+                                          self->allocator->free(DeviceView(dev), self->info);
+                                      } catch (...) {
+                                          // Only a range from another allocator throws, and
+                                          // Allocation::create checked the range's origin.
+                                      }
+                                      delete self;
+                                  },
+                                  0, this},
+                                 serial());
 }
 
 // The public header's inline checks hand over the caller's name as text.
@@ -98,7 +98,7 @@ Allocation Allocation::create(const Device& device, const AllocationRequest& req
         a->free(DeviceView(s), info);
         throw;
     }
-    st->device = detail::Ref<detail::DeviceState>::share(&s);
+    st->device = device;
     st->allocator = a;
     const VkMemoryPropertyFlags flags =
         device.physical_device().memory_properties().memoryTypes[info.memory_type].propertyFlags;

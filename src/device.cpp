@@ -142,6 +142,83 @@ bool DeviceState::reached(Span<const std::uint64_t> snapshot) noexcept {
 
 // ---------------------------------------------------------------- DeferredDestructor
 
+// ---------------------------------------------------------------- ChildCount
+
+namespace {
+// Far below any count: a stripe at or under it was drained (dead_credit: its
+// value once drained; returns that still land there do not bring it near).
+constexpr std::int64_t dead_credit = INT64_MIN / 2;
+constexpr std::int64_t credit_batch = 64;  // taken from / given back to the total at once
+bool is_dead(std::int64_t credits) noexcept { return credits < dead_credit / 2; }
+
+// The calling thread's stripe: threads take them round-robin at their first child.
+std::size_t thread_stripe(std::size_t count) noexcept {
+    static Atomic<std::size_t> next{0};
+    thread_local std::size_t mine = next.fetch_add(1, __ATOMIC_RELAXED);
+    return mine % count;
+}
+}  // namespace
+
+// A new reference comes from an existing one (a handle or a child), so the
+// total cannot be at zero here, and increments need no order (as RefCounted's).
+void ChildCount::add() noexcept {
+    if constexpr (!ThreadPolicy::multi_thread) {
+        total_.store(total_.load(__ATOMIC_RELAXED) + 1, __ATOMIC_RELAXED);
+    } else {
+        auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
+        std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
+        while (credits > 0) {
+            if (stripe.compare_exchange_weak(credits, credits - 1, __ATOMIC_RELAXED)) return;
+        }
+        if (is_dead(credits)) {
+            total_.fetch_add(1, __ATOMIC_RELAXED);
+            return;
+        }
+        // None left: a batch from the total, one for this reference.
+        total_.fetch_add(credit_batch, __ATOMIC_RELAXED);
+        if (is_dead(stripe.fetch_add(credit_batch - 1, __ATOMIC_RELAXED))) {
+            total_.fetch_sub(credit_batch - 1, __ATOMIC_RELAXED);  // drained meanwhile: this one's stays
+        }
+    }
+}
+
+// Acquire-release, as RefCounted's decrement: the thread that destroys the
+// device sees every write made through the other references. Each path
+// gives up this reference in its one last write (a return to a live stripe
+// is counted by release_handles when it drains), after which another thread
+// may destroy the device: nothing here touches it after that write.
+bool ChildCount::release() noexcept {
+    if constexpr (!ThreadPolicy::multi_thread) {
+        const std::int64_t left = total_.load(__ATOMIC_RELAXED) - 1;
+        total_.store(left, __ATOMIC_RELAXED);
+        return left == 0;
+    } else {
+        auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
+        std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
+        for (;;) {
+            if (is_dead(credits)) return total_.fetch_sub(1, __ATOMIC_ACQ_REL) == 1;
+            // Past two batches, one goes back with this reference, so that a
+            // thread that only drops holds few credits.
+            const bool surplus = credits >= 2 * credit_batch;
+            const std::int64_t next = surplus ? credits + 1 - credit_batch : credits + 1;
+            if (stripe.compare_exchange_weak(credits, next, __ATOMIC_ACQ_REL)) {
+                return surplus && total_.fetch_sub(credit_batch, __ATOMIC_ACQ_REL) == credit_batch;
+            }
+        }
+    }
+}
+
+bool ChildCount::release_handles() noexcept {
+    std::int64_t drained = 0;
+    if constexpr (ThreadPolicy::multi_thread) {
+        for (auto& s : stripes_) {
+            const std::int64_t credits = s.credits.exchange(dead_credit, __ATOMIC_ACQ_REL);
+            if (!is_dead(credits)) drained += credits;
+        }
+    }
+    return total_.fetch_sub(1 + drained, __ATOMIC_ACQ_REL) == 1 + drained;
+}
+
 void DeferredDestructor::destroy_after_gpu(DeviceState& device, DeferredAction action) noexcept {
     // Nothing queued and nothing pending: runs now without the lock, so
     // threads dropping objects at once do not queue behind each other.

@@ -1,4 +1,5 @@
 #include "support/vk_test.hpp"
+#include "support/wrapped_allocator.hpp"
 
 #include <algorithm>
 #include <array>
@@ -49,6 +50,45 @@ TEST(DestructionOrder, EveryOrderIsClean) {
         ++runs;
     } while (std::next_permutation(order.begin(), order.end()));
     EXPECT_EQ(runs, 24);
+}
+
+// allocator's release() count shows when the device was torn down.
+vkrc::Buffer small_buffer(const vkrc::Device& device, const vkrc::SharedAllocator& allocator) {
+    return vkrc::Buffer::create(device,
+                                {.size = 256, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .allocator = allocator});
+}
+
+// A device outlives its last handle while a child lives, a handle made again
+// from a child's device() keeps it too, and it goes with the last of either.
+// The layer reports a vkDestroyDevice with live children, and the instance
+// dropped last reports a device never destroyed.
+TEST(DeviceLifetime, LastChildOrHandleDestroysTheDevice) {
+    for (int last_is_handle = 0; last_is_handle < 2; ++last_is_handle) {
+        auto log = std::make_shared<ValidationLog>();
+        Chain c = make_chain(log);
+        const auto allocator = vkrc::make_allocator<vkrc_test::CountingAllocator>();
+        vkrc::Buffer first = small_buffer(c.device, allocator);
+        c.device.reset();
+        c.queue = {};
+        vkrc::Device again = first.device();  // a handle again, made from a child
+        vkrc::Buffer second = small_buffer(again, allocator);
+        EXPECT_EQ(again.use_count(), 1u) << "children hold no handle";
+        first.reset();
+        if (last_is_handle) {
+            second.reset();
+            EXPECT_NE(again.vk(), VK_NULL_HANDLE);
+            EXPECT_EQ(allocator->releases(), 0) << "torn down while a handle lives";
+            again.reset();
+        } else {
+            again.reset();
+            EXPECT_NE(second.device().vk(), VK_NULL_HANDLE);
+            EXPECT_EQ(allocator->releases(), 0) << "torn down while a child lives";
+            second.reset();
+        }
+        EXPECT_EQ(allocator->releases(), 1) << "not torn down with the last child or handle";
+        c = {};
+        vkrc_test::expect_no_validation_messages(*log);
+    }
 }
 
 TEST_F(VulkanTest, ChildrenKeepParentsAlive) {
@@ -310,6 +350,38 @@ TEST_F(VulkanTest, SixteenThreadsShareAndDropHandles) {
     for (auto& t : threads) t.join();
     queue.wait_idle();
     EXPECT_EQ(device.use_count(), 2u);  // the fixture's device and queue handles
+}
+
+// Sixteen threads make and drop buffers (and so their device references,
+// counted on per-thread stripes) while the device's handles go one by one:
+// each thread drops its own handle halfway and goes on from a buffer it
+// keeps, making handles again from it. The device must be destroyed once,
+// after its last child (the layer and ASan/TSan watch).
+TEST(DeviceLifetime, SixteenThreadsMakeAndDropChildrenWhileTheHandlesGo) {
+    auto log = std::make_shared<ValidationLog>();
+    Chain c = make_chain(log);
+    c.queue = {};
+    const auto allocator = vkrc::make_allocator<vkrc_test::CountingAllocator>();
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 16; ++t) {
+        threads.emplace_back([device = c.device, t, &allocator]() mutable {
+            vkrc::Buffer kept = small_buffer(device, allocator);
+            for (int i = 0; i < 400; ++i) {
+                if (i == 200) device.reset();
+                const vkrc::Device& from = device ? device : kept.device();
+                vkrc::Buffer b = small_buffer(from, allocator);
+                if ((i + t) % 7 == 0) {
+                    vkrc::Device handle = b.device();  // a handle made from a child
+                    b = small_buffer(handle, allocator);
+                }
+            }
+        });
+    }
+    c.device.reset();  // the threads' copies and buffers keep it
+    for (auto& t : threads) t.join();
+    EXPECT_EQ(allocator->releases(), 1) << "the device was not torn down once, after its last child";
+    c = {};
+    vkrc_test::expect_no_validation_messages(*log);
 }
 #endif
 

@@ -12,6 +12,7 @@ class DeviceAllocator;
 
 namespace detail {
 class DeviceState;
+class DeviceLink;
 class QueueState;
 }  // namespace detail
 
@@ -133,6 +134,10 @@ public:
 private:
     using Handle::Handle;
     friend class Queue;
+    friend class detail::DeviceLink;
+    // A Device over s that took no reference, for DeviceLink's view only
+    // (which is never destroyed, so gives none back).
+    static Device view_of(detail::DeviceState* s) noexcept { return Device(detail::Ref<detail::DeviceState>(s)); }
 };
 
 // The colour of a debug-utils label (all zero: none).

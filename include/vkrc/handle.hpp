@@ -29,6 +29,8 @@ struct SingleThreadPolicy {
     using SpinLock = Mutex;
     static constexpr bool multi_thread = false;
     static void increment(Count& c) noexcept { ++c; }
+    // Increments; true when the count was zero.
+    static bool increment_from_zero(Count& c) noexcept { return c++ == 0; }
     // True when the count reached zero.
     static bool decrement(Count& c) noexcept { return --c == 0; }
     // Increments unless the count is zero (the object is being destroyed).
@@ -132,6 +134,7 @@ struct MultiThreadPolicy {
     };
     static constexpr bool multi_thread = true;
     static void increment(Count& c) noexcept { c.fetch_add(1, __ATOMIC_RELAXED); }
+    static bool increment_from_zero(Count& c) noexcept { return c.fetch_add(1, __ATOMIC_RELAXED) == 0; }
     static bool decrement(Count& c) noexcept { return c.fetch_sub(1, __ATOMIC_ACQ_REL) == 1; }
     static bool increment_if_live(Count& c) noexcept {
         std::uint32_t seen = c.load(__ATOMIC_RELAXED);
@@ -201,6 +204,10 @@ protected:
     // Default: free now. Device children override this to defer destruction
     // until the GPU has finished with them.
     virtual void on_last_release() noexcept { delete this; }
+    // add_ref(); true when the count was zero (a state that outlives its
+    // last handle, as DeviceState does while it has children, sees a handle
+    // to it made again).
+    bool add_ref_from_zero() const noexcept { return Policy::increment_from_zero(refs_); }
 
 private:
     mutable typename Policy::Count refs_{1};
@@ -284,7 +291,8 @@ class Handle {
 public:
     Handle() noexcept = default;
     explicit operator bool() const noexcept { return static_cast<bool>(state_); }
-    // Number of handles and child objects that keep this object alive.
+    // Number of handles and child objects that keep this object alive (a
+    // Device's children are counted apart: its count is its handles').
     std::uint32_t use_count() const noexcept { return state_ ? state_->use_count() : 0; }
     // Drops this handle's reference.
     void reset() noexcept { state_.reset(); }

@@ -270,7 +270,7 @@ constexpr MemoryRange mapped_range(VkDeviceSize allocation_offset, VkDeviceSize 
 
 class AllocationState final : public RefCounted {
 public:
-    Ref<DeviceState> device;
+    DeviceLink device;
     AllocationInfo info;
     DeviceAllocator* allocator = nullptr;
     VkDeviceSize atom = 1;

@@ -37,10 +37,17 @@ public:
         WrappedPoolAllocator::free(device, allocation);
         ++frees_;
     }
+    // The device calls release() once, at its teardown: this shows when it went.
+    void release(vkrc::DeviceView device) noexcept override {
+        WrappedPoolAllocator::release(device);
+        ++releases_;
+    }
     int frees() const { return frees_; }
+    int releases() const { return releases_; }
 
 private:
     std::atomic<int> frees_{0};
+    std::atomic<int> releases_{0};
 };
 
 }  // namespace vkrc_test

@@ -10,6 +10,7 @@
 #include "vkrc/detail/object_registry.hpp"
 
 #include <cstdint>
+#include <new>
 
 VKRC_BEGIN_NAMESPACE
 
@@ -227,11 +228,52 @@ private:
     Atomic<std::size_t> recent_count_{0};
 };
 
+// What keeps a device alive besides its handles: its children's references
+// (DeviceLink) and one share for all its handles together. Under vkrc::mt a
+// thread takes and returns references as credits on a stripe of its own,
+// and the shared total moves by batches, so that threads making and
+// dropping children at once write no shared line (one count written by
+// every thread capped Buffer::create + drop at a fraction of one thread's
+// rate, bench/contention). When the handles' share goes, every stripe is
+// drained and marked dead, and from then on references go to the total,
+// so that the drop that takes it to zero is exact.
+class ChildCount {
+public:
+    void add() noexcept;
+    // True when the total reached zero: the caller destroys the device.
+    [[nodiscard]] bool release() noexcept;
+    // The handles' share, given back by their last one and taken again by a
+    // handle made from a child's device() after that.
+    void add_handles() noexcept { total_.fetch_add(1, __ATOMIC_RELAXED); }
+    [[nodiscard]] bool release_handles() noexcept;
+
+private:
+    static constexpr std::size_t stripe_count = ThreadPolicy::multi_thread ? 64 : 1;
+    struct alignas(64) Stripe {  // apart in cache: threads on different stripes share no line
+        Atomic<std::int64_t> credits{0};
+    };
+    Stripe stripes_[stripe_count];
+    alignas(64) Atomic<std::int64_t> total_{1};  // references held + credits on live stripes + the handles' share
+};
+
 // The device's machinery, through named operations: the other layers call
 // these, never the parts (commands, deferred, allocators) directly.
 class DeviceState final : public RefCounted {
 public:
     ~DeviceState() override;
+
+    // ---- References: handles count in RefCounted, children in ChildCount
+    // Hides RefCounted::add_ref (Ref<DeviceState> calls this one): a handle
+    // made when none was left takes the handles' share back.
+    void add_ref() const noexcept {
+        if (add_ref_from_zero()) [[unlikely]]
+            children_.add_handles();
+    }
+    void add_child() noexcept { children_.add(); }
+    // May destroy this device: the caller touches it no more.
+    void release_child() noexcept {
+        if (children_.release()) delete this;
+    }
 
     // ---- Deferred destruction
     // Defers a destruction: see DeferredDestructor::destroy_after_gpu; serial
@@ -359,12 +401,17 @@ public:
 
 private:
     friend class OpenCommandBuffers;  // moves released drops into deferred
+    // The last handle went: the handles' share of children_ goes.
+    void on_last_release() noexcept override {
+        if (children_.release_handles()) delete this;
+    }
     // Reads one queue's timeline into its completed cache.
     VkResult refresh(QueueState& queue) noexcept;
 
     OpenCommandBuffers commands;
     DeferredDestructor deferred;
     AllocatorRegistry allocators;
+    mutable ChildCount children_;
 };
 
 // The timeline operations from a Queue handle, for the layers above the
@@ -436,11 +483,57 @@ void destroy_owned(const VulkanObjectState<VkHandle>& state, const Device& devic
     if (device && state.owns_handle()) defer_destroy<destroy>(*device.state(), state.handle, state.serial());
 }
 
+// A child's reference to its device, which keeps it alive (ChildCount) and
+// reads as a Device: a copy of that Device is a handle of its own.
+class DeviceLink {
+public:
+    DeviceLink() noexcept {}
+    explicit DeviceLink(const Device& device) noexcept : view_(device.state()) {
+        if (DeviceState* s = device.state()) s->add_child();
+    }
+    DeviceLink(DeviceLink&& other) noexcept : view_(other.view_.take()) {}
+    DeviceLink(const DeviceLink&) = delete;
+    DeviceLink& operator=(const DeviceLink&) = delete;
+    DeviceLink& operator=(const Device& device) noexcept {
+        DeviceLink link(device);
+        DeviceState* old = view_.take();
+        view_.set(link.view_.take());
+        if (old) old->release_child();
+        return *this;
+    }
+    ~DeviceLink() {
+        if (DeviceState* s = view_.take()) s->release_child();
+    }
+    explicit operator bool() const noexcept { return state() != nullptr; }
+    DeviceState* state() const noexcept { return view_.device.state(); }
+    operator const Device&() const noexcept { return view_.device; }
+    const Device& get() const noexcept { return view_.device; }
+    // Device's accessors, which the children's code reaches through it.
+    VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT { return view_.device.vk(); }
+    const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT { return view_.device.fn(); }
+    const PhysicalDevice& physical_device() const VKRC_UNCHECKED_NOEXCEPT { return view_.device.physical_device(); }
+
+private:
+    // A Device that counts nothing: made over the state without a
+    // reference and never destroyed (its union's destructor does nothing).
+    union View {
+        explicit View(DeviceState* s = nullptr) noexcept : device(Device::view_of(s)) {}
+        ~View() {}
+        DeviceState* take() noexcept {
+            DeviceState* s = device.state();
+            set(nullptr);
+            return s;
+        }
+        void set(DeviceState* s) noexcept { new (&device) Device(Device::view_of(s)); }
+        Device device;
+    } view_;
+};
+
 // The state of most objects made from a Device: the device, kept alive.
 template <class VkHandle>
 class DeviceChildState : public VulkanObjectState<VkHandle> {
 public:
-    Device device;
+    DeviceLink device;
 };
 
 }  // namespace detail
