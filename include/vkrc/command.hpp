@@ -4,10 +4,11 @@
 //
 // CommandBuffer's recording methods by topic: here its lifetime, render
 // passes and dynamic rendering, bindings, draws and dispatches, barriers and
-// events, secondaries, queries and labels; in its bases, each in its own
-// header that this one includes, the transfer commands
-// (vkrc/command_transfer.hpp), the dynamic state (vkrc/command_dynamic_state.hpp)
-// and the ray tracing commands (vkrc/command_ray_tracing.hpp).
+// events, secondaries and labels; in its bases, each in its own header that
+// this one includes, the transfer commands (vkrc/command_transfer.hpp), the
+// dynamic state (vkrc/command_dynamic_state.hpp), the queries
+// (vkrc/command_query.hpp) and the ray tracing commands
+// (vkrc/command_ray_tracing.hpp).
 //
 // Recording methods are inline: each is one call through the device function
 // table with the raw handles read out of the wrappers. No allocation, no
@@ -18,6 +19,7 @@
 #include "vkrc/barrier.hpp"
 #include "vkrc/command_dynamic_state.hpp"
 #include "vkrc/command_pool.hpp"
+#include "vkrc/command_query.hpp"
 #include "vkrc/command_ray_tracing.hpp"
 #include "vkrc/command_transfer.hpp"
 #include "vkrc/descriptor_template.hpp"
@@ -41,6 +43,7 @@ class CommandBufferState;
 class CommandBuffer : public Handle<detail::CommandBufferState>,
                       public detail::TransferCommands<CommandBuffer>,
                       public detail::DynamicStateCommands<CommandBuffer>,
+                      public detail::QueryCommands<CommandBuffer>,
                       public detail::RayTracingCommands<CommandBuffer> {
 public:
     CommandBuffer() noexcept = default;
@@ -360,36 +363,6 @@ public:
         fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
     }
 
-    // Queries
-    void reset_query_pool(Raw<VkQueryPool> pool, std::uint32_t first_query,
-                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
-        fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
-    }
-    void write_timestamp(VkPipelineStageFlags2 stage, Raw<VkQueryPool> pool,
-                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
-        fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
-    }
-    // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
-    void begin_query(Raw<VkQueryPool> pool, std::uint32_t query,
-                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
-        fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
-    }
-    void end_query(Raw<VkQueryPool> pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
-        fn_->vkCmdEndQuery(cmd_, pool, query);
-    }
-    // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
-    void copy_query_results(Raw<VkQueryPool> pool, std::uint32_t first_query, std::uint32_t query_count,
-                            Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize stride,
-                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
-        fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
-                                       flags | VK_QUERY_RESULT_64_BIT);
-    }
-
     // Debug-utils labels around and between commands, shown by debuggers and
     // capture tools. No-ops when the instance has not enabled
     // VK_EXT_debug_utils, so they may stay in release code. name is copied.
@@ -428,6 +401,7 @@ private:
     // as VKRC_REQUIRE_STATE checks (who names the method).
     friend class detail::TransferCommands<CommandBuffer>;
     friend class detail::DynamicStateCommands<CommandBuffer>;
+    friend class detail::QueryCommands<CommandBuffer>;
     friend class detail::RayTracingCommands<CommandBuffer>;
     template <class Base>
     static const CommandBuffer& recording(const Base& base, const char* who) VKRC_UNCHECKED_NOEXCEPT {

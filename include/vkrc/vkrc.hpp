@@ -8,6 +8,7 @@
 #include "vkrc/command.hpp"
 #include "vkrc/command_dynamic_state.hpp"
 #include "vkrc/command_pool.hpp"
+#include "vkrc/command_query.hpp"
 #include "vkrc/command_ray_tracing.hpp"
 #include "vkrc/command_transfer.hpp"
 #include "vkrc/config.hpp"
