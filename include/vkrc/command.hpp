@@ -2,6 +2,14 @@
 // vkrc/barrier.hpp; what rendering begins with: vkrc/rendering.hpp;
 // submission: vkrc/submit.hpp).
 //
+// CommandBuffer's recording methods by topic: here its lifetime, render
+// passes and dynamic rendering, bindings, draws and dispatches, barriers and
+// events, secondaries and labels; in its bases, each in its own header that
+// this one includes, the transfer commands (vkrc/command_transfer.hpp), the
+// dynamic state (vkrc/command_dynamic_state.hpp), the queries
+// (vkrc/command_query.hpp) and the ray tracing commands
+// (vkrc/command_ray_tracing.hpp).
+//
 // Recording methods are inline: each is one call through the device function
 // table with the raw handles read out of the wrappers. No allocation, no
 // atomics, no locks. Anything not wrapped stays callable as
@@ -9,10 +17,13 @@
 #pragma once
 
 #include "vkrc/barrier.hpp"
+#include "vkrc/command_dynamic_state.hpp"
 #include "vkrc/command_pool.hpp"
+#include "vkrc/command_query.hpp"
+#include "vkrc/command_ray_tracing.hpp"
+#include "vkrc/command_transfer.hpp"
 #include "vkrc/descriptor_template.hpp"
 #include "vkrc/pipeline.hpp"
-#include "vkrc/ray_tracing.hpp"
 #include "vkrc/rendering.hpp"
 #include "vkrc/sync.hpp"
 
@@ -22,14 +33,18 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 class CommandBufferState;
-[[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
 }  // namespace detail
 
 // A command buffer; keeps its pool alive and returns to it when dropped (once
 // the GPU has finished the work submitted before the drop). A recording
 // method's Raw<VkX> parameter takes the vkrc wrapper (a Buffer, an Image, ...)
-// or a raw handle made by other code: one method for both.
-class CommandBuffer : public Handle<detail::CommandBufferState> {
+// or a raw handle made by other code: one method for both. The methods of
+// its bases are as much its own (see the top of this file).
+class CommandBuffer : public Handle<detail::CommandBufferState>,
+                      public detail::TransferCommands<CommandBuffer>,
+                      public detail::DynamicStateCommands<CommandBuffer>,
+                      public detail::QueryCommands<CommandBuffer>,
+                      public detail::RayTracingCommands<CommandBuffer> {
 public:
     CommandBuffer() noexcept = default;
     // A command buffer of level allocated by other code from pool's Vulkan
@@ -127,7 +142,7 @@ public:
         fn_->vkCmdEndRendering(cmd_);
     }
 
-    // State
+    // Bindings (the dynamic state: vkrc/command_dynamic_state.hpp)
     // Each binding by a wrapper is followed by its twin by raw handles or a
     // PipelineLayout, for pipelines and layouts made by other code (or
     // adopted): the same single call.
@@ -148,6 +163,16 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers");
         fn_->vkCmdBindVertexBuffers(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
                                     offsets.data());
+    }
+    // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
+    // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
+    void bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
+                              Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes = {},
+                              Span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
+        fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
+                                     offsets.data(), sizes.empty() ? nullptr : sizes.data(),
+                                     strides.empty() ? nullptr : strides.data());
     }
     void bind_index_buffer(Raw<VkBuffer> buffer, VkDeviceSize offset = 0,
                            VkIndexType type = VK_INDEX_TYPE_UINT32) const VKRC_UNCHECKED_NOEXCEPT {
@@ -215,21 +240,6 @@ public:
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::push_constants");
         fn_->vkCmdPushConstants(cmd_, layout, stages, offset, size, data);
     }
-    void set_viewport(const VkViewport& viewport) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport");
-        fn_->vkCmdSetViewport(cmd_, 0, 1, &viewport);
-    }
-    void set_scissor(const VkRect2D& scissor) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor");
-        fn_->vkCmdSetScissor(cmd_, 0, 1, &scissor);
-    }
-    // Viewport (depth 0..1) and scissor covering extent.
-    void set_viewport_and_scissor(VkExtent2D extent) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_and_scissor");
-        set_viewport({0.0f, 0.0f, static_cast<float>(extent.width), static_cast<float>(extent.height), 0.0f, 1.0f});
-        set_scissor({{0, 0}, extent});
-    }
-
     // Work
     void draw(std::uint32_t vertex_count, std::uint32_t instance_count = 1, std::uint32_t first_vertex = 0,
               std::uint32_t first_instance = 0) const VKRC_UNCHECKED_NOEXCEPT {
@@ -244,142 +254,6 @@ public:
     void dispatch(std::uint32_t x, std::uint32_t y = 1, std::uint32_t z = 1) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch");
         fn_->vkCmdDispatch(cmd_, x, y, z);
-    }
-    void copy_buffer(Raw<VkBuffer> src, Raw<VkBuffer> dst,
-                     Span<const VkBufferCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer");
-        fn_->vkCmdCopyBuffer(cmd_, src, dst, static_cast<std::uint32_t>(regions.size()), regions.data());
-    }
-    void copy_buffer_to_image(Raw<VkBuffer> src, Raw<VkImage> dst, VkImageLayout dst_layout,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_buffer_to_image");
-        fn_->vkCmdCopyBufferToImage(cmd_, src, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                                    regions.data());
-    }
-    void copy_image_to_buffer(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkBuffer> dst,
-                              Span<const VkBufferImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image_to_buffer");
-        fn_->vkCmdCopyImageToBuffer(cmd_, src, src_layout, dst, static_cast<std::uint32_t>(regions.size()),
-                                    regions.data());
-    }
-    void copy_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
-                    Span<const VkImageCopy> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_image");
-        fn_->vkCmdCopyImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                            regions.data());
-    }
-    void fill_buffer(Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize size,
-                     std::uint32_t data) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::fill_buffer");
-        fn_->vkCmdFillBuffer(cmd_, dst, offset, size, data);
-    }
-
-    // Synchronisation (synchronization2)
-    void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-        fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
-    }
-    // The barriers' structs: vkrc/barrier.hpp.
-    void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
-                          Span<const VkImageMemoryBarrier2> images,
-                          VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-        VkDependencyInfo d{};
-        d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-        d.dependencyFlags = flags;
-        d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
-        d.pMemoryBarriers = memory.data();
-        d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
-        d.pBufferMemoryBarriers = buffers.data();
-        d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
-        d.pImageMemoryBarriers = images.data();
-        fn_->vkCmdPipelineBarrier2(cmd_, &d);
-    }
-    void set_event(Raw<VkEvent> event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
-        fn_->vkCmdSetEvent2(cmd_, event, &dependency);
-    }
-    void reset_event(Raw<VkEvent> event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
-        fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
-    }
-
-    // Secondaries: any number, passed to Vulkan in chunks from the stack.
-    void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
-        constexpr std::size_t chunk = 32;
-        VkCommandBuffer raw[chunk];
-        for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
-            std::uint32_t n = 0;
-            for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
-            fn_->vkCmdExecuteCommands(cmd_, n, raw);
-        }
-    }
-    // Raw secondaries (recorded by other code): passed as they are, in one call.
-    void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
-        fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
-    }
-
-    // Queries
-    void reset_query_pool(Raw<VkQueryPool> pool, std::uint32_t first_query,
-                          std::uint32_t query_count) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_query_pool");
-        fn_->vkCmdResetQueryPool(cmd_, pool, first_query, query_count);
-    }
-    void write_timestamp(VkPipelineStageFlags2 stage, Raw<VkQueryPool> pool,
-                         std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_timestamp");
-        fn_->vkCmdWriteTimestamp2(cmd_, stage, pool, query);
-    }
-
-    // Transfer commands on whole images and buffers. Layouts are the images'
-    // current ones (TRANSFER_SRC/DST_OPTIMAL or GENERAL); regions are read
-    // during the call only.
-    void blit_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
-                    Span<const VkImageBlit> regions, VkFilter filter = VK_FILTER_LINEAR) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::blit_image");
-        fn_->vkCmdBlitImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                            regions.data(), filter);
-    }
-    // src: multisampled; dst: single-sample, same format.
-    void resolve_image(Raw<VkImage> src, VkImageLayout src_layout, Raw<VkImage> dst, VkImageLayout dst_layout,
-                       Span<const VkImageResolve> regions) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::resolve_image");
-        fn_->vkCmdResolveImage(cmd_, src, src_layout, dst, dst_layout, static_cast<std::uint32_t>(regions.size()),
-                               regions.data());
-    }
-    // Outside rendering; the image needs TRANSFER_DST usage.
-    void clear_color_image(Raw<VkImage> image, VkImageLayout layout, const VkClearColorValue& color,
-                           Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_color_image");
-        fn_->vkCmdClearColorImage(cmd_, image, layout, &color, static_cast<std::uint32_t>(ranges.size()),
-                                  ranges.data());
-    }
-    void clear_depth_stencil_image(Raw<VkImage> image, VkImageLayout layout, const VkClearDepthStencilValue& value,
-                                   Span<const VkImageSubresourceRange> ranges) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_depth_stencil_image");
-        fn_->vkCmdClearDepthStencilImage(cmd_, image, layout, &value, static_cast<std::uint32_t>(ranges.size()),
-                                         ranges.data());
-    }
-    // Inside rendering (a render pass or dynamic rendering).
-    void clear_attachments(Span<const VkClearAttachment> attachments,
-                           Span<const VkClearRect> rects) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::clear_attachments");
-        fn_->vkCmdClearAttachments(cmd_, static_cast<std::uint32_t>(attachments.size()), attachments.data(),
-                                   static_cast<std::uint32_t>(rects.size()), rects.data());
-    }
-    // vkCmdUpdateBuffer: size bytes of data, copied into the command buffer at
-    // this call (data need not outlive it). size and offset are multiples of
-    // 4 and size is at most 65536; with VKRC_RUNTIME_CHECKS, UsageError otherwise.
-    void update_buffer(Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize size, const void* data) const {
-#if VKRC_RUNTIME_CHECKS
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::update_buffer");
-        if (size == 0 || size > 65536 || size % 4 != 0 || offset % 4 != 0) [[unlikely]] {
-            detail::throw_bad_update_buffer(offset, size);
-        }
-#endif
-        fn_->vkCmdUpdateBuffer(cmd_, dst, offset, size, data);
     }
 
     // Indirect work: parameters read by the GPU from buffer (INDIRECT_BUFFER
@@ -442,70 +316,51 @@ public:
             stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
     }
 
-    // Ray tracing (VK_KHR_ray_tracing_pipeline: DeviceCreateInfo::ray_tracing_pipeline_features)
-    // with a bound RayTracingPipeline: width * height * depth raygen
-    // invocations through the table's four regions, which the table holds
-    // (a drop of it while this recording is open waits, as every drop does).
-    void trace_rays(const ShaderBindingTable& table, std::uint32_t width, std::uint32_t height,
-                    std::uint32_t depth = 1) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::trace_rays");
-        const VkStridedDeviceAddressRegionKHR* r = table.regions();
-        fn_->vkCmdTraceRaysKHR(cmd_, &r[0], &r[1], &r[2], &r[3], width, height, depth);
+    // Synchronisation (synchronization2)
+    void pipeline_barrier(const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
+        fn_->vkCmdPipelineBarrier2(cmd_, &dependency);
     }
-    // The dimensions from a VkTraceRaysIndirectCommandKHR at indirect, a
-    // device address in a buffer with INDIRECT_BUFFER usage, read at
-    // execution. Needs the rayTracingPipelineTraceRaysIndirect feature.
-    void trace_rays_indirect(const ShaderBindingTable& table, VkDeviceAddress indirect) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::trace_rays_indirect");
-        const VkStridedDeviceAddressRegionKHR* r = table.regions();
-        fn_->vkCmdTraceRaysIndirectKHR(cmd_, &r[0], &r[1], &r[2], &r[3], indirect);
+    // The barriers' structs: vkrc/barrier.hpp.
+    void pipeline_barrier(Span<const VkMemoryBarrier2> memory, Span<const VkBufferMemoryBarrier2> buffers,
+                          Span<const VkImageMemoryBarrier2> images,
+                          VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
+        VkDependencyInfo d{};
+        d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
+        d.dependencyFlags = flags;
+        d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
+        d.pMemoryBarriers = memory.data();
+        d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
+        d.pBufferMemoryBarriers = buffers.data();
+        d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
+        d.pImageMemoryBarriers = images.data();
+        fn_->vkCmdPipelineBarrier2(cmd_, &d);
     }
-
-    // Occlusion and pipeline-statistics queries (reset them first, outside rendering).
-    void begin_query(Raw<VkQueryPool> pool, std::uint32_t query,
-                     VkQueryControlFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_query");
-        fn_->vkCmdBeginQuery(cmd_, pool, query, flags);
+    void set_event(Raw<VkEvent> event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_event");
+        fn_->vkCmdSetEvent2(cmd_, event, &dependency);
     }
-    void end_query(Raw<VkQueryPool> pool, std::uint32_t query) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end_query");
-        fn_->vkCmdEndQuery(cmd_, pool, query);
-    }
-    // vkCmdCopyQueryPoolResults into dst (TRANSFER_DST usage) as 64-bit values.
-    void copy_query_results(Raw<VkQueryPool> pool, std::uint32_t first_query, std::uint32_t query_count,
-                            Raw<VkBuffer> dst, VkDeviceSize offset, VkDeviceSize stride,
-                            VkQueryResultFlags flags = VK_QUERY_RESULT_WAIT_BIT) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_query_results");
-        fn_->vkCmdCopyQueryPoolResults(cmd_, pool, first_query, query_count, dst, offset, stride,
-                                       flags | VK_QUERY_RESULT_64_BIT);
+    void reset_event(Raw<VkEvent> event, VkPipelineStageFlags2 stage_mask) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::reset_event");
+        fn_->vkCmdResetEvent2(cmd_, event, stage_mask);
     }
 
-    // Acceleration structures (VK_KHR_acceleration_structure, enabled on the
-    // device: the functions are called as loaded). The builds as given,
-    // ranges[i] holding infos[i]'s geometryCount ranges; build_bottom_level
-    // and build_top_level (vkrc/acceleration_structure.hpp) fill them in.
-    void build_acceleration_structures(Span<const VkAccelerationStructureBuildGeometryInfoKHR> infos,
-                                       const VkAccelerationStructureBuildRangeInfoKHR* const* ranges) const
-        VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::build_acceleration_structures");
-        fn_->vkCmdBuildAccelerationStructuresKHR(cmd_, static_cast<std::uint32_t>(infos.size()), infos.data(), ranges);
+    // Secondaries: any number, passed to Vulkan in chunks from the stack.
+    void execute_commands(Span<const CommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+        constexpr std::size_t chunk = 32;
+        VkCommandBuffer raw[chunk];
+        for (std::size_t i = 0; i < secondaries.size(); i += chunk) {
+            std::uint32_t n = 0;
+            for (std::size_t j = i; j < secondaries.size() && n < chunk; ++j) raw[n++] = secondaries[j].vk();
+            fn_->vkCmdExecuteCommands(cmd_, n, raw);
+        }
     }
-    // mode CLONE or COMPACT (dst made with the size the compacted-size query gave).
-    void copy_acceleration_structure(Raw<VkAccelerationStructureKHR> src, Raw<VkAccelerationStructureKHR> dst,
-                                     VkCopyAccelerationStructureModeKHR mode) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::copy_acceleration_structure");
-        const VkCopyAccelerationStructureInfoKHR info{VK_STRUCTURE_TYPE_COPY_ACCELERATION_STRUCTURE_INFO_KHR, nullptr,
-                                                      src, dst, mode};
-        fn_->vkCmdCopyAccelerationStructureKHR(cmd_, &info);
-    }
-    // Writes a property of each structure (e.g. ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR)
-    // into consecutive queries of pool from first_query (reset them first).
-    void write_acceleration_structures_properties(Span<const VkAccelerationStructureKHR> structures,
-                                                  VkQueryType query_type, Raw<VkQueryPool> pool,
-                                                  std::uint32_t first_query) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::write_acceleration_structures_properties");
-        fn_->vkCmdWriteAccelerationStructuresPropertiesKHR(cmd_, static_cast<std::uint32_t>(structures.size()),
-                                                           structures.data(), query_type, pool, first_query);
+    // Raw secondaries (recorded by other code): passed as they are, in one call.
+    void execute_commands(Span<const VkCommandBuffer> secondaries) const VKRC_UNCHECKED_NOEXCEPT {
+        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::execute_commands");
+        fn_->vkCmdExecuteCommands(cmd_, static_cast<std::uint32_t>(secondaries.size()), secondaries.data());
     }
 
     // Debug-utils labels around and between commands, shown by debuggers and
@@ -530,114 +385,6 @@ public:
         }
     }
 
-    // Dynamic state (Vulkan 1.0): each needs its VK_DYNAMIC_STATE_* in the
-    // bound pipeline's dynamic states.
-    void set_viewports(std::uint32_t first, Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewports");
-        fn_->vkCmdSetViewport(cmd_, first, static_cast<std::uint32_t>(viewports.size()), viewports.data());
-    }
-    void set_scissors(std::uint32_t first, Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissors");
-        fn_->vkCmdSetScissor(cmd_, first, static_cast<std::uint32_t>(scissors.size()), scissors.data());
-    }
-    // Other widths than 1.0 need the wideLines feature.
-    void set_line_width(float width) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_line_width");
-        fn_->vkCmdSetLineWidth(cmd_, width);
-    }
-    // A clamp other than 0 needs the depthBiasClamp feature.
-    void set_depth_bias(float constant_factor, float clamp, float slope_factor) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bias");
-        fn_->vkCmdSetDepthBias(cmd_, constant_factor, clamp, slope_factor);
-    }
-    void set_blend_constants(const float (&constants)[4]) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_blend_constants");
-        fn_->vkCmdSetBlendConstants(cmd_, constants);
-    }
-    void set_depth_bounds(float min_bounds, float max_bounds) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_bounds");
-        fn_->vkCmdSetDepthBounds(cmd_, min_bounds, max_bounds);
-    }
-    void set_stencil_compare_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_compare_mask");
-        fn_->vkCmdSetStencilCompareMask(cmd_, faces, mask);
-    }
-    void set_stencil_write_mask(VkStencilFaceFlags faces, std::uint32_t mask) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_write_mask");
-        fn_->vkCmdSetStencilWriteMask(cmd_, faces, mask);
-    }
-    void set_stencil_reference(VkStencilFaceFlags faces, std::uint32_t reference) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_reference");
-        fn_->vkCmdSetStencilReference(cmd_, faces, reference);
-    }
-
-    // Dynamic state (Vulkan 1.3 core, formerly extended dynamic state 1 and 2).
-    void set_cull_mode(VkCullModeFlags mode) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_cull_mode");
-        fn_->vkCmdSetCullMode(cmd_, mode);
-    }
-    void set_front_face(VkFrontFace face) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_front_face");
-        fn_->vkCmdSetFrontFace(cmd_, face);
-    }
-    void set_primitive_topology(VkPrimitiveTopology topology) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_primitive_topology");
-        fn_->vkCmdSetPrimitiveTopology(cmd_, topology);
-    }
-    // The viewport and scissor counts are dynamic too (VIEWPORT_WITH_COUNT / SCISSOR_WITH_COUNT).
-    void set_viewport_with_count(Span<const VkViewport> viewports) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_viewport_with_count");
-        fn_->vkCmdSetViewportWithCount(cmd_, static_cast<std::uint32_t>(viewports.size()), viewports.data());
-    }
-    void set_scissor_with_count(Span<const VkRect2D> scissors) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_scissor_with_count");
-        fn_->vkCmdSetScissorWithCount(cmd_, static_cast<std::uint32_t>(scissors.size()), scissors.data());
-    }
-    // vkCmdBindVertexBuffers2: sizes and strides empty or one per buffer
-    // (strides need VERTEX_INPUT_BINDING_STRIDE dynamic).
-    void bind_vertex_buffers2(std::uint32_t first_binding, Span<const VkBuffer> buffers,
-                              Span<const VkDeviceSize> offsets, Span<const VkDeviceSize> sizes = {},
-                              Span<const VkDeviceSize> strides = {}) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::bind_vertex_buffers2");
-        fn_->vkCmdBindVertexBuffers2(cmd_, first_binding, static_cast<std::uint32_t>(buffers.size()), buffers.data(),
-                                     offsets.data(), sizes.empty() ? nullptr : sizes.data(),
-                                     strides.empty() ? nullptr : strides.data());
-    }
-    void set_depth_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetDepthTestEnable>("vkrc::CommandBuffer::set_depth_test_enable", enable);
-    }
-    void set_depth_write_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetDepthWriteEnable>("vkrc::CommandBuffer::set_depth_write_enable", enable);
-    }
-    void set_depth_compare_op(VkCompareOp op) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_depth_compare_op");
-        fn_->vkCmdSetDepthCompareOp(cmd_, op);
-    }
-    // Enabling needs the depthBounds feature.
-    void set_depth_bounds_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetDepthBoundsTestEnable>("vkrc::CommandBuffer::set_depth_bounds_test_enable",
-                                                                    enable);
-    }
-    void set_stencil_test_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetStencilTestEnable>("vkrc::CommandBuffer::set_stencil_test_enable", enable);
-    }
-    void set_stencil_op(VkStencilFaceFlags faces, VkStencilOp fail_op, VkStencilOp pass_op, VkStencilOp depth_fail_op,
-                        VkCompareOp compare_op) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE("vkrc::CommandBuffer::set_stencil_op");
-        fn_->vkCmdSetStencilOp(cmd_, faces, fail_op, pass_op, depth_fail_op, compare_op);
-    }
-    void set_rasterizer_discard_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetRasterizerDiscardEnable>(
-            "vkrc::CommandBuffer::set_rasterizer_discard_enable", enable);
-    }
-    void set_depth_bias_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetDepthBiasEnable>("vkrc::CommandBuffer::set_depth_bias_enable", enable);
-    }
-    void set_primitive_restart_enable(bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        set_enable<&DeviceFunctions::vkCmdSetPrimitiveRestartEnable>(
-            "vkrc::CommandBuffer::set_primitive_restart_enable", enable);
-    }
-
 private:
     friend class CommandPool;
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
@@ -649,14 +396,23 @@ private:
     const DeviceFunctions* fn_ = nullptr;
     VkCommandBuffer cmd_ = VK_NULL_HANDLE;
 
-    // The one body of the VkBool32 dynamic-state setters (cmd is the
-    // vkCmdSet*Enable member of the table; who names the caller).
-    template <auto cmd>
-    void set_enable([[maybe_unused]] const char* who, bool enable) const VKRC_UNCHECKED_NOEXCEPT {
-        VKRC_REQUIRE_STATE(who);
-        (fn_->*cmd)(cmd_, enable ? VK_TRUE : VK_FALSE);
+    // The bases' way in: their methods record through the fn_ and cmd_ of
+    // recording(*this, who), the CommandBuffer the base is part of, checked
+    // as VKRC_REQUIRE_STATE checks (who names the method).
+    friend class detail::TransferCommands<CommandBuffer>;
+    friend class detail::DynamicStateCommands<CommandBuffer>;
+    friend class detail::QueryCommands<CommandBuffer>;
+    friend class detail::RayTracingCommands<CommandBuffer>;
+    template <class Base>
+    static const CommandBuffer& recording(const Base& base, const char* who) VKRC_UNCHECKED_NOEXCEPT {
+        const auto& self = static_cast<const CommandBuffer&>(base);
+        self.live(who);
+        return self;
     }
 };
+// The bases are empty: a CommandBuffer stays the state, the table and the
+// raw handle, which recording reads.
+static_assert(sizeof(CommandBuffer) == 3 * sizeof(void*));
 
 namespace detail {
 

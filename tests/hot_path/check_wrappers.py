@@ -8,7 +8,8 @@ Usage: check_wrappers.py OBJDUMP OBJECT MANIFEST INCLUDE_DIR
 First the coverage: the manifest the object was built from must list what
 the headers hold now (gen_wrappers.py run again), and a grep independent of
 that parser finds every vkCmd in the headers' code and fails unless it lies in
-a wrapped method (or a private helper the wrapped methods reach).
+a wrapped method (or a private helper the wrapped methods reach) of
+CommandBuffer or of one of the bases gen_wrappers.py reads its methods from.
 
 Then each wrapper, with what it reaches by direct call or jump inside the
 object (an inline method the compiler did not inline), must have:
@@ -51,6 +52,10 @@ CALLS = 1
 EXCEPTIONS = {
     # VkRenderPassBeginInfo built on the stack (22, 22).
     "hot_begin_render_pass": (1, 0, 26),
+    # VkCopyAccelerationStructureInfoKHR built on the stack (17, 12): GCC
+    # spends one register move more since the method moved to a class
+    # template (vkrc/command_ray_tracing.hpp); 16 as a member of CommandBuffer.
+    "hot_copy_acceleration_structure": (1, 0, 19),
     # Up to 8 VkRenderingAttachmentInfo copied into a stack array in a loop,
     # the optional depth and stencil ones and VkRenderingInfo on the stack;
     # not inlined by either compiler, so the wrapper jumps to the method's
@@ -276,8 +281,9 @@ def coverage(manifest, include_dir):
     if built != [(n, m.name) for n, m, _ in gen_wrappers.wrappers(public)] or helpers != set(now_helpers):
         bad.append("the wrappers were generated from other headers than these: rebuild")
     covered = {m for _, m in built} | helpers
+    classes = {name for name, _ in gen_wrappers.recording_classes(include_dir)}
     for where, cls, method in recording_sites(include_dir):
-        if cls != gen_wrappers.CLASS or method not in covered:
+        if cls not in classes or method not in covered:
             bad.append(f"{where}: vkCmd in {(cls + '::') if cls else ''}{method or '?'}, which no wrapper covers "
                        f"(extend tests/hot_path/gen_wrappers.py)")
     return built, bad

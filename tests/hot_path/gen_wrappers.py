@@ -2,7 +2,9 @@
 """Finds every public recording method of vkrc::CommandBuffer in the public
 headers and writes one wrapper per method (per overload) for the hot-path
 check (check_wrappers.py), so that a new recording method is covered without
-anyone listing it.
+anyone listing it. The methods are CommandBuffer's own (vkrc/command.hpp) and
+those of each base its class head names as Name<CommandBuffer> (the topic
+headers, vkrc/command_transfer.hpp...), found by name in any header.
 
 A method records when its inline body calls the device table (fn_->vkCmd...,
 fn_->*member) or calls another method that records. Each wrapper takes the
@@ -13,6 +15,8 @@ Usage: gen_wrappers.py INCLUDE_DIR OUT.cpp OUT.manifest
 The manifest lists "wrapper method" per line, then "helper NAME" for the
 private recording helpers the wrapped methods reach.
 """
+import glob
+import os
 import re
 import sys
 
@@ -43,14 +47,33 @@ def matching(text, i, open_ch, close_ch):
             depth -= 1
             if depth == 0:
                 return j + 1
-    raise SystemExit(f"gen_wrappers: unbalanced {open_ch} in {HEADER}")
+    raise SystemExit(f"gen_wrappers: unbalanced {open_ch} in the headers")
 
 
-def class_body(text):
-    m = re.search(r"\bclass\s+" + CLASS + r"\s*(?::[^{;]*)?\{", text)
-    if not m:
+def class_definition(text, name):
+    """(head up to its "{", body) of class name's definition in text, or None."""
+    m = re.search(r"\bclass\s+" + name + r"\s*(?::[^{;]*)?\{", text)
+    return (m.group(0), text[m.end():matching(text, m.end() - 1, "{", "}") - 1]) if m else None
+
+
+def recording_classes(include_dir):
+    """[(name, body)]: CommandBuffer, then each base its head names as
+    Name<CommandBuffer>, defined in exactly one header of include_dir/vkrc."""
+    headers = {}
+    for path in sorted(glob.glob(os.path.join(include_dir, "vkrc", "**", "*.hpp"), recursive=True)):
+        with open(path, encoding="utf-8") as f:
+            headers[os.path.relpath(path, include_dir)] = strip_comments_and_directives(f.read())
+    own = class_definition(headers[HEADER], CLASS)
+    if not own:
         raise SystemExit(f"gen_wrappers: class {CLASS} not found in {HEADER}")
-    return text[m.end():matching(text, m.end() - 1, "{", "}") - 1]
+    classes = [(CLASS, own[1])]
+    for base in re.findall(r"(\w+)\s*<\s*" + CLASS + r"\s*>", own[0]):
+        found = [(h, d) for h, text in headers.items() if (d := class_definition(text, base))]
+        if len(found) != 1:
+            raise SystemExit(f"gen_wrappers: {CLASS}'s base {base} is defined in {len(found)} headers "
+                             f"({', '.join(h for h, _ in found) or 'none'}), not one")
+        classes.append((base, found[0][1][1]))
+    return classes
 
 
 def members(body):
@@ -111,9 +134,8 @@ class Method:
 
 
 def recording_methods(include_dir):
-    with open(f"{include_dir}/{HEADER}", encoding="utf-8") as f:
-        text = strip_comments_and_directives(f.read())
-    methods = [Method(a, h, b) for a, h, b in members(class_body(text)) if b is not None and "(" in h]
+    methods = [Method(a, h, b) for _, body in recording_classes(include_dir) for a, h, b in members(body)
+               if b is not None and "(" in h]
     methods = [m for m in methods if m.returns and not m.returns.startswith(("static", "explicit"))]
     recording = {m.name for m in methods if RECORDS.search(m.body)}
     grew = True
