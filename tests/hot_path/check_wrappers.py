@@ -35,6 +35,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree: running the tests leaves git status clean
 import gen_wrappers  # noqa: E402
 
 # Default bounds, for a method that is one call with its arguments. They
