@@ -142,6 +142,23 @@ bool DeviceState::reached(Span<const std::uint64_t> snapshot) noexcept {
 
 // ---------------------------------------------------------------- DeferredDestructor
 
+// ---------------------------------------------------------------- DeviceLink
+
+DeviceLink::DeviceLink(const Device& device) noexcept : view_(device.state()) {
+    if (DeviceState* s = device.state()) s->add_child();
+}
+DeviceLink::DeviceLink(DeviceLink&& other) noexcept : view_(other.view_.take()) {}
+DeviceLink& DeviceLink::operator=(const Device& device) noexcept {
+    DeviceLink link(device);
+    DeviceState* old = view_.take();
+    view_.set(link.view_.take());
+    if (old) old->release_child();
+    return *this;
+}
+DeviceLink::~DeviceLink() {
+    if (DeviceState* s = view_.take()) s->release_child();
+}
+
 // ---------------------------------------------------------------- ChildCount
 
 namespace {

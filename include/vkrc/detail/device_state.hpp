@@ -487,23 +487,15 @@ void destroy_owned(const VulkanObjectState<VkHandle>& state, const Device& devic
 // reads as a Device: a copy of that Device is a handle of its own.
 class DeviceLink {
 public:
+    // Out of line (device.cpp): made and dropped with objects, never per
+    // command, and every child state's destructor would parse them.
     DeviceLink() noexcept {}
-    explicit DeviceLink(const Device& device) noexcept : view_(device.state()) {
-        if (DeviceState* s = device.state()) s->add_child();
-    }
-    DeviceLink(DeviceLink&& other) noexcept : view_(other.view_.take()) {}
+    explicit DeviceLink(const Device& device) noexcept;
+    DeviceLink(DeviceLink&& other) noexcept;
     DeviceLink(const DeviceLink&) = delete;
     DeviceLink& operator=(const DeviceLink&) = delete;
-    DeviceLink& operator=(const Device& device) noexcept {
-        DeviceLink link(device);
-        DeviceState* old = view_.take();
-        view_.set(link.view_.take());
-        if (old) old->release_child();
-        return *this;
-    }
-    ~DeviceLink() {
-        if (DeviceState* s = view_.take()) s->release_child();
-    }
+    DeviceLink& operator=(const Device& device) noexcept;
+    ~DeviceLink();
     explicit operator bool() const noexcept { return state() != nullptr; }
     DeviceState* state() const noexcept { return view_.device.state(); }
     operator const Device&() const noexcept { return view_.device; }
