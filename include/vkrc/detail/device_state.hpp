@@ -499,7 +499,6 @@ public:
     explicit operator bool() const noexcept { return state() != nullptr; }
     DeviceState* state() const noexcept { return view_.device.state(); }
     operator const Device&() const noexcept { return view_.device; }
-    const Device& get() const noexcept { return view_.device; }
     // Device's accessors, which the children's code reaches through it.
     VkDevice vk() const VKRC_UNCHECKED_NOEXCEPT { return view_.device.vk(); }
     const DeviceFunctions& fn() const VKRC_UNCHECKED_NOEXCEPT { return view_.device.fn(); }
