@@ -37,12 +37,14 @@ void OpenCommandBuffers::close_pool_slow(DeviceState& device, const void* pool) 
 // was made before now, and its end() comes later still.
 std::uint64_t OpenCommandBuffers::limit_locked() const noexcept {
     std::uint64_t limit = 0;
+    bool recording = false;
     for (const RecordingWindow* w : windows_) {
-        std::uint64_t end = w->end.load();
-        if (end == UINT64_MAX) end = current_serial();
-        if (end > limit) limit = end;
+        const std::uint64_t end = w->end.load();
+        if (end == UINT64_MAX) recording = true;
+        else if (end > limit) limit = end;
     }
-    return limit;
+    // Once, however many record: current_serial() moves the epoch on.
+    return recording ? current_serial() : limit;
 }
 
 std::uint64_t OpenCommandBuffers::limit() noexcept {
