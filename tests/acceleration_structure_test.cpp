@@ -279,13 +279,7 @@ TEST_F(AccelerationStructureTest, FragmentShaderRayQueriesMatchTheExpectedHits) 
         s.cmd.set_viewport_and_scissor(framebuffer.extent());
         s.cmd.draw(3);
         s.cmd.end_render_pass();
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {width, height, 1};
-        s.cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, hits, std::span(&region, 1));
-        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-        s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        vkrc_test::record_readback(s.cmd, image.vk(), hits.vk(), width, height);
         s.run(queue);
         return read_hits();
     };

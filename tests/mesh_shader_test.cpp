@@ -108,13 +108,7 @@ protected:
             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         s.cmd.pipeline_barrier({}, {}, std::span(&to_copy, 1));
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {size, size, 1};
-        s.cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pixels, std::span(&region, 1));
-        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-        s.cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        vkrc_test::record_readback(s.cmd, image.vk(), pixels.vk(), size, size);
         s.run(queue);
         std::vector<Rgba> out(size * size);
         pixels.allocation().read(0, out.data(), out.size());

@@ -128,6 +128,20 @@ inline VkMemoryBarrier2 compute_to_host() {
                                 VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
 }
 
+// Records a copy of the whole colour image (mip 0, layer 0, in
+// TRANSFER_SRC_OPTIMAL) into buffer, tightly packed, and the barrier that
+// makes it visible to host reads.
+inline void record_readback(const vkrc::CommandBuffer& cmd, VkImage image, VkBuffer buffer, std::uint32_t width,
+                            std::uint32_t height) {
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {width, height, 1};
+    cmd.copy_image_to_buffer(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer, std::span(&region, 1));
+    const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                              VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    cmd.pipeline_barrier(std::span(&to_host, 1), {}, {});
+}
+
 // A 1x1 R32_UINT image holding value: cleared by cmd and left in layout for
 // any later read (usage gets TRANSFER_DST added).
 inline vkrc::Image uint_image(const vkrc::Device& device, const vkrc::CommandBuffer& cmd, std::uint32_t value,
