@@ -14,6 +14,7 @@
 // that fails at each of its allocations.
 #include "support/fault_injection.hpp"
 #include "support/fault_scenarios.hpp"
+#include "support/features.hpp"
 #include "support/teapot_scenario.hpp"
 #include "support/vk_test.hpp"
 #include "support/watchdog.hpp"
@@ -540,13 +541,7 @@ public:
             VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         cmd_.pipeline_barrier({}, {}, std::span(&to_copy, 1));
-        VkBufferImageCopy region{};
-        region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-        region.imageExtent = {side, side, 1};
-        cmd_.copy_image_to_buffer(image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback_, std::span(&region, 1));
-        const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-        cmd_.pipeline_barrier(std::span(&to_host, 1), {}, {});
+        vkrc_test::record_readback(cmd_, image_.vk(), readback_.vk(), side, side);
         cmd_.end();
         fence_.unsignal();
         vkrc::submit(queue_, {.command_buffers = std::span(&cmd_, 1)}, fence_);
