@@ -113,7 +113,7 @@ Table* load(std::uint32_t version, const GetProcAddr& get, const Wanted& wanted)
 
 // Publishes a table made by make unless another thread already did.
 template <class Table, class Make>
-const Table& load_once(detail::Atomic<Table*>& slot, const Make& make) {
+const Table& load_once(detail::PolicyAtomic<Table*>& slot, const Make& make) {
     if (Table* t = slot.load(__ATOMIC_ACQUIRE)) return *t;
     Table* made = make();
     Table* expected = nullptr;

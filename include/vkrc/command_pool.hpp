@@ -80,7 +80,7 @@ public:
     List<VkCommandBuffer> scratch;          // under mutex
     // Whether pending is not empty: written under mutex, read without it by
     // free_completed (a drop it misses is freed at the next one).
-    detail::Atomic<bool> has_pending{false};
+    detail::PolicyAtomic<bool> has_pending{false};
 };
 
 }  // namespace detail

@@ -17,27 +17,6 @@
 
 VKRC_BEGIN_NAMESPACE
 
-// Plain count and a lock that does nothing: for programs that touch vkrc
-// objects from one thread at a time.
-struct SingleThreadPolicy {
-    using Count = std::uint32_t;
-    struct Mutex {
-        void lock() noexcept {}
-        bool try_lock() noexcept { return true; }
-        void unlock() noexcept {}
-    };
-    using SpinLock = Mutex;
-    static constexpr bool multi_thread = false;
-    static void increment(Count& c) noexcept { ++c; }
-    // Increments; true when the count was zero.
-    static bool increment_from_zero(Count& c) noexcept { return c++ == 0; }
-    // True when the count reached zero.
-    static bool decrement(Count& c) noexcept { return --c == 0; }
-    // Increments unless the count is zero (the object is being destroyed).
-    static bool increment_if_live(Count& c) noexcept { return c != 0 && ++c != 0; }
-    static std::uint32_t load(const Count& c) noexcept { return c; }
-};
-
 namespace detail {
 
 // A word accessed atomically, with the subset of std::atomic's interface vkrc
@@ -91,13 +70,94 @@ private:
     T value_;
 };
 
+// Atomic's interface over a plain word: the single-thread policy's
+// per-instance bookkeeping, which one thread at a time touches (an
+// uncontended locked read-modify-write still costs about 20 cycles on x86,
+// several per frame). Memory orders are accepted and ignored.
+template <class T>
+class PlainAtomic {
+public:
+    constexpr PlainAtomic(T value = T{}) noexcept : value_(value) {}
+    PlainAtomic(const PlainAtomic&) = delete;
+    PlainAtomic& operator=(const PlainAtomic&) = delete;
+
+    template <class Order = int>
+    T load(Order = Order()) const noexcept {
+        return value_;
+    }
+    template <class Order = int>
+    void store(T value, Order = Order()) noexcept {
+        value_ = value;
+    }
+    template <class Order = int>
+    T exchange(T value, Order = Order()) noexcept {
+        const T old = value_;
+        value_ = value;
+        return old;
+    }
+    template <class Order = int>
+    T fetch_add(T delta, Order = Order()) noexcept {
+        const T old = value_;
+        value_ = static_cast<T>(old + delta);
+        return old;
+    }
+    template <class Order = int>
+    T fetch_sub(T delta, Order = Order()) noexcept {
+        const T old = value_;
+        value_ = static_cast<T>(old - delta);
+        return old;
+    }
+    template <class Order = int>
+    bool compare_exchange_weak(T& expected, T desired, Order = Order()) noexcept {
+        return compare_exchange_strong(expected, desired);
+    }
+    template <class Order = int>
+    bool compare_exchange_strong(T& expected, T desired, Order = Order()) noexcept {
+        if (value_ != expected) {
+            expected = value_;
+            return false;
+        }
+        value_ = desired;
+        return true;
+    }
+
+private:
+    T value_;
+};
+
 }  // namespace detail
+
+// Plain count and a lock that does nothing: for programs that touch vkrc
+// objects from one thread at a time.
+struct SingleThreadPolicy {
+    using Count = std::uint32_t;
+    // Per-instance bookkeeping words (detail::PolicyAtomic).
+    template <class T>
+    using Word = detail::PlainAtomic<T>;
+    struct Mutex {
+        void lock() noexcept {}
+        bool try_lock() noexcept { return true; }
+        void unlock() noexcept {}
+    };
+    using SpinLock = Mutex;
+    static constexpr bool multi_thread = false;
+    static void increment(Count& c) noexcept { ++c; }
+    // Increments; true when the count was zero.
+    static bool increment_from_zero(Count& c) noexcept { return c++ == 0; }
+    // True when the count reached zero.
+    static bool decrement(Count& c) noexcept { return --c == 0; }
+    // Increments unless the count is zero (the object is being destroyed).
+    static bool increment_if_live(Count& c) noexcept { return c != 0 && ++c != 0; }
+    static std::uint32_t load(const Count& c) noexcept { return c; }
+};
 
 // Atomic count and a real mutex. Increments are relaxed (a new reference can
 // only come from an existing one); the decrement is acq_rel so that the thread
 // that destroys the object sees every write made through the other references.
 struct MultiThreadPolicy {
     using Count = detail::Atomic<std::uint32_t>;
+    template <class T>
+    using Word = detail::Atomic<T>;
     // A pthread mutex, as std::mutex is on this platform (std::mutex's header
     // brings in <system_error> and <string>). lock() cannot fail on a default
     // mutex used correctly, so it reports nothing.
@@ -151,6 +211,15 @@ using ThreadPolicy = SingleThreadPolicy;
 #endif
 using Mutex = ThreadPolicy::Mutex;
 using SpinLock = ThreadPolicy::SpinLock;
+
+namespace detail {
+// A word of one instance's bookkeeping (a device's, a queue's, a pool's):
+// atomic under vkrc::mt, plain under vkrc::st, where one thread at a time
+// touches the instance. Process-wide words stay Atomic under both policies,
+// since two instances may live on two threads.
+template <class T>
+using PolicyAtomic = ThreadPolicy::Word<T>;
+}  // namespace detail
 
 // Holds a Mutex (or SpinLock) locked for its scope (std::lock_guard without <mutex>).
 template <class Lockable = Mutex>

@@ -223,7 +223,7 @@ public:
     GlobalFunctions global_fn;
     InstanceFunctions fn;
     // Loaded by the first Instance::ext_fn() (src/extension_functions.cpp).
-    Atomic<InstanceExtensionFunctions*> ext_fn{nullptr};
+    PolicyAtomic<InstanceExtensionFunctions*> ext_fn{nullptr};
     List<Text> enabled_extensions;
     List<Text> enabled_layers;
     VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;

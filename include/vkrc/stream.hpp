@@ -50,7 +50,7 @@ namespace detail {
 // 0 until the batch is submitted.
 class BatchValue final : public RefCounted {
 public:
-    Atomic<std::uint64_t> value{0};
+    PolicyAtomic<std::uint64_t> value{0};
 };
 }  // namespace detail
 

@@ -309,8 +309,8 @@ public:
     std::uint64_t acquired = 0;  // under lock
     // Written by present without the lock: present then touches no state it
     // must read first (its frame is checked against the frame's own fields).
-    Atomic<std::uint32_t> last_presented{UINT32_MAX};
-    Atomic<bool> needs_resize{false};
+    PolicyAtomic<std::uint32_t> last_presented{UINT32_MAX};
+    PolicyAtomic<bool> needs_resize{false};
     // Guards ring and acquired: held for a few instructions per acquire.
     mutable SpinLock lock;
     // Serialises re-making the ring (Vulkan calls, allocation) outside lock.

@@ -69,10 +69,10 @@ public:
     }
 
 private:
-    Atomic<std::uint64_t> submitted_{0};
-    Atomic<std::uint64_t> signalled_{0};
-    Atomic<bool> signal_wanted_{false};
-    Atomic<std::uint64_t> completed_{0};
+    PolicyAtomic<std::uint64_t> submitted_{0};
+    PolicyAtomic<std::uint64_t> signalled_{0};
+    PolicyAtomic<bool> signal_wanted_{false};
+    PolicyAtomic<std::uint64_t> completed_{0};
 };
 
 class QueueState {
@@ -125,7 +125,7 @@ private:
     mutable Mutex mutex_;
     List<Batch> batches_;
     // Read without the lock by collect() to skip it when nothing is queued.
-    Atomic<std::size_t> count_{0};
+    PolicyAtomic<std::size_t> count_{0};
 };
 
 // One command buffer's recording window, as the device's OpenCommandBuffers
@@ -133,7 +133,7 @@ private:
 // end() the creation counter's value then: the command buffer may refer to
 // objects with a lower serial only.
 struct RecordingWindow {
-    Atomic<std::uint64_t> end{0};
+    PolicyAtomic<std::uint64_t> end{0};
     const void* pool = nullptr;  // the CommandPoolState, for pool resets
     bool one_time = false;       // a ONE_TIME_SUBMIT primary: closes when submitted
     std::size_t index = 0;       // in the registry
@@ -194,10 +194,10 @@ private:
     mutable Mutex mutex_;
     List<RecordingWindow*> windows_;  // every allocated command buffer of the device
     List<Held> held_;
-    Atomic<std::size_t> open_{0};
-    Atomic<std::size_t> held_count_{0};
-    Atomic<bool> stale_{false};
-    Atomic<std::uint64_t> covered_{0};  // limit_locked() at the last hold or release
+    PolicyAtomic<std::size_t> open_{0};
+    PolicyAtomic<std::size_t> held_count_{0};
+    PolicyAtomic<bool> stale_{false};
+    PolicyAtomic<std::uint64_t> covered_{0};  // limit_locked() at the last hold or release
 };
 
 // Every allocator used with the device, kept until teardown so that deferred
@@ -223,9 +223,9 @@ private:
 
     Mutex mutex_;
     List<Ref<DeviceAllocator>> allocators_;  // the default one first, once made
-    Atomic<DeviceAllocator*> default_{nullptr};
-    Atomic<const DeviceAllocator*> recent_[recent_slots];  // written under mutex_, append-only
-    Atomic<std::size_t> recent_count_{0};
+    PolicyAtomic<DeviceAllocator*> default_{nullptr};
+    PolicyAtomic<const DeviceAllocator*> recent_[recent_slots];  // written under mutex_, append-only
+    PolicyAtomic<std::size_t> recent_count_{0};
 };
 
 // What keeps a device alive besides its handles: its children's references
@@ -250,10 +250,10 @@ public:
 private:
     static constexpr std::size_t stripe_count = ThreadPolicy::multi_thread ? 64 : 1;
     struct alignas(64) Stripe {  // apart in cache: threads on different stripes share no line
-        Atomic<std::int64_t> credits{0};
+        PolicyAtomic<std::int64_t> credits{0};
     };
     Stripe stripes_[stripe_count];
-    alignas(64) Atomic<std::int64_t> total_{1};  // references held + credits on live stripes + the handles' share
+    alignas(64) PolicyAtomic<std::int64_t> total_{1};  // references held + credits on live stripes + the handles' share
 };
 
 // The device's machinery, through named operations: the other layers call
@@ -387,7 +387,7 @@ public:
     VkDevice device = VK_NULL_HANDLE;
     DeviceFunctions fn;
     // Loaded by the first Device::ext_fn() (src/extension_functions.cpp).
-    Atomic<DeviceExtensionFunctions*> ext_fn{nullptr};
+    PolicyAtomic<DeviceExtensionFunctions*> ext_fn{nullptr};
     PhysicalDevice physical_device;
     Ownership ownership = Ownership::owned;
     List<Text> enabled_extensions;
@@ -395,7 +395,7 @@ public:
     DeviceFeatures enabled_features;
     List<QueueState> queues;                 // made once, never grows: Queue handles point into it
     std::size_t role_queues[3] = {0, 0, 0};  // by QueueRole: an index into queues
-    Atomic<bool> lost{false};
+    PolicyAtomic<bool> lost{false};
     // Raw handle -> state of what descriptors point to (descriptor writes of raw handles).
     ObjectRegistry objects;
 

@@ -32,8 +32,8 @@ public:
 
 private:
     struct Impl;
-    Mutex mutex_;                  // makes impl_, once
-    Atomic<Impl*> impl_{nullptr};  // made at the first add; striped locks inside
+    Mutex mutex_;                        // makes impl_, once
+    PolicyAtomic<Impl*> impl_{nullptr};  // made at the first add; striped locks inside
 };
 
 }  // namespace detail
