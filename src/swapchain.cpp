@@ -466,9 +466,6 @@ void Frame::hold(const detail::Ref<detail::FrameImages>& set) noexcept {
     filled_from_ = set.get();
 }
 
-Span<const SemaphoreSubmit> Frame::waits() const noexcept { return {&wait_, sync_count_}; }
-Span<const SemaphoreSubmit> Frame::signals() const noexcept { return {&signal_, sync_count_}; }
-
 VkExtent2D Swapchain::extent() const noexcept { return state_->extent; }
 VkFormat Swapchain::format() const noexcept { return state_->surface_format.format; }
 std::uint32_t Swapchain::image_count() const noexcept {

@@ -71,10 +71,8 @@ public:
     const ImageView& view() const noexcept { return *view_; }
     // For the submission that renders the image: it waits until the image is
     // free and signals when rendering is done. Empty spans headless.
-    // Out of line: building a std::span in a header makes every includer
-    // check the span constructors' range concepts (bench/header_cost).
-    Span<const SemaphoreSubmit> waits() const noexcept;
-    Span<const SemaphoreSubmit> signals() const noexcept;
+    Span<const SemaphoreSubmit> waits() const noexcept { return {&wait_, sync_count_}; }
+    Span<const SemaphoreSubmit> signals() const noexcept { return {&signal_, sync_count_}; }
 
 private:
     friend class Swapchain;
