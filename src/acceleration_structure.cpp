@@ -319,8 +319,8 @@ void update_bottom_level(const CommandBuffer& cmd, const AccelerationStructure& 
     const detail::Caller caller{"vkrc::update_bottom_level"};
     const Device& device = structure_device(caller, cmd, bottom_level, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR);
     caller.require(bottom_level.build_flags() & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_UPDATE_BIT_KHR,
-                   "the structure was not built with ALLOW_UPDATE (VUID-VkAccelerationStructureBuildGeometryInfoKHR-"
-                   "mode-04631)");
+                   "the structure was not built with ALLOW_UPDATE (VUID-vkCmdBuildAccelerationStructuresKHR-pInfos-"
+                   "03667)");
     caller.require(info.flags == bottom_level.build_flags(), "flags ", detail::Hex{info.flags},
                    " differ from the build's ", detail::Hex{bottom_level.build_flags()});
     const BuildInputs in = geometry_inputs(caller, device, info);
