@@ -65,13 +65,15 @@ constexpr int finest_tessellation = 32;    // the image error's reference level
 constexpr const char* reference_name = "raw-direct";
 constexpr const char* control_name = "raw-direct-control";
 
-// The overhead budget of issue 12 on the stages a timer resolves: the
-// interval's upper bound must be within it (and the control within 1 +- 0.01).
+// The overhead budget on the stages a timer resolves (issue 12, vkrc-mt's
+// tightened from 1.03 by issue 32): the interval's upper bound must be within
+// it (and the control within 1 +- 0.01). scripts/gen_bench_docs.py judges by
+// the same (TEAPOT_TARGETS).
 std::optional<double> target_ratio(const std::string& variant, int stage) {
     const std::string s = stage_names[stage];
     if (s != "command" && s != "submit" && s != "wait") return std::nullopt;
     if (variant == "vkrc-st") return 1.01;
-    if (variant == "vkrc-mt") return 1.03;
+    if (variant == "vkrc-mt") return 1.02;
     return std::nullopt;
 }
 
