@@ -118,7 +118,10 @@ struct UploaderCreateInfo {
 //
 // Destinations must not be in use by the GPU when the batch runs: give
 // submit() the waits that say so (e.g. a graphics ticket), or upload into
-// fresh resources. Downloads read resources whose queue family ownership
+// fresh resources. The copies of one batch have no barrier between them (one
+// per batch keeps a stream of uploads cheap), so they must not overlap: two
+// uploads into the same bytes, or a download of bytes the batch uploads, go
+// in separate batches (submit() between them). Downloads read resources whose queue family ownership
 // is the Uploader's queue's (or that were never used on another family).
 class Uploader : public Handle<detail::UploaderState> {
 public:
