@@ -33,6 +33,12 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 class CommandBufferState;
+
+// An indirect command's stride: stride, or the command's size when stride is 0 (tightly packed).
+template <class Command>
+constexpr std::uint32_t indirect_stride(std::uint32_t stride) noexcept {
+    return stride ? stride : std::uint32_t{sizeof(Command)};
+}
 }  // namespace detail
 
 // A command buffer; keeps its pool alive and returns to it when dropped (once
@@ -262,13 +268,13 @@ public:
                        std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect");
         fn_->vkCmdDrawIndirect(cmd_, buffer, offset, draw_count,
-                               stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+                               detail::indirect_stride<VkDrawIndirectCommand>(stride));
     }
     void draw_indexed_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset, std::uint32_t draw_count,
                                std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect");
         fn_->vkCmdDrawIndexedIndirect(cmd_, buffer, offset, draw_count,
-                                      stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+                                      detail::indirect_stride<VkDrawIndexedIndirectCommand>(stride));
     }
     void dispatch_indirect(Raw<VkBuffer> buffer, VkDeviceSize offset = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::dispatch_indirect");
@@ -281,14 +287,14 @@ public:
                              std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indirect_count");
         fn_->vkCmdDrawIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
-                                    stride ? stride : std::uint32_t{sizeof(VkDrawIndirectCommand)});
+                                    detail::indirect_stride<VkDrawIndirectCommand>(stride));
     }
     void draw_indexed_indirect_count(Raw<VkBuffer> buffer, VkDeviceSize offset, Raw<VkBuffer> count_buffer,
                                      VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                      std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_indexed_indirect_count");
         fn_->vkCmdDrawIndexedIndirectCount(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
-                                           stride ? stride : std::uint32_t{sizeof(VkDrawIndexedIndirectCommand)});
+                                           detail::indirect_stride<VkDrawIndexedIndirectCommand>(stride));
     }
 
     // Mesh shading (VK_EXT_mesh_shader: DeviceCreateInfo::mesh_shader_features)
@@ -304,16 +310,15 @@ public:
                                   std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_mesh_tasks_indirect");
         fn_->vkCmdDrawMeshTasksIndirectEXT(cmd_, buffer, offset, draw_count,
-                                           stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
+                                           detail::indirect_stride<VkDrawMeshTasksIndirectCommandEXT>(stride));
     }
     // The draw count from count_buffer as draw_indirect_count (also needs drawIndirectCount).
     void draw_mesh_tasks_indirect_count(Raw<VkBuffer> buffer, VkDeviceSize offset, Raw<VkBuffer> count_buffer,
                                         VkDeviceSize count_offset, std::uint32_t max_draw_count,
                                         std::uint32_t stride = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::draw_mesh_tasks_indirect_count");
-        fn_->vkCmdDrawMeshTasksIndirectCountEXT(
-            cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
-            stride ? stride : std::uint32_t{sizeof(VkDrawMeshTasksIndirectCommandEXT)});
+        fn_->vkCmdDrawMeshTasksIndirectCountEXT(cmd_, buffer, offset, count_buffer, count_offset, max_draw_count,
+                                                detail::indirect_stride<VkDrawMeshTasksIndirectCommandEXT>(stride));
     }
 
     // Synchronisation (synchronization2)
@@ -432,9 +437,6 @@ public:
     DeviceState& device() const noexcept { return *device_state; }
 };
 
-}  // namespace detail
-
-namespace detail {
 // After a submit that carried them: closes the ONE_TIME_SUBMIT primaries
 // (OpenCommandBuffers), whose held drops then wait for that submission.
 // Inline: a frame's submit closes one command buffer.
