@@ -180,7 +180,7 @@ std::size_t thread_stripe(std::size_t count) noexcept {
 // total cannot be at zero here, and increments need no order (as RefCounted's).
 void ChildCount::add() noexcept {
     if constexpr (!ThreadPolicy::multi_thread) {
-        total_.store(total_.load(__ATOMIC_RELAXED) + 1, __ATOMIC_RELAXED);
+        total_.fetch_add(1);  // a plain word under vkrc::st
     } else {
         auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
         std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
@@ -206,9 +206,7 @@ void ChildCount::add() noexcept {
 // may destroy the device: nothing here touches it after that write.
 bool ChildCount::release() noexcept {
     if constexpr (!ThreadPolicy::multi_thread) {
-        const std::int64_t left = total_.load(__ATOMIC_RELAXED) - 1;
-        total_.store(left, __ATOMIC_RELAXED);
-        return left == 0;
+        return total_.fetch_sub(1) == 1;
     } else {
         auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
         std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
