@@ -53,7 +53,7 @@ VkPhysicalDeviceAccelerationStructurePropertiesKHR structure_properties(const De
 // A buffer for the build's own use, its address aligned to alignment (the
 // buffer is made that much larger); address receives the aligned address.
 Buffer build_buffer(const Device& device, VkDeviceSize size, VkBufferUsageFlags usage, MemoryUsage memory,
-                    const SharedAllocator& allocator, VkDeviceSize alignment, VkDeviceAddress& address) {
+                    AllocatorView allocator, VkDeviceSize alignment, VkDeviceAddress& address) {
     const VkDeviceSize slack = alignment > 1 ? alignment - 1 : 0;
     Buffer buffer = Buffer::create(device, {.size = size + slack,
                                             .usage = usage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
@@ -111,7 +111,7 @@ namespace {
 
 // A structure of type and size over a buffer of its own.
 AccelerationStructure structure_of(const Device& device, VkAccelerationStructureTypeKHR type, VkDeviceSize size,
-                                   const SharedAllocator& allocator) {
+                                   AllocatorView allocator) {
     Buffer storage = Buffer::create(device, {.size = size,
                                              .usage = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR |
                                                       VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
@@ -266,7 +266,7 @@ const Device& structure_device(const detail::Caller& caller, const CommandBuffer
 AccelerationStructure record_build(const detail::Caller& caller, const CommandBuffer& cmd,
                                    VkAccelerationStructureBuildGeometryInfoKHR build, const std::uint32_t* counts,
                                    const VkAccelerationStructureBuildRangeInfoKHR* ranges, AccelerationStructure dst,
-                                   const SharedAllocator& allocator) {
+                                   AllocatorView allocator) {
     const Device& device = cmd.pool().device();
     const auto& fn = device.fn();
     VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
@@ -407,7 +407,7 @@ void rebuild_top_level(const CommandBuffer& cmd, const AccelerationStructure& to
 }
 
 AccelerationStructure compact(const CommandBuffer& cmd, const AccelerationStructure& source,
-                              VkDeviceSize compacted_size, const SharedAllocator& allocator) {
+                              VkDeviceSize compacted_size, AllocatorView allocator) {
     const detail::Caller caller{"vkrc::compact"};
     const Device& device = structure_device(caller, cmd, source, VK_ACCELERATION_STRUCTURE_TYPE_MAX_ENUM_KHR);
     caller.require(source.build_flags() & VK_BUILD_ACCELERATION_STRUCTURE_ALLOW_COMPACTION_BIT_KHR,

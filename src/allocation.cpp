@@ -74,14 +74,13 @@ void AllocationState::on_last_release() noexcept {
 
 }  // namespace detail
 
-Allocation Allocation::create(const Device& device, const AllocationRequest& request,
-                              const SharedAllocator& allocator) {
+Allocation Allocation::create(const Device& device, const AllocationRequest& request, AllocatorView allocator) {
     const detail::Caller caller{"vkrc::Allocation::create"};
     caller.require_handle(device, "the Device");
     auto& s = *device.state();
     DeviceAllocator* a = allocator.get();
     if (a) {
-        s.keep_allocator(allocator);
+        s.keep_allocator(a);
     } else {
         a = &s.default_allocator();
     }

@@ -123,16 +123,16 @@ bool AllocatorRegistry::kept_recently(const DeviceAllocator* allocator) const no
     return false;
 }
 
-void AllocatorRegistry::keep(const Ref<DeviceAllocator>& allocator) {
-    if (kept_recently(allocator.get())) return;
+void AllocatorRegistry::keep(DeviceAllocator* allocator) {
+    if (kept_recently(allocator)) return;
     LockGuard lock(mutex_);
-    auto same = [&](const Ref<DeviceAllocator>& a) { return a.get() == allocator.get(); };
+    auto same = [&](const Ref<DeviceAllocator>& a) { return a.get() == allocator; };
     if (std::find_if(allocators_.begin(), allocators_.end(), same) == allocators_.end()) {
-        allocators_.push_back(allocator);
+        allocators_.push_back(Ref<DeviceAllocator>::share(allocator));
     }
     const std::size_t n = recent_count_.load(__ATOMIC_RELAXED);
-    if (n < recent_slots && !kept_recently(allocator.get())) {
-        recent_[n].store(allocator.get(), __ATOMIC_RELAXED);
+    if (n < recent_slots && !kept_recently(allocator)) {
+        recent_[n].store(allocator, __ATOMIC_RELAXED);
         recent_count_.store(n + 1, __ATOMIC_RELEASE);
     }
 }

@@ -89,7 +89,7 @@ namespace {
 // allocator, and the bind. request carries the intent and placement.
 template <class State, class CreateInfo>
 void create_bound(const Device& device, const CreateInfo& ci, State& state, AllocationRequest request,
-                  const SharedAllocator& allocator) {
+                  AllocatorView allocator) {
     constexpr bool is_buffer = std::is_same_v<State, detail::BufferState>;
     const auto& fn = device.fn();
     VkMemoryDedicatedRequirements dedicated{VK_STRUCTURE_TYPE_MEMORY_DEDICATED_REQUIREMENTS};

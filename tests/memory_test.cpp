@@ -16,6 +16,7 @@
 #include <span>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace {
@@ -368,6 +369,23 @@ TEST_P(AllocatorTest, DeviceReleasesItsAllocatorsAtTeardown) {
     EXPECT_TRUE(buffer);
     buffer.reset();  // the last handle: the device goes, after its deferred frees
     EXPECT_EQ(observer->use_count(), 1u);
+}
+
+// A create-info names its allocator through a view: naming one shared by
+// every thread writes no reference count on it (the contention benchmark's
+// buffer-pool case); the device keeps it from its first use.
+TEST_P(AllocatorTest, CreateInfosNameTheAllocatorWithoutCountingIt) {
+    static_assert(std::is_convertible_v<const vkrc::SharedAllocator&, vkrc::AllocatorView>);
+    static_assert(!std::is_convertible_v<vkrc::SharedAllocator&&, vkrc::AllocatorView>,
+                  "a view of a temporary would dangle in a create-info kept past the statement");
+    EXPECT_EQ(allocator->use_count(), 1u);
+    auto first = make_buffer(256, vkrc::MemoryUsage::gpu_only);
+    EXPECT_EQ(allocator->use_count(), 2u) << "the device keeps the allocator from its first use";
+    const vkrc::BufferCreateInfo info{.size = 256, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, .allocator = allocator};
+    EXPECT_EQ(allocator->use_count(), 2u) << "the create-info owns no reference";
+    auto second = vkrc::Buffer::create(device, info);
+    EXPECT_EQ(second.allocation().info().allocator, allocator.get());
+    EXPECT_EQ(allocator->use_count(), 2u);
 }
 
 TEST_P(AllocatorTest, StatisticsAndBudget) {

@@ -228,7 +228,7 @@ protected:
                     {triangles_group, std::as_bytes(std::span(&tags[1], 1))},
                     {spheres_group, std::as_bytes(std::span(&sphere_record, 1))}};
         info.callable = {{callable_group, std::as_bytes(std::span(&callable_bits, 1))}};
-        info.allocator = std::move(allocator);
+        info.allocator = allocator;
         return vkrc::ShaderBindingTable::create(pipeline, info);
     }
 

@@ -111,8 +111,9 @@ struct BottomLevelBuildInfo {
     List<AabbGeometry> aabbs{};
     // PREFER_FAST_TRACE by default; ALLOW_UPDATE to refit later with update_bottom_level.
     VkBuildAccelerationStructureFlagsKHR flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-    // Where the structure's buffer and the scratch come from (null: the device's default).
-    SharedAllocator allocator{};
+    // Where the structure's buffer and the scratch come from (null: the device's
+    // default). Must outlive the build call; the Device keeps it from then on.
+    AllocatorView allocator{};
 };
 
 // One instance of a top-level build (VkAccelerationStructureInstanceKHR).
@@ -136,8 +137,9 @@ struct TopLevelBuildInfo {
     // Required, not empty.
     List<AccelerationStructureInstance> instances{};
     VkBuildAccelerationStructureFlagsKHR flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-    // Where the structure's buffer, the scratch and the instance buffer come from.
-    SharedAllocator allocator{};
+    // Where the structure's buffer, the scratch and the instance buffer come from
+    // (null: the device's default). Must outlive the build call.
+    AllocatorView allocator{};
 };
 
 // The build helpers query the build sizes, make the structure (over a
@@ -172,7 +174,7 @@ void update_bottom_level(const CommandBuffer& cmd, const AccelerationStructure& 
 // copy keeps the same bottom levels. The caller records the barrier from
 // source's build before, as for any read of it.
 AccelerationStructure compact(const CommandBuffer& cmd, const AccelerationStructure& source,
-                              VkDeviceSize compacted_size, const SharedAllocator& allocator = {});
+                              VkDeviceSize compacted_size, AllocatorView allocator = {});
 
 namespace detail {
 

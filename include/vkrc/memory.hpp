@@ -137,6 +137,28 @@ public:
 // Shared ownership of an allocator; empty means the device's default.
 using SharedAllocator = detail::Ref<DeviceAllocator>;
 
+// Names the allocator of one create call without owning it (empty: the
+// device's default). The caller's SharedAllocator keeps it alive through the
+// call and the device keeps it from then on, so naming a shared allocator
+// writes no reference count: a count that every creating thread increments
+// is one cache line they all contend for. Made from a named SharedAllocator
+// only: one made from a temporary would dangle in a create-info kept past
+// the statement.
+class AllocatorView {
+public:
+    AllocatorView() noexcept = default;
+    AllocatorView(std::nullptr_t) noexcept {}
+    template <class A>
+    AllocatorView(const detail::Ref<A>& allocator) noexcept : p_(allocator.get()) {}
+    template <class A>
+    AllocatorView(detail::Ref<A>&&) = delete;
+    DeviceAllocator* get() const noexcept { return p_; }
+    explicit operator bool() const noexcept { return p_ != nullptr; }
+
+private:
+    DeviceAllocator* p_ = nullptr;
+};
+
 // Makes an allocator of type A, owned by the returned reference (which
 // converts to SharedAllocator).
 template <class A, class... Args>
@@ -384,8 +406,7 @@ private:
 class Allocation : public Handle<detail::AllocationState>, public detail::MappedWrites<Allocation> {
 public:
     // Allocates for request from allocator (null: the device's default).
-    static Allocation create(const Device& device, const AllocationRequest& request,
-                             const SharedAllocator& allocator = {});
+    static Allocation create(const Device& device, const AllocationRequest& request, AllocatorView allocator = {});
 
     const AllocationInfo& info() const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::Allocation::info");

@@ -123,7 +123,8 @@ struct ShaderBindingTableCreateInfo {
     List<ShaderRecord> hit{};
     List<ShaderRecord> callable{};
     // Optional (null: the device's default): where the table's buffer comes from.
-    SharedAllocator allocator{};
+    // Must outlive create().
+    AllocatorView allocator{};
 };
 
 // A shader binding table: one host-visible buffer (SHADER_BINDING_TABLE and

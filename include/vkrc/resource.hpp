@@ -33,8 +33,9 @@ struct BufferCreateInfo {
     List<std::uint32_t> queue_family_indices{};
     // Optional (default: GPU-only memory).
     MemoryIntent memory{};
-    // Null: the device's default allocator (a PoolAllocator). The Device keeps it alive once used.
-    SharedAllocator allocator{};
+    // Optional (null: the device's default PoolAllocator). Must outlive create();
+    // the Device keeps it alive from then on.
+    AllocatorView allocator{};
     // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };
@@ -92,8 +93,9 @@ struct ImageCreateInfo {
     VkImageLayout initial_layout = VK_IMAGE_LAYOUT_UNDEFINED;
     // Optional (default: GPU-only memory). Ignored by adopt().
     MemoryIntent memory{};
-    // Null: the device's default allocator. The Device keeps it alive once used. Ignored by adopt().
-    SharedAllocator allocator{};
+    // Optional (null: the device's default allocator). Must outlive create();
+    // the Device keeps it alive from then on. Ignored by adopt().
+    AllocatorView allocator{};
     // Optional pNext chain. Read during create(); need not outlive the call.
     const void* next = nullptr;
 };

@@ -210,8 +210,8 @@ public:
     ~AllocatorRegistry();
     // The device's default allocator, a PoolAllocator made on first use.
     DeviceAllocator& default_allocator();
-    // Keeps allocator until release_all (once per allocator).
-    void keep(const Ref<DeviceAllocator>& allocator);
+    // Takes a reference to allocator, kept until release_all (once per allocator).
+    void keep(DeviceAllocator* allocator);
     // Calls each allocator's release() and drops them; teardown, after every deferred free ran.
     void release_all(DeviceState& device) noexcept;
 
@@ -312,7 +312,7 @@ public:
     // The device's default allocator, a PoolAllocator made on first use.
     DeviceAllocator& default_allocator() { return allocators.default_allocator(); }
     // Keeps allocator until teardown, so that deferred frees still reach it.
-    void keep_allocator(const Ref<DeviceAllocator>& allocator) { allocators.keep(allocator); }
+    void keep_allocator(DeviceAllocator* allocator) { allocators.keep(allocator); }
 
     // ---- Results and device loss
     // Marks the device lost: the GPU will touch nothing any more, so every
