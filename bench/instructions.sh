@@ -46,50 +46,16 @@ device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
   echo "# git: $(bench_revision "$(dirname "$teapot")/..")"
   echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$(dirname "$teapot")/../CMakeCache.txt" | cut -d= -f2 || true)"
 } >"$dumps/header"
-python3 - "$dumps" "$csv" <<'PY'
-import glob, os, re, sys
+python3 - "$dumps" "$csv" "$source_dir/bench" <<'PY'
+import glob, os, sys
 dumps, csv = sys.argv[1], sys.argv[2]
-# The driver: the ICD and what it links (lavapipe's LLVM and gallium, GPU
-# vendors' user-mode drivers). Calls from any other object into one of them
-# are the driver's work; their inclusive cost is subtracted to give the
-# instructions outside the driver (application, wrapper, loader, libc).
-DRIVER = re.compile(r"libvulkan_|libLLVM|libgallium|libnvidia|libdrm|libamdgpu|libGLX_nvidia|lvp|radv|anv")
+sys.path.insert(0, sys.argv[3])
+from callgrind_dump import read_dump
 rows = {}
 for path in glob.glob(os.path.join(dumps, "callgrind.out*")):
-    desc, total, driver = None, None, 0
-    names, ob, cob, call_target = {}, None, None, None
-    with open(path, errors="replace") as f:
-        for line in f:
-            m = re.match(r"desc: Trigger: Client Request: teapot (.*)", line)
-            if m:
-                desc = dict(kv.split("=", 1) for kv in m.group(1).split())
-            m = re.match(r"(?:summary|totals): (\d+)", line)
-            if m:
-                total = int(m.group(1))
-            m = re.match(r"(c?ob)=(?:\((\d+)\))?\s*(.*)", line)
-            if m:
-                key, ident, name = m.group(1), m.group(2), m.group(3).strip()
-                if ident and name:
-                    names[ident] = name
-                obj = names.get(ident, name) if ident else name
-                if key == "ob":
-                    ob, cob = obj, None
-                else:
-                    cob = obj
-                continue
-            if line.startswith("calls="):
-                call_target = cob if cob is not None else ob
-                cob = None
-                continue
-            if call_target is not None and re.match(r"[+\-*\d]", line):
-                cost = int(line.split()[1]) if len(line.split()) > 1 else 0
-                if DRIVER.search(call_target or "") and not DRIVER.search(ob or ""):
-                    driver += cost
-                call_target = None
-            elif line.startswith(("fn=", "cfn=", "cfi=", "cfl=")) and line.startswith("fn="):
-                cob = None
+    desc, total, outside = read_dump(path, "teapot ")
     if desc and total is not None:
-        rows[(desc["variant"], desc["stage"])] = (int(desc["calls"]), total, total - driver)
+        rows[(desc["variant"], desc["stage"])] = (int(desc["calls"]), total, outside)
 if not rows:
     sys.exit("instructions.sh: FAILED: no per-stage dumps (teapot built without valgrind/callgrind.h?)")
 order = ["acquire", "uniform", "command", "submit", "present", "wait", "update"]

@@ -31,8 +31,17 @@
 // block-to-block noise). Run several processes (bench/contention_run.sh) so
 // that the intervals include the spread between runs.
 //
+// --instructions N instead counts, on one thread, the instructions of each
+// case's first N operations after a warm-up one: each case is collected
+// alone under callgrind and dumped (bench/contention_instructions.sh), so
+// that the per-object cost of either policy is a deterministic count. The
+// target contention_st is this program under vkrc::st, for that mode.
+//
 // Usage: contention [--threads 1,2,4,8,16] [--blocks N] [--ms N] [--cases a,b,...] [--csv PATH]
+//                   [--instructions N]
 #include <vkrc/vkrc.hpp>
+
+#include <valgrind/callgrind.h>
 
 #include <algorithm>
 #include <atomic>
@@ -344,6 +353,22 @@ Shared make_shared_state(const vkrc::Device& device, unsigned max_threads) {
     return s;
 }
 
+// --instructions: each case's operations on one thread, collected alone.
+void count_instructions(const std::vector<Case>& cases, const Shared& s, std::size_t operations) {
+    for (const Case& c : cases) {
+        Step step = c.make(s, 0);
+        step();  // first use (a pool's first block) is not the per-object cost
+        std::size_t done = 0;
+        CALLGRIND_ZERO_STATS;
+        CALLGRIND_TOGGLE_COLLECT;
+        while (done < operations) done += step();
+        CALLGRIND_TOGGLE_COLLECT;
+        const std::string label = std::string("case=") + c.name + " operations=" + std::to_string(done);
+        CALLGRIND_DUMP_STATS_AT(label.c_str());
+        std::printf("%s: %zu operations counted\n", c.name, done);
+    }
+}
+
 struct Row {
     std::string name;
     unsigned threads = 0;
@@ -407,7 +432,8 @@ void write_csv(const std::string& path, const std::vector<Row>& rows) {
 
 [[noreturn]] void usage() {
     std::fprintf(stderr,
-                 "usage: contention [--threads 1,2,4,8,16] [--blocks N] [--ms N] [--cases a,b,...] [--csv PATH]\n");
+                 "usage: contention [--threads 1,2,4,8,16] [--blocks N] [--ms N] [--cases a,b,...] [--csv PATH]"
+                 " [--instructions N]\n");
     std::exit(2);
 }
 
@@ -429,7 +455,7 @@ std::vector<std::string> split(const std::string& text) {
 
 int main(int argc, char** argv) try {
     std::vector<unsigned> threads{1, 2, 4, 8, 16};
-    unsigned blocks = 5, block_ms = 50;
+    unsigned blocks = 5, block_ms = 50, instructions = 0;
     std::vector<std::string> names;
     std::string csv;
     for (int i = 1; i < argc; ++i) {
@@ -443,6 +469,7 @@ int main(int argc, char** argv) try {
         else if (a == "--ms") block_ms = parse_count(v);
         else if (a == "--cases") names = split(v);
         else if (a == "--csv") csv = v;
+        else if (a == "--instructions") instructions = parse_count(v);
         else usage();
     }
     if (threads.empty()) usage();
@@ -464,6 +491,11 @@ int main(int argc, char** argv) try {
     auto physical = vkrc::PhysicalDevice::select(instance);
     const Shared shared =
         make_shared_state(vkrc::Device::create(physical), *std::max_element(threads.begin(), threads.end()));
+    if (instructions) {
+        std::printf("device: %s; %u operations per case counted on one thread\n", physical.name(), instructions);
+        count_instructions(cases, shared, instructions);
+        return 0;
+    }
     std::printf("device: %s; %u hardware threads; %u blocks of %u ms per case and thread count\n", physical.name(),
                 std::thread::hardware_concurrency(), blocks, block_ms);
 
