@@ -149,9 +149,10 @@ DeviceLink::DeviceLink(const Device& device) noexcept : view_(device.state()) {
 }
 DeviceLink::DeviceLink(DeviceLink&& other) noexcept : view_(other.view_.take()) {}
 DeviceLink& DeviceLink::operator=(const Device& device) noexcept {
-    DeviceLink link(device);
+    DeviceState* s = device.state();
+    if (s) s->add_child();  // first: device may be the one this link holds
     DeviceState* old = view_.take();
-    view_.set(link.view_.take());
+    view_.set(s);
     if (old) old->release_child();
     return *this;
 }
@@ -178,24 +179,20 @@ std::size_t thread_stripe(std::size_t count) noexcept {
 
 // A new reference comes from an existing one (a handle or a child), so the
 // total cannot be at zero here, and increments need no order (as RefCounted's).
-void ChildCount::add() noexcept {
-    if constexpr (!ThreadPolicy::multi_thread) {
-        total_.fetch_add(1);  // a plain word under vkrc::st
-    } else {
-        auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
-        std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
-        while (credits > 0) {
-            if (stripe.compare_exchange_weak(credits, credits - 1, __ATOMIC_RELAXED)) return;
-        }
-        if (is_dead(credits)) {
-            total_.fetch_add(1, __ATOMIC_RELAXED);
-            return;
-        }
-        // None left: a batch from the total, one for this reference.
-        total_.fetch_add(credit_batch, __ATOMIC_RELAXED);
-        if (is_dead(stripe.fetch_add(credit_batch - 1, __ATOMIC_RELAXED))) {
-            total_.fetch_sub(credit_batch - 1, __ATOMIC_RELAXED);  // drained meanwhile: this one's stays
-        }
+void ChildCount::add_striped() noexcept {
+    auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
+    std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
+    while (credits > 0) {
+        if (stripe.compare_exchange_weak(credits, credits - 1, __ATOMIC_RELAXED)) return;
+    }
+    if (is_dead(credits)) {
+        total_.fetch_add(1, __ATOMIC_RELAXED);
+        return;
+    }
+    // None left: a batch from the total, one for this reference.
+    total_.fetch_add(credit_batch, __ATOMIC_RELAXED);
+    if (is_dead(stripe.fetch_add(credit_batch - 1, __ATOMIC_RELAXED))) {
+        total_.fetch_sub(credit_batch - 1, __ATOMIC_RELAXED);  // drained meanwhile: this one's stays
     }
 }
 
@@ -204,21 +201,17 @@ void ChildCount::add() noexcept {
 // gives up this reference in its one last write (a return to a live stripe
 // is counted by release_handles when it drains), after which another thread
 // may destroy the device: nothing here touches it after that write.
-bool ChildCount::release() noexcept {
-    if constexpr (!ThreadPolicy::multi_thread) {
-        return total_.fetch_sub(1) == 1;
-    } else {
-        auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
-        std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
-        for (;;) {
-            if (is_dead(credits)) return total_.fetch_sub(1, __ATOMIC_ACQ_REL) == 1;
-            // Past two batches, one goes back with this reference, so that a
-            // thread that only drops holds few credits.
-            const bool surplus = credits >= 2 * credit_batch;
-            const std::int64_t next = surplus ? credits + 1 - credit_batch : credits + 1;
-            if (stripe.compare_exchange_weak(credits, next, __ATOMIC_ACQ_REL)) {
-                return surplus && total_.fetch_sub(credit_batch, __ATOMIC_ACQ_REL) == credit_batch;
-            }
+bool ChildCount::release_striped() noexcept {
+    auto& stripe = stripes_[thread_stripe(stripe_count)].credits;
+    std::int64_t credits = stripe.load(__ATOMIC_RELAXED);
+    for (;;) {
+        if (is_dead(credits)) return total_.fetch_sub(1, __ATOMIC_ACQ_REL) == 1;
+        // Past two batches, one goes back with this reference, so that a
+        // thread that only drops holds few credits.
+        const bool surplus = credits >= 2 * credit_batch;
+        const std::int64_t next = surplus ? credits + 1 - credit_batch : credits + 1;
+        if (stripe.compare_exchange_weak(credits, next, __ATOMIC_ACQ_REL)) {
+            return surplus && total_.fetch_sub(credit_batch, __ATOMIC_ACQ_REL) == credit_batch;
         }
     }
 }

@@ -1,11 +1,15 @@
 // The reference-counting core, independent of Vulkan.
 #include <vkrc/handle.hpp>
 #include <vkrc/detail/list.hpp>
+#include <vkrc/detail/object_registry.hpp>
 #include <vkrc/detail/span.hpp>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cstdint>
+#include <random>
 #include <span>
 #include <thread>
 #include <type_traits>
@@ -185,3 +189,37 @@ TEST(Raw, ReadsTheWrappersHandle) {
 }
 
 }  // namespace
+
+// The descriptor-reference registry's table through collisions, growth and
+// removals in any order: every live handle finds its object, no removed one
+// does; a remove naming another object (a later adoption of the same handle
+// replaced it) leaves the entry.
+TEST(ObjectRegistry, FindsEveryLiveHandleThroughCollisionsGrowthAndRemovals) {
+    using vkrc::detail::DescribedKind;
+    vkrc::detail::ObjectRegistry registry;
+    std::vector<vkrc::detail::Ref<Counted>> objects;
+    std::vector<std::uint64_t> bits;
+    for (std::uint64_t i = 1; i <= 3000; ++i) {
+        objects.emplace_back(new Counted);
+        // Aligned pointers and dispatchable-style handles: alike in most bits.
+        bits.push_back(i % 2 ? 0x7f0000000000ull + i * 64 : i << 32);
+        registry.add(DescribedKind::buffer, bits.back(), objects.back().get());
+    }
+    std::vector<std::size_t> order(objects.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), std::mt19937(7));
+    std::vector<bool> live(objects.size(), true);
+    for (std::size_t k = 0; k < order.size() / 2; ++k) {
+        const std::size_t i = order[k];
+        registry.remove(DescribedKind::buffer, bits[i], objects[(i + 1) % objects.size()].get());  // not its object
+        registry.remove(DescribedKind::buffer, bits[i], objects[i].get());
+        live[i] = false;
+    }
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const auto found = registry.find(DescribedKind::buffer, bits[i]);
+        EXPECT_EQ(found.get(), live[i] ? objects[i].get() : nullptr) << "handle " << i;
+        EXPECT_FALSE(registry.find(DescribedKind::image_view, bits[i])) << "another kind's table";
+    }
+    registry.add(DescribedKind::buffer, bits[order[0]], objects[0].get());  // re-added after its removal
+    EXPECT_EQ(registry.find(DescribedKind::buffer, bits[order[0]]).get(), objects[0].get());
+}

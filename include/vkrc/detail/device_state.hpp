@@ -239,15 +239,31 @@ private:
 // so that the drop that takes it to zero is exact.
 class ChildCount {
 public:
-    void add() noexcept;
+    // Inline under vkrc::st, where each is one plain add: a child's
+    // creation and drop pay no call for it.
+    void add() noexcept {
+        if constexpr (ThreadPolicy::multi_thread) {
+            add_striped();
+        } else {
+            total_.fetch_add(1);
+        }
+    }
     // True when the total reached zero: the caller destroys the device.
-    [[nodiscard]] bool release() noexcept;
+    [[nodiscard]] bool release() noexcept {
+        if constexpr (ThreadPolicy::multi_thread) {
+            return release_striped();
+        } else {
+            return total_.fetch_sub(1) == 1;
+        }
+    }
     // The handles' share, given back by their last one and taken again by a
     // handle made from a child's device() after that.
     void add_handles() noexcept { total_.fetch_add(1, __ATOMIC_RELAXED); }
     [[nodiscard]] bool release_handles() noexcept;
 
 private:
+    void add_striped() noexcept;
+    bool release_striped() noexcept;
     static constexpr std::size_t stripe_count = ThreadPolicy::multi_thread ? 64 : 1;
     struct alignas(64) Stripe {  // apart in cache: threads on different stripes share no line
         PolicyAtomic<std::int64_t> credits{0};
