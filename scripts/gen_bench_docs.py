@@ -1186,6 +1186,38 @@ def descriptors_section(pending):
     return out[:-1]
 
 
+def objects_section(pending):
+    """bench/contention_instructions.sh runs: instructions per create + drop on one thread, per policy, the
+    runs side by side in path order (the first: the baseline they are compared with), outside the driver
+    (what vkrc and the allocator execute) with the total beside it."""
+    found = sorted((load(p) for p in glob.glob(os.path.join(ROOT, "docs/results/*-objects.csv"))),
+                   key=lambda r: r["path"])
+    if not found:
+        return [pending]
+    out = []
+    for i, r in enumerate(found):
+        out += [f"Run {i + 1}: {run_line(r)}", ""]
+    out += ["Instructions per operation outside the driver (total with the driver in parentheses); the "
+            f"last column: the last run against run 1.", "",
+            "| case | policy | " + " | ".join(f"run {i + 1} ({r['meta'].get('git', '?')})"
+                                             for i, r in enumerate(found)) + " | last - run 1 |",
+            "|---|---|" + "---:|" * (len(found) + 1)]
+    keys = []
+    for r in found:
+        for x in r["rows"]:
+            if (x["case"], x["policy"]) not in keys:
+                keys.append((x["case"], x["policy"]))
+    def count(v):  # a handle copy costs about ten: keep its decimal
+        return f"{float(v):.1f}" if float(v) < 100 else thousands(v)
+    for case, policy in sorted(keys, key=lambda k: (k[1] != "st", k[0])):
+        cells = [next((x for x in r["rows"] if x["case"] == case and x["policy"] == policy), None) for r in found]
+        text = [f"{count(c['outside_driver_per_op'])} ({count(c['instructions_per_op'])})" if c else "" for c in cells]
+        delta = (f"{float(cells[-1]['outside_driver_per_op']) - float(cells[0]['outside_driver_per_op']):+.1f}"
+                 if cells[0] and cells[-1] else "")
+        out.append(f"| {case} | {policy} | " + " | ".join(text) + f" | {delta} |")
+    return out
+
+
 def raytrace_rows(rows, path):
     return [x for x in rows if x["path"] == path]
 
@@ -1224,6 +1256,7 @@ def raytrace_section(pending):
 BLOCKS = {
     "raytrace": lambda: raytrace_section("No examples/raytrace results in docs/results/ yet."),
     "descriptors": lambda: descriptors_section("No descriptor-write results in docs/results/ yet."),
+    "objects": lambda: objects_section("No per-object instruction counts in docs/results/ yet."),
     "upload-lavapipe": lambda: upload_section("llvmpipe", "No lavapipe upload results in docs/results/ yet."),
     "upload-h200": lambda: upload_section(
         "H200", "**Pending:** no H200 upload run is committed yet. `bench/upload_run.sh BUILD_DIR OUT NAME` on the "
