@@ -256,13 +256,47 @@ void check_image_usage(const detail::Caller& caller, const Device& device, const
                    " needs the shaderStorageImageMultisample feature enabled");
 }
 
+// vkGetPhysicalDeviceImageFormatProperties for info's combination. It answers
+// the same for the same arguments, and a program makes many images of few
+// kinds, so each thread keeps the last few answers (no lock), keyed by the
+// device's id: creation pays the query, which costs more than all of vkrc's
+// own per-image work, once per kind rather than per image.
+VkResult image_format_properties(const Device& device, const ImageCreateInfo& info, VkImageFormatProperties& p) {
+    struct Answer {
+        std::uint64_t device_id = 0;  // 0: empty
+        VkFormat format{};
+        VkImageType type{};
+        VkImageTiling tiling{};
+        VkImageUsageFlags usage = 0;
+        VkImageCreateFlags flags = 0;
+        VkResult result{};
+        VkImageFormatProperties properties{};
+    };
+    constexpr std::size_t kept = 4;
+    thread_local Answer answers[kept];
+    thread_local std::size_t next = 0;
+    const std::uint64_t id = device.state()->id;
+    for (const Answer& a : answers) {
+        if (a.device_id == id && a.format == info.format && a.type == info.image_type && a.tiling == info.tiling &&
+            a.usage == info.usage && a.flags == info.flags) {
+            p = a.properties;
+            return a.result;
+        }
+    }
+    const PhysicalDevice& physical = device.physical_device();
+    const VkResult r = physical.fn().vkGetPhysicalDeviceImageFormatProperties(
+        physical.vk(), info.format, info.image_type, info.tiling, info.usage, info.flags, &p);
+    if (r == VK_SUCCESS || r == VK_ERROR_FORMAT_NOT_SUPPORTED) {  // answers; an out-of-memory is not one
+        answers[next++ % kept] = {id, info.format, info.image_type, info.tiling, info.usage, info.flags, r, p};
+    }
+    return r;
+}
+
 // What vkGetPhysicalDeviceImageFormatProperties allows for the image: the
 // combination at all, then extent, levels, layers and samples.
 void check_image_format(const detail::Caller& caller, const Device& device, const ImageCreateInfo& info) {
-    const PhysicalDevice& physical = device.physical_device();
     VkImageFormatProperties p{};
-    const VkResult r = physical.fn().vkGetPhysicalDeviceImageFormatProperties(
-        physical.vk(), info.format, info.image_type, info.tiling, info.usage, info.flags, &p);
+    const VkResult r = image_format_properties(device, info, p);
     caller.require(r != VK_ERROR_FORMAT_NOT_SUPPORTED, "format ", info.format, " as a ", info.image_type, " with ",
                    info.tiling, ", usage ", detail::Hex{info.usage}, " and flags ", detail::Hex{info.flags},
                    " is not supported by the device (vkGetPhysicalDeviceImageFormatProperties)");

@@ -252,6 +252,43 @@ TEST_F(VulkanTest, PushConstantsOutsideTheLayoutsRangesAreRejected) {
 
 // What the device's limits, features and format properties rule out is
 // refused at creation, naming the value and the limit (docs/validation.md).
+int format_queries = 0;
+PFN_vkGetPhysicalDeviceImageFormatProperties real_format_query = nullptr;
+VKAPI_ATTR VkResult VKAPI_CALL counting_format_query(VkPhysicalDevice physical, VkFormat format, VkImageType type,
+                                                     VkImageTiling tiling, VkImageUsageFlags usage,
+                                                     VkImageCreateFlags flags, VkImageFormatProperties* properties) {
+    ++format_queries;
+    return real_format_query(physical, format, type, tiling, usage, flags, properties);
+}
+
+// vkGetPhysicalDeviceImageFormatProperties answers the same for the same
+// arguments: Image::create asks once per device and kind of image (on each
+// thread), and still refuses an unsupported kind every time.
+TEST_F(VulkanTest, ImageCreationQueriesTheFormatOncePerDeviceAndKind) {
+    auto& fn = instance.state()->fn;
+    real_format_query = fn.vkGetPhysicalDeviceImageFormatProperties;
+    fn.vkGetPhysicalDeviceImageFormatProperties = counting_format_query;
+    struct Restore {
+        vkrc::InstanceFunctions& fn;
+        ~Restore() { fn.vkGetPhysicalDeviceImageFormatProperties = real_format_query; }
+    } restore{fn};
+    format_queries = 0;
+    const vkrc::ImageCreateInfo sampled{
+        .format = VK_FORMAT_R8G8B8A8_UNORM, .extent = {64, 64, 1}, .usage = VK_IMAGE_USAGE_SAMPLED_BIT};
+    for (int i = 0; i < 3; ++i) vkrc::Image::create(device, sampled);
+    EXPECT_EQ(format_queries, 1);
+    vkrc::ImageCreateInfo unsupported = sampled;
+    unsupported.format = VK_FORMAT_BC1_RGB_UNORM_BLOCK;  // never a colour attachment
+    unsupported.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+    for (int i = 0; i < 2; ++i) {
+        expect_usage_error([&] { vkrc::Image::create(device, unsupported); }, {"is not supported by the device"});
+    }
+    EXPECT_EQ(format_queries, 2);
+    const auto other = vkrc::Device::create(physical_device);  // another device asks again
+    vkrc::Image::create(other, sampled);
+    EXPECT_EQ(format_queries, 3);
+}
+
 TEST_F(VulkanTest, CreationRespectsTheDevicesLimitsFeaturesAndFormats) {
     vkrc::ImageCreateInfo image{.format = VK_FORMAT_R8G8B8A8_UNORM,
                                 .extent = {1024, 1024, 1},

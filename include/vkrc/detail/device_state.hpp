@@ -275,6 +275,8 @@ private:
 // The device's machinery, through named operations: the other layers call
 // these, never the parts (commands, deferred, allocators) directly.
 class DeviceState final : public RefCounted {
+    inline static Atomic<std::uint64_t> next_id{0};  // process-wide: atomic under both policies
+
 public:
     ~DeviceState() override;
 
@@ -401,6 +403,9 @@ public:
     bool idle_now() noexcept;
 
     VkDevice device = VK_NULL_HANDLE;
+    // Unique in the process (an address may be reused by a later device):
+    // keys what a thread caches about this device (resource.cpp's format queries).
+    const std::uint64_t id = next_id.fetch_add(1, __ATOMIC_RELAXED) + 1;
     DeviceFunctions fn;
     // Loaded by the first Device::ext_fn() (src/extension_functions.cpp).
     PolicyAtomic<DeviceExtensionFunctions*> ext_fn{nullptr};
