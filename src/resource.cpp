@@ -262,33 +262,35 @@ void check_image_usage(const detail::Caller& caller, const Device& device, const
 // device's id: creation pays the query, which costs more than all of vkrc's
 // own per-image work, once per kind rather than per image.
 VkResult image_format_properties(const Device& device, const ImageCreateInfo& info, VkImageFormatProperties& p) {
-    struct Answer {
-        std::uint64_t device_id = 0;  // 0: empty
+    struct Question {
+        std::uint64_t device_id = 0;  // 0: an empty slot
         VkFormat format{};
         VkImageType type{};
         VkImageTiling tiling{};
         VkImageUsageFlags usage = 0;
         VkImageCreateFlags flags = 0;
+        bool operator==(const Question&) const = default;
+    };
+    struct Answer {
+        Question question;
         VkResult result{};
         VkImageFormatProperties properties{};
     };
     constexpr std::size_t kept = 4;
     thread_local Answer answers[kept];
     thread_local std::size_t next = 0;
-    const std::uint64_t id = device.state()->id;
+    const Question q{device.state()->id, info.format, info.image_type, info.tiling, info.usage, info.flags};
     for (const Answer& a : answers) {
-        if (a.device_id == id && a.format == info.format && a.type == info.image_type && a.tiling == info.tiling &&
-            a.usage == info.usage && a.flags == info.flags) {
+        if (a.question == q) {
             p = a.properties;
             return a.result;
         }
     }
     const PhysicalDevice& physical = device.physical_device();
-    const VkResult r = physical.fn().vkGetPhysicalDeviceImageFormatProperties(
-        physical.vk(), info.format, info.image_type, info.tiling, info.usage, info.flags, &p);
-    if (r == VK_SUCCESS || r == VK_ERROR_FORMAT_NOT_SUPPORTED) {  // answers; an out-of-memory is not one
-        answers[next++ % kept] = {id, info.format, info.image_type, info.tiling, info.usage, info.flags, r, p};
-    }
+    const VkResult r = physical.fn().vkGetPhysicalDeviceImageFormatProperties(physical.vk(), q.format, q.type, q.tiling,
+                                                                              q.usage, q.flags, &p);
+    if (r == VK_SUCCESS || r == VK_ERROR_FORMAT_NOT_SUPPORTED)
+        answers[next++ % kept] = {q, r, p};  // not an out-of-memory
     return r;
 }
 
