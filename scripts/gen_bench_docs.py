@@ -1190,15 +1190,14 @@ def objects_section(pending):
     """bench/contention_instructions.sh runs: instructions per create + drop on one thread, per policy, the
     runs side by side in path order (the first: the baseline they are compared with), outside the driver
     (what vkrc and the allocator execute) with the total beside it."""
-    found = sorted((load(p) for p in glob.glob(os.path.join(ROOT, "docs/results/*-objects.csv"))),
-                   key=lambda r: r["path"])
+    found = results("", "outside_driver_per_op")
     if not found:
         return [pending]
     out = []
     for i, r in enumerate(found):
         out += [f"Run {i + 1}: {run_line(r)}", ""]
     out += ["Instructions per operation outside the driver (total with the driver in parentheses); the "
-            f"last column: the last run against run 1.", "",
+            "last column: the last run against run 1.", "",
             "| case | policy | " + " | ".join(f"run {i + 1} ({r['meta'].get('git', '?')})"
                                              for i, r in enumerate(found)) + " | last - run 1 |",
             "|---|---|" + "---:|" * (len(found) + 1)]
