@@ -73,9 +73,10 @@ private:
     }
     void grow() {
         const std::size_t old_capacity = capacity();
+        const std::size_t new_capacity = old_capacity ? old_capacity * 2 : 16;
         Slot* old = slots_;
-        slots_ = new Slot[old_capacity ? old_capacity * 2 : 16];
-        mask_ = (old_capacity ? old_capacity * 2 : 16) - 1;
+        slots_ = new Slot[new_capacity];
+        mask_ = new_capacity - 1;
         size_ = 0;
         for (std::size_t i = 0; i < old_capacity; ++i) {
             if (old[i].bits != 0) put(old[i].bits, old[i].state);
