@@ -141,41 +141,17 @@ CommandBuffer CommandBuffer::adopt(const CommandPool& pool, VkCommandBuffer comm
     return CommandBuffer(std::move(s));
 }
 
-void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
-    VKRC_REQUIRE_STATE("vkrc::CommandPool::reset_commands");
-    auto& p = *state_;
-    p.free_completed();
-    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
-    p.device.state()->close_pool_windows(&p);
-}
-
 std::size_t CommandPool::pending_free_count() const {
     VKRC_REQUIRE_STATE("vkrc::CommandPool::pending_free_count");
     LockGuard lock(state_->mutex);
     return state_->pending.size();
 }
 
-namespace {
-// one_time: a ONE_TIME_SUBMIT primary, which its submit closes (a ONE_TIME
-// secondary stays open until reset, re-begin or free).
-void begin_with(detail::CommandBufferState& s, const VkCommandBufferBeginInfo& info, bool one_time) {
-    s.pool.state()->free_completed();
-    check(s.fn->vkBeginCommandBuffer(s.cmd, &info), "vkBeginCommandBuffer");
-    s.device().open_window(s.window, one_time);
-}
-}  // namespace
-
 CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept
     : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
 
-void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
-    const detail::Caller caller{"vkrc::CommandBuffer::begin"};
-    VKRC_REQUIRE_STATE(caller.name());
-    caller.require(state_->level == VK_COMMAND_BUFFER_LEVEL_PRIMARY,
-                   "a secondary command buffer needs begin_secondary");
-    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    info.flags = flags;
-    begin_with(*state_, info, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
+void detail::refuse_begin_of_secondary() {
+    throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
 }
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
@@ -203,14 +179,10 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = flags;
     info.pInheritanceInfo = &inherit;
-    begin_with(*state_, info, false);
-}
-
-void CommandBuffer::end() const {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
-    auto& s = *state_;
-    check(s.fn->vkEndCommandBuffer(s.cmd), "vkEndCommandBuffer");
-    s.device().end_window(s.window);
+    state_->pool.state()->free_completed();
+    check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
+    // A ONE_TIME secondary stays open until reset, re-begin or free: only a primary's submit closes it.
+    state_->device().open_window(state_->window, false);
 }
 
 void CommandBuffer::reset_commands(VkCommandBufferResetFlags flags) const {

@@ -74,7 +74,8 @@ public:
     VkCommandBufferLevel level() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkBeginCommandBuffer for a primary. flags: ONE_TIME_SUBMIT (default) or
-    // SIMULTANEOUS_USE, or 0 to resubmit without overlap.
+    // SIMULTANEOUS_USE, or 0 to resubmit without overlap. Inline, as end()
+    // and CommandPool::reset_commands: a frame calls each once.
     void begin(VkCommandBufferUsageFlags flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) const;
     // vkBeginCommandBuffer for a secondary; RENDER_PASS_CONTINUE is added when
     // inheritance names a render pass or colour formats.
@@ -447,6 +448,37 @@ inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept 
     }
 }
 }  // namespace detail
+
+namespace detail {
+// begin() of a secondary command buffer: throws UsageError.
+[[noreturn]] void refuse_begin_of_secondary();
+}  // namespace detail
+
+inline void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin");
+    auto& s = *state_;
+    if (s.level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) [[unlikely]]
+        detail::refuse_begin_of_secondary();
+    s.pool.state()->free_completed();
+    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    info.flags = flags;
+    check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
+    s.device().open_window(s.window, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
+}
+
+inline void CommandBuffer::end() const {
+    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
+    check(fn_->vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
+    state_->device().end_window(state_->window);
+}
+
+inline void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {
+    VKRC_REQUIRE_STATE("vkrc::CommandPool::reset_commands");
+    auto& p = *state_;
+    p.free_completed();
+    check(p.device.fn().vkResetCommandPool(p.device.vk(), p.handle, flags), "vkResetCommandPool");
+    p.device.state()->close_pool_windows(&p);
+}
 
 inline const CommandPool& CommandBuffer::pool() const VKRC_UNCHECKED_NOEXCEPT {
     return live("vkrc::CommandBuffer::pool").pool;
