@@ -8,14 +8,6 @@
 
 VKRC_BEGIN_NAMESPACE
 
-namespace {
-// After a wait or a status query: a signalled fence is no longer in flight.
-VkResult finish_fence_query(detail::FenceState& s, VkResult r, const char* name) {
-    if (r == VK_SUCCESS) s.note_signalled();
-    return s.device.state()->finish_call(r, name);
-}
-}  // namespace
-
 namespace detail {
 void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t serial) noexcept {
     if (fence == VK_NULL_HANDLE) return;
@@ -53,21 +45,9 @@ Fence Fence::adopt(const Device& device, VkFence fence, Ownership ownership) {
                                                            fence, "VkFence", ownership));
 }
 
-VkResult Fence::wait(std::uint64_t timeout_ns) const {
-    const auto& d = state_->device;
-    return finish_fence_query(*state_, d.fn().vkWaitForFences(d.vk(), 1, &state_->handle, VK_TRUE, timeout_ns),
-                              "vkWaitForFences");
-}
-
 VkResult Fence::status() const {
     const auto& d = state_->device;
-    return finish_fence_query(*state_, d.fn().vkGetFenceStatus(d.vk(), state_->handle), "vkGetFenceStatus");
-}
-
-void Fence::unsignal() const {
-    const auto& d = state_->device;
-    check(d.fn().vkResetFences(d.vk(), 1, &state_->handle), "vkResetFences");
-    state_->note_unsignalled();
+    return state_->finish_query(d.fn().vkGetFenceStatus(d.vk(), state_->handle), "vkGetFenceStatus");
 }
 
 namespace {

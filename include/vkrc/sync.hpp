@@ -27,7 +27,8 @@ public:
 
     // vkWaitForFences: VK_SUCCESS, or VK_TIMEOUT when timeout_ns passed first.
     // After VK_SUCCESS for a fence given to vkrc::submit, every object dropped
-    // before that submission has been destroyed.
+    // before that submission has been destroyed. Inline, as unsignal(): a
+    // frame calls both.
     VkResult wait(std::uint64_t timeout_ns = wait_forever) const;
     // vkGetFenceStatus: VK_SUCCESS (signalled) or VK_NOT_READY.
     VkResult status() const;
@@ -157,6 +158,12 @@ public:
         queue = nullptr;
         in_flight = false;
     }
+    // After vkWaitForFences or vkGetFenceStatus returned r: a signalled
+    // fence is no longer in flight; then DeviceState::finish_call.
+    VkResult finish_query(VkResult r, const char* call) {
+        if (r == VK_SUCCESS) note_signalled();
+        return device.state()->finish_call(r, call);
+    }
 };
 
 // Queues the destruction of a fence that was submitted and may not have been
@@ -187,6 +194,18 @@ public:
 };
 
 }  // namespace detail
+
+inline VkResult Fence::wait(std::uint64_t timeout_ns) const {
+    auto& s = live("vkrc::Fence::wait");
+    const auto& d = *s.device.state();
+    return s.finish_query(d.fn.vkWaitForFences(d.device, 1, &s.handle, VK_TRUE, timeout_ns), "vkWaitForFences");
+}
+inline void Fence::unsignal() const {
+    auto& s = live("vkrc::Fence::unsignal");
+    const auto& d = *s.device.state();
+    check(d.fn.vkResetFences(d.device, 1, &s.handle), "vkResetFences");
+    s.note_unsignalled();
+}
 
 inline SemaphoreType Semaphore::type() const VKRC_UNCHECKED_NOEXCEPT { return live("vkrc::Semaphore::type").type; }
 inline std::uint32_t QueryPool::query_count() const VKRC_UNCHECKED_NOEXCEPT {
