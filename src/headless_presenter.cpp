@@ -66,7 +66,9 @@ PresentStatus HeadlessPresenter::acquire(Frame& frame) {
         return frame.status;
     }
     LockGuard lock(s.lock);
-    const auto index = static_cast<std::uint32_t>(s.acquired++ % s.info.image_count);
+    // A wrapping index, not a count modulo image_count: no division per frame.
+    const std::uint32_t index = s.next_index;
+    s.next_index = index + 1 == s.info.image_count ? 0 : index + 1;
     if (frame.filled_from_ != s.ring.get()) [[unlikely]]
         return refill(frame, s, index);  // a tail call: the common path has no call
     frame.point_at(*s.ring, index);

@@ -303,13 +303,13 @@ class HeadlessPresenterState final : public RefCounted {
 public:
     Queue queue;
     HeadlessPresenterCreateInfo info;
-    Ref<FrameImages> ring;       // under lock
-    std::uint64_t acquired = 0;  // under lock
+    Ref<FrameImages> ring;         // under lock
+    std::uint32_t next_index = 0;  // the image the next acquire gets; under lock
     // Written by present without the lock: present then touches no state it
     // must read first (its frame is checked against the frame's own fields).
     PolicyAtomic<std::uint32_t> last_presented{UINT32_MAX};
     PolicyAtomic<bool> needs_resize{false};
-    // Guards ring and acquired: held for a few instructions per acquire.
+    // Guards ring and next_index: held for a few instructions per acquire.
     mutable SpinLock lock;
     // Serialises re-making the ring (Vulkan calls, allocation) outside lock.
     mutable Mutex resize_mutex;
