@@ -11,8 +11,6 @@
 
 #include <vulkan/vulkan_core.h>
 
-#include <pthread.h>
-
 #include <cstdint>
 
 VKRC_BEGIN_NAMESPACE
@@ -125,6 +123,11 @@ private:
     T value_;
 };
 
+// MultiThreadPolicy::Mutex's slow paths (src/mutex.cpp). state: 0 unlocked,
+// 1 locked, 2 locked with waiters; seen, the value lock()'s exchange found.
+void futex_lock_contended(Atomic<std::uint32_t>& state, std::uint32_t seen) noexcept;
+void futex_wake_one(Atomic<std::uint32_t>& state) noexcept;
+
 }  // namespace detail
 
 // Plain count and a lock that does nothing: for programs that touch vkrc
@@ -158,24 +161,37 @@ struct MultiThreadPolicy {
     using Count = detail::Atomic<std::uint32_t>;
     template <class T>
     using Word = detail::Atomic<T>;
-    // A pthread mutex, as std::mutex is on this platform (std::mutex's header
-    // brings in <system_error> and <string>). lock() cannot fail on a default
-    // mutex used correctly, so it reports nothing.
+    // A futex mutex (Drepper, "Futexes Are Tricky", mutex 3): uncontended,
+    // one compare-exchange to lock and one exchange to unlock, inline; the
+    // kernel only when threads contend. A queue submit takes one per frame,
+    // where a pthread mutex's two calls cost 57 instructions (bench/instructions.sh).
+    // Linux only, as vkrc is (its Debian target).
     class Mutex {
     public:
         Mutex() noexcept = default;
         Mutex(const Mutex&) = delete;
         Mutex& operator=(const Mutex&) = delete;
-        ~Mutex() { pthread_mutex_destroy(&m_); }
-        void lock() noexcept { pthread_mutex_lock(&m_); }
-        bool try_lock() noexcept { return pthread_mutex_trylock(&m_) == 0; }
-        void unlock() noexcept { pthread_mutex_unlock(&m_); }
+        void lock() noexcept {
+            std::uint32_t seen = unlocked;
+            if (!state_.compare_exchange_strong(seen, locked, __ATOMIC_ACQUIRE)) [[unlikely]]
+                detail::futex_lock_contended(state_, seen);
+        }
+        bool try_lock() noexcept {
+            std::uint32_t seen = unlocked;
+            return state_.compare_exchange_strong(seen, locked, __ATOMIC_ACQUIRE);
+        }
+        void unlock() noexcept {
+            if (state_.exchange(unlocked, __ATOMIC_RELEASE) == contended) [[unlikely]]
+                detail::futex_wake_one(state_);
+        }
 
     private:
-        pthread_mutex_t m_ = PTHREAD_MUTEX_INITIALIZER;
+        static constexpr std::uint32_t unlocked = 0, locked = 1, contended = 2;
+        detail::Atomic<std::uint32_t> state_{unlocked};
     };
-    // For critical sections of a few instructions, where a pthread mutex
-    // would cost more than the work: one exchange to lock, one store to unlock.
+    // For critical sections of a few instructions, where a futex mutex's
+    // unlock exchange would cost more than the work: one exchange to lock,
+    // one store to unlock.
     class SpinLock {
     public:
         void lock() noexcept {
