@@ -44,8 +44,78 @@ struct SubmitBatch {
 // Queue::submit with typed batches; the fence (if any) signals when all are
 // done. The Vulkan structures are built on the stack up to 4 wait and 4
 // signal semaphores and 8 command buffers per batch (4 batches), on the heap
-// beyond.
+// beyond. The one-batch form is inline: a frame's submit reaches
+// vkQueueSubmit2 without a call of its own.
 void submit(const Queue& queue, Span<const SubmitBatch> batches, const Fence& fence = {});
 void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence = {});
+
+namespace detail {
+
+// What one batch of a frame loop needs fits on the stack; more goes to the heap.
+inline constexpr std::size_t inline_semaphores = 4;
+inline constexpr std::size_t inline_command_buffers = 8;
+inline constexpr std::size_t inline_batches = 4;
+
+// Throws UsageError "vkrc::submit: what".
+[[noreturn]] void refuse_submit(const char* what);
+
+// Fills info for batch, its semaphores and command buffers going to the
+// given arrays, which have room for them.
+[[gnu::always_inline]] inline void fill_batch(const Queue& queue, const SubmitBatch& batch, VkSubmitInfo2& info,
+                                              VkSemaphoreSubmitInfo* waits, VkSemaphoreSubmitInfo* signals,
+                                              VkCommandBufferSubmitInfo* cmds) {
+    info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
+    info.pWaitSemaphoreInfos = waits;
+    for (const auto& w : batch.waits) *waits++ = w.info();
+    info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
+    info.pSignalSemaphoreInfos = signals;
+    for (const auto& s : batch.signals) *signals++ = s.info();
+    info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
+    info.pCommandBufferInfos = cmds;
+    for (const auto& c : batch.command_buffers) {
+        if (!c) [[unlikely]]
+            refuse_submit("a CommandBuffer handle is empty");
+#if VKRC_RUNTIME_CHECKS
+        if (!(c.pool().device() == queue.device()))
+            refuse_submit("a CommandBuffer belongs to another device than the queue");
+#else
+        (void)queue;
+#endif
+        *cmds = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+        cmds++->commandBuffer = c.vk();
+    }
+}
+
+// Submits infos on queue (DeviceState::submit) and notes the fenced submission.
+[[gnu::always_inline]] inline void submit_infos(const Queue& queue, Span<const VkSubmitInfo2> infos,
+                                                const Fence& fence) {
+#if VKRC_RUNTIME_CHECKS
+    if (fence && !(fence.device() == queue.device()))
+        refuse_submit("the Fence belongs to another device than the queue");
+#endif
+    auto& q = *queue.state();
+    FenceState* f = fence.state();
+    const std::uint64_t number = queue.device().state()->submit(q, infos, f ? f->handle : VK_NULL_HANDLE);
+    if (f) f->note_submitted(q, number);
+}
+
+}  // namespace detail
+
+[[gnu::always_inline]] inline void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
+    if (batch.waits.size() > detail::inline_semaphores || batch.signals.size() > detail::inline_semaphores ||
+        batch.command_buffers.size() > detail::inline_command_buffers) [[unlikely]] {
+        return submit(queue, Span<const SubmitBatch>(&batch, 1), fence);
+    }
+    if (!queue) [[unlikely]]
+        detail::refuse_submit("the Queue is empty");
+    VkSubmitInfo2 info;
+    VkSemaphoreSubmitInfo waits[detail::inline_semaphores];
+    VkSemaphoreSubmitInfo signals[detail::inline_semaphores];
+    VkCommandBufferSubmitInfo cmds[detail::inline_command_buffers];
+    detail::fill_batch(queue, batch, info, waits, signals, cmds);
+    detail::submit_infos(queue, Span<const VkSubmitInfo2>(&info, 1), fence);
+    detail::close_submitted(batch.command_buffers);
+}
 
 VKRC_END_NAMESPACE
