@@ -70,6 +70,9 @@ void throw_empty_handle(const char* call) {
         "the handle is empty (default-constructed, moved-from or reset(); an adopted Buffer or Image has no "
         "Allocation)");
 }
+void throw_stale_handle(const char* type) {
+    Caller(type).refuse("the wrapper's copy of the raw handle differs from its state's (a vkrc bug; please report it)");
+}
 void throw_empty_handle(const char* type, const char* member) {
     throw_empty_handle((std::string(type) + "::" + member).c_str());
 }

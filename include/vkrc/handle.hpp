@@ -164,8 +164,8 @@ struct MultiThreadPolicy {
     // A futex mutex (Drepper, "Futexes Are Tricky", mutex 3): uncontended,
     // one compare-exchange to lock and one exchange to unlock, inline; the
     // kernel only when threads contend. A queue submit takes one per frame,
-    // where a pthread mutex's two calls cost 57 instructions (bench/instructions.sh).
-    // Linux only, as vkrc is (its Debian target).
+    // where a pthread mutex costs two calls (bench/instructions.sh counts
+    // them). Linux only, as vkrc is (its Debian target).
     class Mutex {
     public:
         Mutex() noexcept = default;
@@ -419,15 +419,53 @@ public:
 };
 }  // namespace detail
 
-// Base of the wrappers of a VulkanObjectState: the raw handle.
+namespace detail {
+// vk() found the wrapper's copy of the handle differing from its state's: a vkrc bug.
+[[noreturn]] void throw_stale_handle(const char* type);
+}  // namespace detail
+
+// Base of the wrappers of a VulkanObjectState: the raw handle, copied into
+// the wrapper as CommandBuffer copies its own. A state's handle never changes
+// once a wrapper exists, and recording reads vk() of every bound object per
+// frame: from the wrapper, that is no load from the state's block, which the
+// frame's wait has usually evicted (bench/instructions.sh --cache-sim).
 template <class State, class VkHandle>
 class VulkanObject : public Handle<State> {
 public:
-    VkHandle vk() const VKRC_UNCHECKED_NOEXCEPT { return this->live(State::type_name, "vk").handle; }
+    VkHandle vk() const VKRC_UNCHECKED_NOEXCEPT {
+#if VKRC_RUNTIME_CHECKS
+        if (this->live(State::type_name, "vk").handle != handle_) [[unlikely]]
+            detail::throw_stale_handle(State::type_name);
+#endif
+        return handle_;
+    }
+    // Drops this handle's reference (hides Handle::reset, which would leave the copy).
+    void reset() noexcept {
+        Handle<State>::reset();
+        handle_ = VK_NULL_HANDLE;
+    }
+
+    VulkanObject(const VulkanObject&) noexcept = default;
+    VulkanObject& operator=(const VulkanObject&) noexcept = default;
+    // A moved-from wrapper is empty, its copy of the handle included.
+    VulkanObject(VulkanObject&& other) noexcept : Handle<State>(moves::move(other)), handle_(other.handle_) {
+        other.handle_ = VK_NULL_HANDLE;
+    }
+    VulkanObject& operator=(VulkanObject&& other) noexcept {
+        const VkHandle handle = other.handle_;
+        Handle<State>::operator=(moves::move(other));
+        other.handle_ = VK_NULL_HANDLE;
+        handle_ = handle;
+        return *this;
+    }
 
 protected:
     VulkanObject() noexcept = default;
-    explicit VulkanObject(detail::Ref<State> state) noexcept : Handle<State>(moves::move(state)) {}
+    explicit VulkanObject(detail::Ref<State> state) noexcept
+        : Handle<State>(moves::move(state)), handle_(this->state_ ? this->state_->handle : VK_NULL_HANDLE) {}
+
+private:
+    VkHandle handle_ = VK_NULL_HANDLE;
 };
 
 // A raw handle parameter that also takes a vkrc wrapper (any class whose
