@@ -1,4 +1,5 @@
 // The reference-counting core, independent of Vulkan.
+#include <vkrc/error.hpp>
 #include <vkrc/handle.hpp>
 #include <vkrc/detail/list.hpp>
 #include <vkrc/detail/object_registry.hpp>
@@ -186,6 +187,73 @@ TEST(Raw, ReadsTheWrappersHandle) {
     EXPECT_EQ(static_cast<VkBuffer>(from_wrapper), FakeBuffer{}.vk());
     EXPECT_EQ(*from_wrapper.get(), FakeBuffer{}.vk());
     EXPECT_EQ(static_cast<VkBuffer>(from_raw), VK_NULL_HANDLE);
+}
+
+// A wrapper of a Vulkan object keeps a copy of the raw handle: copies carry
+// it, a move or reset() empties the source, copy included.
+struct FakeObjectState final : vkrc::detail::VulkanObjectState<VkBuffer> {
+    static constexpr const char* type_name = "FakeObject";
+};
+class FakeObject : public vkrc::VulkanObject<FakeObjectState, VkBuffer> {
+public:
+    FakeObject() = default;
+    static FakeObject make(std::uintptr_t raw) {
+        vkrc::detail::Ref<FakeObjectState> s(new FakeObjectState);
+        s->handle = reinterpret_cast<VkBuffer>(raw);
+        return FakeObject(std::move(s));
+    }
+
+private:
+    using VulkanObject::VulkanObject;
+};
+
+TEST(VulkanObject, CopiesCarryTheRawHandleAndMovesEmptyTheSource) {
+    const VkBuffer raw_a = reinterpret_cast<VkBuffer>(std::uintptr_t{0x10});
+    const VkBuffer raw_b = reinterpret_cast<VkBuffer>(std::uintptr_t{0x20});
+    FakeObject a = FakeObject::make(0x10);
+    FakeObject copy = a;
+    EXPECT_EQ(copy.vk(), raw_a);
+    FakeObject moved = std::move(copy);
+    EXPECT_FALSE(copy);  // NOLINT(bugprone-use-after-move): the moved-from state is what is tested
+    EXPECT_EQ(moved.vk(), raw_a);
+    moved = FakeObject::make(0x20);  // move-assigned: the old object's count goes, the new handle comes
+    EXPECT_EQ(moved.vk(), raw_b);
+    EXPECT_EQ(a.use_count(), 1u);
+    moved = a;
+    EXPECT_EQ(moved.vk(), raw_a);
+    FakeObject& alias = moved;
+    moved = std::move(alias);  // self-move keeps the object and its handle
+    EXPECT_EQ(moved.vk(), raw_a);
+    moved.reset();
+    EXPECT_FALSE(moved);
+#if VKRC_RUNTIME_CHECKS
+    EXPECT_THROW(moved.vk(), vkrc::UsageError);
+    a.state()->handle = raw_b;  // what no vkrc code does once a wrapper exists
+    EXPECT_THROW(a.vk(), vkrc::UsageError) << "checked builds compare the copy with the state's handle";
+#endif
+}
+
+// The multi-thread policy's futex mutex under contention (both builds
+// compile it): every increment made under it survives, so the waiters that
+// went to the kernel were woken and excluded.
+TEST(Policy, MultiThreadMutexExcludesUnderContention) {
+    vkrc::MultiThreadPolicy::Mutex mutex;
+    std::uint64_t count = 0;
+    constexpr int threads = 8, rounds = 20000;
+    std::vector<std::thread> workers;
+    for (int t = 0; t < threads; ++t) {
+        workers.emplace_back([&] {
+            for (int i = 0; i < rounds; ++i) {
+                vkrc::LockGuard<vkrc::MultiThreadPolicy::Mutex> lock(mutex);
+                ++count;
+            }
+        });
+    }
+    for (auto& w : workers) w.join();
+    EXPECT_EQ(count, std::uint64_t{threads} * rounds);
+    EXPECT_TRUE(mutex.try_lock());
+    EXPECT_FALSE(mutex.try_lock());
+    mutex.unlock();
 }
 
 }  // namespace
