@@ -427,8 +427,8 @@ namespace detail {
 // Base of the wrappers of a VulkanObjectState: the raw handle, copied into
 // the wrapper as CommandBuffer copies its own. A state's handle never changes
 // once a wrapper exists, and recording reads vk() of every bound object per
-// frame: from the wrapper, that is no load from the state's block, which the
-// frame's wait has usually evicted (bench/instructions.sh --cache-sim).
+// frame: from the wrapper, that is no load from the state's block (fewer
+// data-cache misses per frame in callgrind's cache simulation, docs/design.md).
 template <class State, class VkHandle>
 class VulkanObject : public Handle<State> {
 public:
