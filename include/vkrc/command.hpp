@@ -460,8 +460,10 @@ inline void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
     if (s.level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) [[unlikely]]
         detail::refuse_begin_of_secondary();
     s.pool.state()->free_completed();
-    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    info.flags = flags;
+    const VkCommandBufferBeginInfo info{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                        .pNext = nullptr,
+                                        .flags = flags,
+                                        .pInheritanceInfo = nullptr};
     check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
     s.device().open_window(s.window, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
 }

@@ -64,15 +64,17 @@ inline constexpr std::size_t inline_batches = 4;
 [[gnu::always_inline]] inline void fill_batch(const Queue& queue, const SubmitBatch& batch, VkSubmitInfo2& info,
                                               VkSemaphoreSubmitInfo* waits, VkSemaphoreSubmitInfo* signals,
                                               VkCommandBufferSubmitInfo* cmds) {
-    info = VkSubmitInfo2{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    info.waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size());
-    info.pWaitSemaphoreInfos = waits;
+    info = {.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2,
+            .pNext = nullptr,
+            .flags = 0,
+            .waitSemaphoreInfoCount = static_cast<std::uint32_t>(batch.waits.size()),
+            .pWaitSemaphoreInfos = waits,
+            .commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size()),
+            .pCommandBufferInfos = cmds,
+            .signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size()),
+            .pSignalSemaphoreInfos = signals};
     for (const auto& w : batch.waits) *waits++ = w.info();
-    info.signalSemaphoreInfoCount = static_cast<std::uint32_t>(batch.signals.size());
-    info.pSignalSemaphoreInfos = signals;
     for (const auto& s : batch.signals) *signals++ = s.info();
-    info.commandBufferInfoCount = static_cast<std::uint32_t>(batch.command_buffers.size());
-    info.pCommandBufferInfos = cmds;
     for (const auto& c : batch.command_buffers) {
         if (!c) [[unlikely]]
             refuse_submit("a CommandBuffer handle is empty");
@@ -82,8 +84,10 @@ inline constexpr std::size_t inline_batches = 4;
 #else
         (void)queue;
 #endif
-        *cmds = VkCommandBufferSubmitInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-        cmds++->commandBuffer = c.vk();
+        *cmds++ = {.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+                   .pNext = nullptr,
+                   .commandBuffer = c.vk(),
+                   .deviceMask = 0};
     }
 }
 
