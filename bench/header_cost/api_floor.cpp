@@ -1,12 +1,10 @@
 // Header-cost probe: no vkrc, only the standard and Vulkan headers that
 // vkrc's public API is made of (std::exception as the base of its errors,
 // <initializer_list> and <new> under vkrc::List and vkrc::Function, <cstring>
-// for mapped copies, and pthread.h under vkrc::Mutex), and an empty main.
+// for mapped copies), and an empty main.
 // The least a translation unit using vkrc's API as it stands can cost; keep
 // the list in step with include/vkrc.
 #include <vulkan/vulkan_core.h>
-
-#include <pthread.h>
 
 #include <cstddef>
 #include <cstdint>
