@@ -151,7 +151,7 @@ CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noex
     : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
 
 void detail::refuse_begin_of_secondary() {
-    throw UsageError("vkrc::CommandBuffer::begin: a secondary command buffer needs begin_secondary");
+    Caller("vkrc::CommandBuffer::begin").refuse("a secondary command buffer needs begin_secondary");
 }
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,

@@ -447,9 +447,7 @@ inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept 
         if (s.window.one_time) s.device().close_window(s.window);
     }
 }
-}  // namespace detail
 
-namespace detail {
 // begin() of a secondary command buffer: throws UsageError.
 [[noreturn]] void refuse_begin_of_secondary();
 }  // namespace detail
