@@ -17,15 +17,6 @@ void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size) {
 }
 }  // namespace detail
 
-VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range, VkImageLayout old_layout,
-                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
-                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                                    VkAccessFlags2 dst_access) noexcept {
-    auto b = image_barrier(image, old_layout, new_layout, src_stage, src_access, dst_stage, dst_access);
-    b.subresourceRange = range;
-    return b;
-}
-
 namespace {
 // A barrier of the ownership transfer from src_family to dst_family: the
 // release and acquire helpers differ only in which half carries the stages.

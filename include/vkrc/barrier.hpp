@@ -11,15 +11,15 @@
 
 VKRC_BEGIN_NAMESPACE
 
-// An image barrier over every mip level and layer of one aspect. Inline: it
+// An image barrier over range (see mip_range and layer_range). Inline: it
 // only fills a struct, which the caller's compiler folds into its own stores.
 // Each field is named once: a zeroed struct then assigned field by field
 // cost the teapot's command stage (three barriers) 47 more instructions
 // under GCC 12, which stored most fields twice.
-inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
+inline VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range,
+                                           VkImageLayout old_layout, VkImageLayout new_layout,
                                            VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
-                                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                           VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
+                                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) noexcept {
     return {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
             .pNext = nullptr,
             .srcStageMask = src_stage,
@@ -31,11 +31,20 @@ inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layo
             .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
             .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
             .image = image,
-            .subresourceRange = {.aspectMask = aspect,
-                                 .baseMipLevel = 0,
-                                 .levelCount = VK_REMAINING_MIP_LEVELS,
-                                 .baseArrayLayer = 0,
-                                 .layerCount = VK_REMAINING_ARRAY_LAYERS}};
+            .subresourceRange = range};
+}
+// An image barrier over every mip level and layer of one aspect.
+inline VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageLayout old_layout, VkImageLayout new_layout,
+                                           VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                           VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                           VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept {
+    return image_barrier(image,
+                         {.aspectMask = aspect,
+                          .baseMipLevel = 0,
+                          .levelCount = VK_REMAINING_MIP_LEVELS,
+                          .baseArrayLayer = 0,
+                          .layerCount = VK_REMAINING_ARRAY_LAYERS},
+                         old_layout, new_layout, src_stage, src_access, dst_stage, dst_access);
 }
 // A global memory barrier.
 inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
@@ -48,11 +57,6 @@ inline VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccess
             .dstAccessMask = dst_access};
 }
 
-// An image barrier over range (see mip_range and layer_range).
-VkImageMemoryBarrier2 image_barrier(VkImage image, const VkImageSubresourceRange& range, VkImageLayout old_layout,
-                                    VkImageLayout new_layout, VkPipelineStageFlags2 src_stage,
-                                    VkAccessFlags2 src_access, VkPipelineStageFlags2 dst_stage,
-                                    VkAccessFlags2 dst_access) noexcept;
 // count mip levels from base_level, every layer.
 VkImageSubresourceRange mip_range(std::uint32_t base_level, std::uint32_t level_count = 1,
                                   VkImageAspectFlags aspect = VK_IMAGE_ASPECT_COLOR_BIT) noexcept;
