@@ -97,8 +97,15 @@ namespace detail {
 namespace {
 // "[offset, offset + size) of stage flags 0x..", as push_constants' messages write a range.
 std::string range_text(std::uint32_t offset, std::uint32_t size, VkShaderStageFlags stages) {
-    return "[" + std::to_string(offset) + ", " + std::to_string(std::uint64_t(offset) + size) + ") of stage flags 0x" +
-           hex(stages);
+    // Appended, not "[" + string: GCC 12's -Wrestrict misfires on a literal
+    // inserted before a temporary string (GCC bug 105651).
+    std::string text("[");
+    text += std::to_string(offset);
+    text += ", ";
+    text += std::to_string(std::uint64_t(offset) + size);
+    text += ") of stage flags 0x";
+    text += hex(stages);
+    return text;
 }
 std::string ranges_text(Span<const VkPushConstantRange> ranges) {
     if (ranges.empty()) return "none";

@@ -78,9 +78,12 @@ public:
     void append(const T* items, std::size_t count) { append_copies(items, count); }
     // Grows with value-initialised elements or drops the last ones; keeps the storage.
     void resize(std::size_t count) {
+        if (count <= size_) {
+            while (size_ > count) data_[--size_].~T();
+            return;
+        }
         reserve(count);
         for (; size_ < count; ++size_) new (data_ + size_) T();
-        while (size_ > count) data_[--size_].~T();
     }
     // Removes the first count elements (at most size()), moving the rest down
     // once: a List used as a queue drains what is ready in one pass.
