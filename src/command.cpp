@@ -179,7 +179,6 @@ void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     info.flags = flags;
     info.pInheritanceInfo = &inherit;
-    state_->pool.state()->free_completed();
     check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
     // A ONE_TIME secondary stays open until reset, re-begin or free: only a primary's submit closes it.
     state_->device().open_window(state_->window, false);

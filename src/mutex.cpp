@@ -1,4 +1,4 @@
-// MultiThreadPolicy::Mutex's slow paths: the futex calls (vkrc/handle.hpp).
+// MultiThreadPolicy's lock slow paths: the futex calls and the spin (vkrc/handle.hpp).
 #include "vkrc/handle.hpp"
 
 #include <linux/futex.h>
@@ -29,6 +29,17 @@ void futex_lock_contended(Atomic<std::uint32_t>& state, std::uint32_t seen) noex
 }
 
 void futex_wake_one(Atomic<std::uint32_t>& state) noexcept { futex(state, FUTEX_WAKE_PRIVATE, 1); }
+
+void spin_lock_contended(Atomic<bool>& locked) noexcept {
+    do {
+        // Reads until free, so waiters do not bounce the line with exchanges.
+        while (locked.load(__ATOMIC_RELAXED)) {
+#if defined(__x86_64__) || defined(__i386__)
+            __builtin_ia32_pause();
+#endif
+        }
+    } while (locked.exchange(true, __ATOMIC_ACQUIRE));
+}
 
 }  // namespace detail
 

@@ -458,7 +458,6 @@ inline void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
     auto& s = *state_;
     if (s.level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) [[unlikely]]
         detail::refuse_begin_of_secondary();
-    s.pool.state()->free_completed();
     const VkCommandBufferBeginInfo info{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                         .pNext = nullptr,
                                         .flags = flags,

@@ -60,9 +60,10 @@ class CommandPoolState final : public DeviceChildState<VkCommandPool> {
 public:
     static constexpr const char* type_name = "vkrc::CommandPool";
     ~CommandPoolState() override;
-    // On the pool's thread (allocate, reset, begin), not under mutex: frees
-    // the dropped command buffers the GPU is done with. Inline: a frame
-    // loop's begin and reset find nothing pending, one load and no lock.
+    // On the pool's thread (allocate, reset), not under mutex: frees the
+    // dropped command buffers the GPU is done with. Not at begin: every
+    // dropped buffer was allocated, so the next allocate or reset bounds
+    // what waits. Inline: a frame loop's reset finds nothing, one load.
     void free_completed() {
         if (has_pending.load(__ATOMIC_RELAXED)) [[unlikely]]
             free_pending();

@@ -127,6 +127,8 @@ private:
 // 1 locked, 2 locked with waiters; seen, the value lock()'s exchange found.
 void futex_lock_contended(Atomic<std::uint32_t>& state, std::uint32_t seen) noexcept;
 void futex_wake_one(Atomic<std::uint32_t>& state) noexcept;
+// MultiThreadPolicy::SpinLock's slow path: spins until it takes the lock.
+void spin_lock_contended(Atomic<bool>& locked) noexcept;
 
 }  // namespace detail
 
@@ -195,13 +197,8 @@ struct MultiThreadPolicy {
     class SpinLock {
     public:
         void lock() noexcept {
-            while (locked_.exchange(true, __ATOMIC_ACQUIRE)) {
-                while (locked_.load(__ATOMIC_RELAXED)) {
-#if defined(__x86_64__) || defined(__i386__)
-                    __builtin_ia32_pause();
-#endif
-                }
-            }
+            if (locked_.exchange(true, __ATOMIC_ACQUIRE)) [[unlikely]]
+                detail::spin_lock_contended(locked_);
         }
         void unlock() noexcept { locked_.store(false, __ATOMIC_RELEASE); }
 
