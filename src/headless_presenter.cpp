@@ -28,23 +28,6 @@ detail::Ref<detail::FrameImages> make_ring(const detail::HeadlessPresenterState&
     return ring;
 }
 
-// Makes the ring a pending resize() asked for; false while its extent is
-// zero. The new ring is made outside the spin lock, which acquire holds.
-// Cold: kept out of acquire's fast path.
-[[gnu::cold, gnu::noinline]] bool apply_resize(detail::HeadlessPresenterState& s) {
-    LockGuard resizing(s.resize_mutex);
-    if (!s.needs_resize.load(std::memory_order_acquire)) return true;  // another thread did it
-    const VkExtent2D extent = s.info.extent;
-    if (extent.width == 0 || extent.height == 0) return false;
-    detail::Ref<detail::FrameImages> ring = make_ring(s, extent);
-    {
-        LockGuard lock(s.lock);
-        std::swap(s.ring, ring);
-    }
-    s.needs_resize.store(false, std::memory_order_release);
-    return true;  // the old ring goes with ring, outside the spin lock
-}
-
 }  // namespace
 
 HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPresenterCreateInfo& info) {
@@ -59,21 +42,20 @@ HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPr
     return HeadlessPresenter(std::move(state));
 }
 
-PresentStatus HeadlessPresenter::acquire(Frame& frame) {
-    auto& s = *state_;
-    if (s.needs_resize.load(std::memory_order_acquire) && !apply_resize(s)) [[unlikely]] {
-        frame.clear(PresentStatus::zero_extent);
-        return frame.status;
+// Makes the ring a pending resize() asked for; false while its extent is
+// zero. The new ring is made outside the spin lock, which acquire holds.
+bool HeadlessPresenter::apply_resize(detail::HeadlessPresenterState& s) {
+    LockGuard resizing(s.resize_mutex);
+    if (!s.needs_resize.load(std::memory_order_acquire)) return true;  // another thread did it
+    const VkExtent2D extent = s.info.extent;
+    if (extent.width == 0 || extent.height == 0) return false;
+    detail::Ref<detail::FrameImages> ring = make_ring(s, extent);
+    {
+        LockGuard lock(s.lock);
+        std::swap(s.ring, ring);
     }
-    LockGuard lock(s.lock);
-    // A wrapping index, not a count modulo image_count: no division per frame.
-    const std::uint32_t index = s.next_index;
-    s.next_index = index + 1 == s.info.image_count ? 0 : index + 1;
-    if (frame.filled_from_ != s.ring.get()) [[unlikely]]
-        return refill(frame, s, index);  // a tail call: the common path has no call
-    frame.point_at(*s.ring, index);
-    frame.status = PresentStatus::success;
-    return PresentStatus::success;
+    s.needs_resize.store(false, std::memory_order_release);
+    return true;  // the old ring goes with ring, outside the spin lock
 }
 
 PresentStatus HeadlessPresenter::refill(Frame& frame, detail::HeadlessPresenterState& s, std::uint32_t index) noexcept {
@@ -88,12 +70,8 @@ PresentStatus HeadlessPresenter::refill(Frame& frame, detail::HeadlessPresenterS
     return PresentStatus::success;
 }
 
-PresentStatus HeadlessPresenter::present(const Frame& frame) {
-    auto& s = *state_;
-    detail::Caller("vkrc::HeadlessPresenter::present")
-        .require(frame && frame.source_ == &s, "the frame was not acquired from this presenter");
-    s.last_presented.store(frame.image_index, std::memory_order_relaxed);
-    return PresentStatus::success;
+void HeadlessPresenter::refuse_present() {
+    detail::Caller("vkrc::HeadlessPresenter::present").refuse("the frame was not acquired from this presenter");
 }
 
 List<std::byte> HeadlessPresenter::read_back(std::uint32_t image_index) const {

@@ -227,6 +227,8 @@ class HeadlessPresenter final : public Handle<detail::HeadlessPresenterState>, p
 public:
     static HeadlessPresenter create(const Queue& queue, const HeadlessPresenterCreateInfo& info);
 
+    // Inline (as the frame loop's other calls): a steady loop's acquire and
+    // present pay no call of their own.
     PresentStatus acquire(Frame& frame) override;
     PresentStatus present(const Frame& frame) override;
     VkExtent2D extent() const noexcept override;
@@ -247,6 +249,11 @@ private:
     // acquire() for a frame last filled from elsewhere; under the state's lock.
     [[gnu::noinline]] static PresentStatus refill(Frame& frame, detail::HeadlessPresenterState& s,
                                                   std::uint32_t index) noexcept;
+    // Makes the ring a pending resize() asked for; false while its extent is
+    // zero. Cold: kept out of acquire's fast path.
+    [[gnu::cold]] static bool apply_resize(detail::HeadlessPresenterState& s);
+    // present() of a frame another presenter (or none) filled: throws UsageError.
+    [[noreturn, gnu::cold]] static void refuse_present();
 };
 
 namespace detail {
@@ -322,6 +329,32 @@ inline void Frame::point_at(const detail::FrameImages& set, std::uint32_t index)
     image_ = &set.images[index];
     view_ = &set.views[index];
     extent = set.extent;
+}
+
+inline PresentStatus HeadlessPresenter::acquire(Frame& frame) {
+    auto& s = *state_;
+    if (s.needs_resize.load(__ATOMIC_ACQUIRE) && !apply_resize(s)) [[unlikely]] {
+        frame.clear(PresentStatus::zero_extent);
+        return frame.status;
+    }
+    LockGuard lock(s.lock);
+    // A wrapping index, not a count modulo image_count: no division per frame.
+    const std::uint32_t index = s.next_index;
+    s.next_index = index + 1 == s.info.image_count ? 0 : index + 1;
+    if (frame.filled_from_ != s.ring.get()) [[unlikely]]
+        return refill(frame, s, index);
+    frame.point_at(*s.ring, index);
+    frame.status = PresentStatus::success;
+    return PresentStatus::success;
+}
+
+inline PresentStatus HeadlessPresenter::present(const Frame& frame) {
+    auto& s = *state_;
+    if (!frame || frame.source_ != &s) [[unlikely]]
+        refuse_present();
+    // No lock: present touches no state it must read first.
+    s.last_presented.store(frame.image_index, __ATOMIC_RELAXED);
+    return PresentStatus::success;
 }
 
 VKRC_END_NAMESPACE
