@@ -672,6 +672,12 @@ void Device::wait_idle() const {
     state_->finish_call(r, "vkDeviceWaitIdle");
 }
 
+VkResult detail::DeviceState::finish_failed_call(VkResult r, const char* call) {
+    note_result(r);
+    collect();
+    return check(r, call);
+}
+
 void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::Device::collect_garbage");
     state_->collect();

@@ -23,6 +23,13 @@ private:
 
 void detail::refuse_submit(const char* what) { Caller("vkrc::submit").refuse(what); }
 
+void detail::submit_large_batch(const Queue& queue, Span<const SemaphoreSubmit> waits,
+                                Span<const CommandBuffer> command_buffers, Span<const SemaphoreSubmit> signals,
+                                const Fence& fence) {
+    const SubmitBatch batch{.waits = waits, .command_buffers = command_buffers, .signals = signals};
+    submit(queue, Span<const SubmitBatch>(&batch, 1), fence);
+}
+
 void submit(const Queue& queue, Span<const SubmitBatch> batches, const Fence& fence) {
     if (!queue) detail::refuse_submit("the Queue is empty");
     std::size_t n_waits = 0, n_signals = 0, n_cmds = 0;

@@ -58,6 +58,12 @@ inline constexpr std::size_t inline_batches = 4;
 
 // Throws UsageError "vkrc::submit: what".
 [[noreturn]] void refuse_submit(const char* what);
+// The one-batch submit of a batch too large for the stack: the Span form.
+// Its parts are passed by value, so the inline caller's batch need not be
+// stored to memory for the case it does not take.
+[[gnu::noinline]] void submit_large_batch(const Queue& queue, Span<const SemaphoreSubmit> waits,
+                                          Span<const CommandBuffer> command_buffers,
+                                          Span<const SemaphoreSubmit> signals, const Fence& fence);
 
 // Fills info for batch, its semaphores and command buffers going to the
 // given arrays, which have room for them.
@@ -109,7 +115,7 @@ inline constexpr std::size_t inline_batches = 4;
 [[gnu::always_inline]] inline void submit(const Queue& queue, const SubmitBatch& batch, const Fence& fence) {
     if (batch.waits.size() > detail::inline_semaphores || batch.signals.size() > detail::inline_semaphores ||
         batch.command_buffers.size() > detail::inline_command_buffers) [[unlikely]] {
-        return submit(queue, Span<const SubmitBatch>(&batch, 1), fence);
+        return detail::submit_large_batch(queue, batch.waits, batch.command_buffers, batch.signals, fence);
     }
     if (!queue) [[unlikely]]
         detail::refuse_submit("the Queue is empty");

@@ -346,10 +346,15 @@ public:
     // After a call that may have run or waited for GPU work: marks the device
     // lost when r says so, runs the completed deferred actions, then check(r, call).
     VkResult finish_call(VkResult r, const char* call) {
-        note_result(r);
-        collect();
-        return check(r, call);
+        // Success tested once: the frame loop's path does not test r again after collecting.
+        if (r == VK_SUCCESS) [[likely]] {
+            collect();
+            return VK_SUCCESS;
+        }
+        return finish_failed_call(r, call);
     }
+    // finish_call's other results, out of line.
+    VkResult finish_failed_call(VkResult r, const char* call);
 
     // ---- Queues' timelines
     // Queue::submit: submits under the queue's lock, signalling the queue's
