@@ -331,4 +331,19 @@ TEST_F(VulkanTest, CreationRespectsTheDevicesLimitsFeaturesAndFormats) {
                        {"unnormalized_coordinates needs mipmap_mode NEAREST, not VK_SAMPLER_MIPMAP_MODE_LINEAR"});
 }
 
+TEST_F(VulkanTest, PresentingAFrameOfAnotherPresenterIsRejected) {
+    // present() is inline; its refusal stays a UsageError naming the problem.
+    auto a = vkrc::HeadlessPresenter::create(queue, {.extent = {4, 4}});
+    auto b = vkrc::HeadlessPresenter::create(queue, {.extent = {4, 4}});
+    vkrc::Frame frame;
+    expect_usage_error([&] { a.present(frame); },
+                       {"vkrc::HeadlessPresenter::present", "the frame was not acquired from this presenter"});
+    ASSERT_EQ(b.acquire(frame), vkrc::PresentStatus::success);
+    expect_usage_error([&] { a.present(frame); },
+                       {"vkrc::HeadlessPresenter::present", "the frame was not acquired from this presenter"});
+    EXPECT_EQ(b.present(frame), vkrc::PresentStatus::success);
+    EXPECT_EQ(b.last_presented(), frame.image_index);
+    EXPECT_EQ(a.last_presented(), UINT32_MAX);
+}
+
 }  // namespace
