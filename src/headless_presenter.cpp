@@ -42,8 +42,7 @@ HeadlessPresenter HeadlessPresenter::create(const Queue& queue, const HeadlessPr
     return HeadlessPresenter(std::move(state));
 }
 
-// Makes the ring a pending resize() asked for; false while its extent is
-// zero. The new ring is made outside the spin lock, which acquire holds.
+// The new ring is made outside the spin lock, which acquire holds.
 bool HeadlessPresenter::apply_resize(detail::HeadlessPresenterState& s) {
     LockGuard resizing(s.resize_mutex);
     if (!s.needs_resize.load(std::memory_order_acquire)) return true;  // another thread did it

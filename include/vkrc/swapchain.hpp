@@ -352,7 +352,6 @@ inline PresentStatus HeadlessPresenter::present(const Frame& frame) {
     auto& s = *state_;
     if (!frame || frame.source_ != &s) [[unlikely]]
         refuse_present();
-    // No lock: present touches no state it must read first.
     s.last_presented.store(frame.image_index, __ATOMIC_RELAXED);
     return PresentStatus::success;
 }
