@@ -148,7 +148,7 @@ std::size_t CommandPool::pending_free_count() const {
 }
 
 CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept
-    : Handle(std::move(state)), fn_(state_->fn), cmd_(state_->cmd) {}
+    : Handle(std::move(state)), CommandRecorder(state_->fn, state_->cmd) {}
 
 void detail::refuse_begin_of_secondary() {
     Caller("vkrc::CommandBuffer::begin").refuse("a secondary command buffer needs begin_secondary");

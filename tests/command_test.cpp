@@ -3,7 +3,9 @@
 #include "shaders/fill_pattern.comp.h"
 
 #include <span>
+#include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -92,6 +94,76 @@ TEST_F(VulkanTest, DroppingEverythingAfterSubmitDefersDestruction) {
     auto cmd = pool.allocate();  // frees the dropped command buffer
     EXPECT_EQ(pool.pending_free_count(), 0u);
 }
+
+// Commands recorded through a CommandRecorder taken by value (the recording
+// part of a CommandBuffer, two pointers) land in that command buffer, mixin
+// methods (fill_buffer) and its own (pipeline_barrier) alike; it holds the
+// same table and raw handle and keeps nothing alive.
+void fill_through_recorder(vkrc::CommandRecorder rec, const vkrc::Buffer& target) {
+    rec.fill_buffer(target, 0, 8, 0x600df00d);
+    rec.fill_buffer(target, 8, 8, 0x0ddba11);
+    const auto to_host = vkrc::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                              VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    rec.pipeline_barrier(std::span(&to_host, 1), {}, {});
+}
+
+TEST_F(VulkanTest, RecordingThroughACommandRecorderCopy) {
+    static_assert(sizeof(vkrc::CommandRecorder) == 2 * sizeof(void*));
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto target = vkrc::Buffer::create(
+        device,
+        {.size = 16, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT, .memory = {.usage = vkrc::MemoryUsage::readback}});
+    auto cmd = pool.allocate();
+    const vkrc::CommandRecorder& rec = cmd;
+    EXPECT_EQ(rec.vk(), cmd.vk());
+    EXPECT_EQ(&rec.fn(), &cmd.fn());
+    EXPECT_EQ(pool.use_count(), 2u);  // the recorder counts nothing
+    cmd.begin();
+    fill_through_recorder(cmd, target);
+    cmd.end();
+    auto fence = vkrc::Fence::create(device);
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    EXPECT_EQ(target.allocation().read_value<std::uint32_t>(0), 0x600df00du);
+    EXPECT_EQ(target.allocation().read_value<std::uint32_t>(12), 0x0ddba11u);
+}
+
+#if VKRC_RUNTIME_CHECKS
+// A default recorder, and the recorder part of a moved-from or reset()
+// CommandBuffer, hold no handle: recording through them throws UsageError
+// naming the call rather than reaching Vulkan with a stale handle.
+TEST_F(VulkanTest, EmptyRecordersThrowUsageError) {
+    auto expect_empty = [](auto call, const char* name) {
+        try {
+            call();
+            ADD_FAILURE() << name << " did not throw";
+        } catch (const vkrc::UsageError& e) {
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+        }
+    };
+    const vkrc::CommandRecorder none;
+    expect_empty([&] { none.draw(3); }, "vkrc::CommandBuffer::draw");
+    expect_empty([&] { none.set_line_width(1.0f); }, "vkrc::CommandBuffer::set_line_width");
+    expect_empty([&] { (void)none.vk(); }, "vkrc::CommandRecorder::vk");
+    expect_empty([&] { (void)none.fn(); }, "vkrc::CommandRecorder::fn");
+
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = pool.allocate();
+    const VkCommandBuffer raw = cmd.vk();
+    vkrc::CommandBuffer moved = std::move(cmd);
+    EXPECT_EQ(moved.vk(), raw);
+    expect_empty([&] { cmd.dispatch(1); }, "vkrc::CommandBuffer::dispatch");
+    expect_empty([&] { vkrc::CommandRecorder(cmd).dispatch(1); }, "vkrc::CommandBuffer::dispatch");
+    expect_empty([&] { (void)static_cast<const vkrc::CommandRecorder&>(cmd).vk(); }, "vkrc::CommandRecorder::vk");
+    cmd = std::move(moved);
+    EXPECT_EQ(cmd.vk(), raw);
+    expect_empty([&] { moved.fill_buffer(VK_NULL_HANDLE, 0, 4, 0); }, "vkrc::CommandBuffer::fill_buffer");
+    vkrc::CommandBuffer copy = cmd;
+    copy.reset();
+    expect_empty([&] { copy.end_rendering(); }, "vkrc::CommandBuffer::end_rendering");
+    EXPECT_EQ(cmd.vk(), raw);  // the reset dropped only copy's reference
+}
+#endif
 
 // A descriptor pool without FREE_DESCRIPTOR_SET_BIT reclaims sets only by reset.
 TEST_F(VulkanTest, DescriptorSetsOfAPoolWithoutFreeBit) {

@@ -1,7 +1,8 @@
-// Dynamic state of CommandBuffer (vkrc/command.hpp): the viewports,
-// scissors and the rest a pipeline leaves to the command buffer, each set
-// with its set_* method. A base of vkrc::CommandBuffer, included by
-// vkrc/command.hpp; call them on a CommandBuffer, as cmd.set_cull_mode(mode).
+// Dynamic state of CommandBuffer (vkrc/command.hpp): the viewports, scissors
+// and the rest a pipeline leaves to the command buffer, each set with its
+// set_* method. A base of vkrc::CommandRecorder (so of CommandBuffer),
+// included by vkrc/command.hpp; call them on a CommandBuffer, as
+// cmd.set_cull_mode(mode).
 //
 // bind_vertex_buffers2, whose strides may be dynamic, is beside
 // bind_vertex_buffers in vkrc/command.hpp. Inline, each one call through the
@@ -17,7 +18,7 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-// Self is the CommandBuffer: each method records through the table and the
+// Self is the CommandRecorder: each method records through the table and the
 // raw handle of Self::recording(*this, who), which checks it holds one.
 template <class Self>
 class DynamicStateCommands {

@@ -1,8 +1,8 @@
 // Query commands of CommandBuffer (vkrc/command.hpp): resets, timestamps,
 // occlusion and pipeline-statistics queries, and copies of their results,
 // into a QueryPool (vkrc/sync.hpp) or a raw VkQueryPool. A base of
-// vkrc::CommandBuffer, included by vkrc/command.hpp; call them on a
-// CommandBuffer, as cmd.write_timestamp(stage, pool, 0).
+// vkrc::CommandRecorder (so of CommandBuffer), included by vkrc/command.hpp;
+// call them on a CommandBuffer, as cmd.write_timestamp(stage, pool, 0).
 //
 // Inline, each one call through the device function table, as every
 // recording method.
@@ -14,7 +14,7 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-// Self is the CommandBuffer: each method records through the table and the
+// Self is the CommandRecorder: each method records through the table and the
 // raw handle of Self::recording(*this, who), which checks it holds one.
 template <class Self>
 class QueryCommands {

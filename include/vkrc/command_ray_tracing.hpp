@@ -1,9 +1,9 @@
 // Ray tracing commands of CommandBuffer (vkrc/command.hpp): acceleration
 // structure builds, copies and property queries, and trace_rays through a
-// ShaderBindingTable (vkrc/ray_tracing.hpp). A base of vkrc::CommandBuffer,
-// included by vkrc/command.hpp; call them on a CommandBuffer, as
-// cmd.trace_rays(table, width, height). Building whole structures:
-// vkrc/acceleration_structure.hpp.
+// ShaderBindingTable (vkrc/ray_tracing.hpp). A base of vkrc::CommandRecorder
+// (so of CommandBuffer), included by vkrc/command.hpp; call them on a
+// CommandBuffer, as cmd.trace_rays(table, width, height). Building whole
+// structures: vkrc/acceleration_structure.hpp.
 //
 // Inline, each one call through the device function table, as every
 // recording method.
@@ -18,7 +18,7 @@ VKRC_BEGIN_NAMESPACE
 
 namespace detail {
 
-// Self is the CommandBuffer: each method records through the table and the
+// Self is the CommandRecorder: each method records through the table and the
 // raw handle of Self::recording(*this, who), which checks it holds one.
 template <class Self>
 class RayTracingCommands {

@@ -1,7 +1,7 @@
 // Transfer commands of CommandBuffer (vkrc/command.hpp): copies, blits,
 // resolves, clears, fills and updates of buffers and images. A base of
-// vkrc::CommandBuffer, included by vkrc/command.hpp; call them on a
-// CommandBuffer, as cmd.copy_buffer(src, dst, regions).
+// vkrc::CommandRecorder (so of CommandBuffer), included by vkrc/command.hpp;
+// call them on a CommandBuffer, as cmd.copy_buffer(src, dst, regions).
 //
 // Layouts are the images' current ones (TRANSFER_SRC/DST_OPTIMAL or
 // GENERAL); regions are read during the call only. Inline, each one call
@@ -17,7 +17,7 @@ VKRC_BEGIN_NAMESPACE
 namespace detail {
 [[noreturn]] void throw_bad_update_buffer(VkDeviceSize offset, VkDeviceSize size);
 
-// Self is the CommandBuffer: each method records through the table and the
+// Self is the CommandRecorder: each method records through the table and the
 // raw handle of Self::recording(*this, who), which checks it holds one.
 template <class Self>
 class TransferCommands {

@@ -354,14 +354,19 @@ namespace detail {
 // VKRC_RUNTIME_CHECKS they throw UsageError naming the type and the call (so
 // they are not noexcept); without, the check compiles away and an empty
 // handle stays a precondition violation (recording stays one call).
+// VKRC_REQUIRE_RECORDER is the same check for a CommandRecorder, which has
+// its raw handle and no state.
 // clang-format off
 #if VKRC_RUNTIME_CHECKS
 #  define VKRC_UNCHECKED_NOEXCEPT
 #  define VKRC_REQUIRE_STATE(...) \
       if (!this->state_) [[unlikely]] ::vkrc::detail::throw_empty_handle(__VA_ARGS__)
+#  define VKRC_REQUIRE_RECORDER(...) \
+      if (!this->cmd_) [[unlikely]] ::vkrc::detail::throw_empty_handle(__VA_ARGS__)
 #else
 #  define VKRC_UNCHECKED_NOEXCEPT noexcept
 #  define VKRC_REQUIRE_STATE(...) static_cast<void>(0)
+#  define VKRC_REQUIRE_RECORDER(...) static_cast<void>(0)
 #endif
 // clang-format on
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The hot-path rule on the machine code, per recording method: checks each
 wrapper that gen_wrappers.py wrote (one per public recording method of
-CommandBuffer), compiled with -O2 -DNDEBUG (unchecked) into OBJECT.
+CommandRecorder, the recording part of CommandBuffer), compiled with -O2 -DNDEBUG (unchecked) into OBJECT.
 
 Usage: check_wrappers.py OBJDUMP OBJECT MANIFEST INCLUDE_DIR
 
@@ -9,7 +9,7 @@ First the coverage: the manifest the object was built from must list what
 the headers hold now (gen_wrappers.py run again), and a grep independent of
 that parser finds every vkCmd in the headers' code and fails unless it lies in
 a wrapped method (or a private helper the wrapped methods reach) of
-CommandBuffer or of one of the bases gen_wrappers.py reads its methods from.
+CommandRecorder or of one of the bases gen_wrappers.py reads its methods from.
 
 Then each wrapper, with what it reaches by direct call or jump inside the
 object (an inline method the compiler did not inline), must have:
@@ -55,7 +55,7 @@ EXCEPTIONS = {
     "hot_begin_render_pass": (1, 0, 26),
     # VkCopyAccelerationStructureInfoKHR built on the stack (17, 12): GCC
     # spends one register move more since the method moved to a class
-    # template (vkrc/command_ray_tracing.hpp); 16 as a member of CommandBuffer.
+    # template (vkrc/command_ray_tracing.hpp); 16 as a member of the class.
     "hot_copy_acceleration_structure": (1, 0, 19),
     # Up to 8 VkRenderingAttachmentInfo copied into a stack array in a loop,
     # the optional depth and stencil ones and VkRenderingInfo on the stack;

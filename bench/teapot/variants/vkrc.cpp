@@ -120,7 +120,7 @@ public:
     }
 
     // The barriers into the attachment layouts and the rendering's begin.
-    void begin_target(const vkrc::CommandBuffer& cmd, VkRenderingFlags flags) {
+    void begin_target(vkrc::CommandRecorder cmd, VkRenderingFlags flags) {
         const VkPipelineStageFlags2 depth_stages =
             VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
         const VkImageMemoryBarrier2 to_render[2] = {
@@ -150,8 +150,9 @@ public:
     // The state every draw needs, then the draws of range: the whole
     // command stage's draws into the primary, or one thread's slice into its
     // secondary (which inherits no state). Only reads shared members, so
-    // that threads may run it at once (no handle is copied).
-    void record_draws(const vkrc::CommandBuffer& cmd, const Frame& f, DrawRange range) const {
+    // that threads may run it at once (no handle is copied). The recorder by
+    // value keeps the table and the raw handle in registers across the draws.
+    void record_draws(vkrc::CommandRecorder cmd, const Frame& f, DrawRange range) const {
         cmd.bind_pipeline(pipeline_);
         cmd.set_viewport_and_scissor(frame_.extent);
         cmd.bind_descriptor_set(pipeline_, 0, f.set);
