@@ -160,9 +160,8 @@ public:
         const VkDeviceSize offsets[2] = {0, 0};
         cmd.bind_vertex_buffers(0, vertex_buffers, offsets);
         cmd.bind_index_buffer(indices_, 0, VK_INDEX_TYPE_UINT16);
-        const vkrc::PipelineLayout& layout = pipeline_.layout();
         for (std::size_t i = range.first; i < range.last; ++i) {
-            cmd.push_constants(layout, VK_SHADER_STAGE_VERTEX_BIT, draws_[i]);
+            cmd.push_constants(layout_, VK_SHADER_STAGE_VERTEX_BIT, draws_[i]);
             cmd.draw_indexed(index_count_);
         }
     }
@@ -415,11 +414,11 @@ private:
     void create_pipeline() {
         set_layout_ = vkrc::DescriptorSetLayout::create(
             device_, {.bindings = {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT}}});
-        vkrc::PipelineLayout layout = vkrc::PipelineLayout::create(
+        layout_ = vkrc::PipelineLayout::create(
             device_, {.set_layouts = {set_layout_},
                       .push_constant_ranges = {{VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof(PushConstants)}}});
         pipeline_ =
-            vkrc::GraphicsPipelineBuilder(layout)
+            vkrc::GraphicsPipelineBuilder(layout_)
                 .shader(VK_SHADER_STAGE_VERTEX_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_vert))
                 .shader(VK_SHADER_STAGE_FRAGMENT_BIT, vkrc::ShaderModule::create(device_, vkrc_shaders::teapot_frag))
                 .vertex_binding(0, sizeof(glm::vec3))
@@ -481,6 +480,10 @@ private:
     vkrc::ImageView depth_view_;
     VkExtent2D depth_extent_{};
     vkrc::DescriptorSetLayout set_layout_;
+    // Kept as raw C and vk::raii keep theirs (the pipeline keeps it alive
+    // too): the draw loop reads its handle from this variant, no pointer
+    // chase through the pipeline's state.
+    vkrc::PipelineLayout layout_;
     vkrc::GraphicsPipeline pipeline_;
     vkrc::DescriptorPool descriptor_pool_;
     std::vector<Frame> frames_;
