@@ -456,6 +456,8 @@ public:
     // reset(), which, as on every handle, drops this reference.
     void reset_commands(VkCommandBufferResetFlags flags = 0) const;
 
+    // A move empties other's recorder part with its state, so that recording
+    // through a moved-from CommandBuffer fails the same checks as an empty one.
     CommandBuffer(const CommandBuffer&) noexcept = default;
     CommandBuffer& operator=(const CommandBuffer&) noexcept = default;
     CommandBuffer(CommandBuffer&& other) noexcept
@@ -480,6 +482,7 @@ private:
     explicit CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept;
     void clear_recorder() noexcept { static_cast<CommandRecorder&>(*this) = CommandRecorder(); }
 };
+// The state, then the recorder's table and raw handle.
 static_assert(sizeof(CommandBuffer) == 3 * sizeof(void*));
 
 namespace detail {
