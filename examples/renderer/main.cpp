@@ -347,8 +347,10 @@ int run(const vkrc_examples::WindowOrHeadless& options) {
         vkrc::Sampler::create(device, {.mag_filter = VK_FILTER_NEAREST, .min_filter = VK_FILTER_NEAREST});
 
     // Both passes bind the same sets and buffers, then draw; the main pass
-    // does it in secondaries, which inherit no state from the primary.
-    auto record_draws = [&](const vkrc::CommandBuffer& cmd, const vkrc::GraphicsPipeline& pipeline, VkExtent2D extent,
+    // does it in secondaries, which inherit no state from the primary. The
+    // recorder by value keeps the table and the raw handle in registers
+    // across the draws (docs/guide.md, "Command recording").
+    auto record_draws = [&](vkrc::CommandRecorder cmd, const vkrc::GraphicsPipeline& pipeline, VkExtent2D extent,
                             std::uint32_t uniforms, std::span<const Draw> list) {
         cmd.bind_pipeline(pipeline);
         cmd.set_viewport_and_scissor(extent);
