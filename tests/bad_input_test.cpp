@@ -14,17 +14,8 @@
 
 namespace {
 
+using vkrc_test::expect_usage_error;
 using vkrc_test::VulkanTest;
-
-// Runs f, which must throw UsageError whose message contains every part.
-void expect_usage_error(const std::function<void()>& f, std::initializer_list<const char*> parts) {
-    try {
-        f();
-        ADD_FAILURE() << "no UsageError; expected one saying: " << *parts.begin();
-    } catch (const vkrc::UsageError& e) {
-        for (const char* part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-    }
-}
 
 TEST_F(VulkanTest, InvalidSpirvIsRejected) {
     expect_usage_error([&] { vkrc::ShaderModule::create(device, std::span<const std::uint32_t>()); },

@@ -3,7 +3,6 @@
 #include "shaders/fill_pattern.comp.h"
 
 #include <span>
-#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -133,34 +132,28 @@ TEST_F(VulkanTest, RecordingThroughACommandRecorderCopy) {
 // CommandBuffer, hold no handle: recording through them throws UsageError
 // naming the call rather than reaching Vulkan with a stale handle.
 TEST_F(VulkanTest, EmptyRecordersThrowUsageError) {
-    auto expect_empty = [](auto call, const char* name) {
-        try {
-            call();
-            ADD_FAILURE() << name << " did not throw";
-        } catch (const vkrc::UsageError& e) {
-            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
-        }
-    };
     const vkrc::CommandRecorder none;
-    expect_empty([&] { none.draw(3); }, "vkrc::CommandBuffer::draw");
-    expect_empty([&] { none.set_line_width(1.0f); }, "vkrc::CommandBuffer::set_line_width");
-    expect_empty([&] { (void)none.vk(); }, "vkrc::CommandRecorder::vk");
-    expect_empty([&] { (void)none.fn(); }, "vkrc::CommandRecorder::fn");
+    vkrc_test::expect_usage_error([&] { none.draw(3); }, {"vkrc::CommandBuffer::draw"});
+    vkrc_test::expect_usage_error([&] { none.set_line_width(1.0f); }, {"vkrc::CommandBuffer::set_line_width"});
+    vkrc_test::expect_usage_error([&] { (void)none.vk(); }, {"vkrc::CommandRecorder::vk"});
+    vkrc_test::expect_usage_error([&] { (void)none.fn(); }, {"vkrc::CommandRecorder::fn"});
 
     auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
     auto cmd = pool.allocate();
     const VkCommandBuffer raw = cmd.vk();
     vkrc::CommandBuffer moved = std::move(cmd);
     EXPECT_EQ(moved.vk(), raw);
-    expect_empty([&] { cmd.dispatch(1); }, "vkrc::CommandBuffer::dispatch");
-    expect_empty([&] { vkrc::CommandRecorder(cmd).dispatch(1); }, "vkrc::CommandBuffer::dispatch");
-    expect_empty([&] { (void)static_cast<const vkrc::CommandRecorder&>(cmd).vk(); }, "vkrc::CommandRecorder::vk");
+    vkrc_test::expect_usage_error([&] { cmd.dispatch(1); }, {"vkrc::CommandBuffer::dispatch"});
+    vkrc_test::expect_usage_error([&] { vkrc::CommandRecorder(cmd).dispatch(1); }, {"vkrc::CommandBuffer::dispatch"});
+    vkrc_test::expect_usage_error([&] { (void)static_cast<const vkrc::CommandRecorder&>(cmd).vk(); },
+                                  {"vkrc::CommandRecorder::vk"});
     cmd = std::move(moved);
     EXPECT_EQ(cmd.vk(), raw);
-    expect_empty([&] { moved.fill_buffer(VK_NULL_HANDLE, 0, 4, 0); }, "vkrc::CommandBuffer::fill_buffer");
+    vkrc_test::expect_usage_error([&] { moved.fill_buffer(VK_NULL_HANDLE, 0, 4, 0); },
+                                  {"vkrc::CommandBuffer::fill_buffer"});
     vkrc::CommandBuffer copy = cmd;
     copy.reset();
-    expect_empty([&] { copy.end_rendering(); }, "vkrc::CommandBuffer::end_rendering");
+    vkrc_test::expect_usage_error([&] { copy.end_rendering(); }, {"vkrc::CommandBuffer::end_rendering"});
     EXPECT_EQ(cmd.vk(), raw);  // the reset dropped only copy's reference
 }
 #endif

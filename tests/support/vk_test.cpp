@@ -155,6 +155,15 @@ void expect_no_validation_messages(ValidationLog& log) {
                                   << " validation message(s), first: " << (messages.empty() ? "" : messages.front());
 }
 
+void expect_usage_error(const std::function<void()>& f, std::initializer_list<const char*> parts) {
+    try {
+        f();
+        ADD_FAILURE() << "no UsageError; expected one saying: " << *parts.begin();
+    } catch (const vkrc::UsageError& e) {
+        for (const char* part : parts) EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+    }
+}
+
 }  // namespace vkrc_test
 
 #if defined(__SANITIZE_ADDRESS__)

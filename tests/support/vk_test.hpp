@@ -8,6 +8,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <initializer_list>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -123,5 +125,8 @@ private:
 
 // Asserts that log has no messages (prints them otherwise).
 void expect_no_validation_messages(ValidationLog& log);
+
+// Runs f, which must throw UsageError whose message contains every part.
+void expect_usage_error(const std::function<void()>& f, std::initializer_list<const char*> parts);
 
 }  // namespace vkrc_test
