@@ -150,8 +150,20 @@ std::size_t CommandPool::pending_free_count() const {
 CommandBuffer::CommandBuffer(detail::Ref<detail::CommandBufferState> state) noexcept
     : Handle(std::move(state)), CommandRecorder(state_->fn, state_->cmd) {}
 
-void detail::refuse_begin_of_secondary() {
-    Caller("vkrc::CommandBuffer::begin").refuse("a secondary command buffer needs begin_secondary");
+// Out of line, unlike end(): inlined, its begin info's stack address stayed
+// in a register through the caller's draw loop (GCC 12), which then kept the
+// loop's bound on the stack, one load per draw.
+void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
+    const detail::Caller caller{"vkrc::CommandBuffer::begin"};
+    VKRC_REQUIRE_STATE(caller.name());
+    auto& s = *state_;
+    caller.require(s.level == VK_COMMAND_BUFFER_LEVEL_PRIMARY, "a secondary command buffer needs begin_secondary");
+    const VkCommandBufferBeginInfo info{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                        .pNext = nullptr,
+                                        .flags = flags,
+                                        .pInheritanceInfo = nullptr};
+    check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
+    s.device().open_window(s.window, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
 }
 
 void CommandBuffer::begin_secondary(const CommandBufferInheritance& inheritance,

@@ -444,8 +444,8 @@ public:
     VkCommandBufferLevel level() const VKRC_UNCHECKED_NOEXCEPT;
 
     // vkBeginCommandBuffer for a primary. flags: ONE_TIME_SUBMIT (default) or
-    // SIMULTANEOUS_USE, or 0 to resubmit without overlap. Inline, as end()
-    // and CommandPool::reset_commands: a frame calls each once.
+    // SIMULTANEOUS_USE, or 0 to resubmit without overlap. end() and
+    // CommandPool::reset_commands are inline; begin() is not (src/command.cpp says why).
     void begin(VkCommandBufferUsageFlags flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) const;
     // vkBeginCommandBuffer for a secondary; RENDER_PASS_CONTINUE is added when
     // inheritance names a render pass or colour formats.
@@ -517,22 +517,7 @@ inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept 
     }
 }
 
-// begin() of a secondary command buffer: throws UsageError.
-[[noreturn]] void refuse_begin_of_secondary();
 }  // namespace detail
-
-inline void CommandBuffer::begin(VkCommandBufferUsageFlags flags) const {
-    VKRC_REQUIRE_STATE("vkrc::CommandBuffer::begin");
-    auto& s = *state_;
-    if (s.level != VK_COMMAND_BUFFER_LEVEL_PRIMARY) [[unlikely]]
-        detail::refuse_begin_of_secondary();
-    const VkCommandBufferBeginInfo info{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
-                                        .pNext = nullptr,
-                                        .flags = flags,
-                                        .pInheritanceInfo = nullptr};
-    check(fn_->vkBeginCommandBuffer(cmd_, &info), "vkBeginCommandBuffer");
-    s.device().open_window(s.window, (flags & VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT) != 0);
-}
 
 inline void CommandBuffer::end() const {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
