@@ -678,6 +678,13 @@ VkResult detail::DeviceState::finish_failed_call(VkResult r, const char* call) {
     return check(r, call);
 }
 
+void detail::DeviceState::fail_submit(VkResult r, FencedSubmission* fenced) {
+    if (fenced) fenced->queue = nullptr;
+    note_result(r);
+    collect();
+    throw_vk_error(r, "vkQueueSubmit2");
+}
+
 void Device::collect_garbage() const VKRC_UNCHECKED_NOEXCEPT {
     VKRC_REQUIRE_STATE("vkrc::Device::collect_garbage");
     state_->collect();

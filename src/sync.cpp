@@ -21,7 +21,7 @@ void destroy_submitted_fence(DeviceState& device, VkFence fence, std::uint64_t s
 }
 
 FenceState::~FenceState() {
-    if (in_flight && ownership == Ownership::owned) {
+    if (in_flight() && ownership == Ownership::owned) {
         destroy_submitted_fence(*device.state(), handle, serial());
     } else {
         destroy_owned<&DeviceFunctions::vkDestroyFence>(*this, device);

@@ -511,8 +511,9 @@ public:
 // (OpenCommandBuffers), whose held drops then wait for that submission.
 // Inline: a frame's submit closes one command buffer.
 inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept {
-    for (const CommandBuffer& c : command_buffers) {
-        auto& s = *c.state();
+    // By index: GCC then sees a one-element span's single iteration.
+    for (std::size_t i = 0; i < command_buffers.size(); ++i) {
+        auto& s = *command_buffers[i].state();
         if (s.window.one_time) s.device().close_window(s.window);
     }
 }

@@ -128,36 +128,28 @@ class FenceState final : public DeviceChildState<VkFence> {
 public:
     static constexpr const char* type_name = "vkrc::Fence";
     ~FenceState() override;
-    // Set by vkrc::submit: the fenced submission's queue and number. Once the
-    // fence is seen signalled, all work submitted on that queue up to it has
-    // completed (a fence signal covers everything before it in submission
-    // order), so deferred destructions waiting for it run at that wait. A
-    // fence reset without unsignal() (raw vkResetFences) must have been
-    // waited for first, so the record never claims work that is pending.
-    // Written only by submit and unsignal, which Vulkan already requires to
-    // be externally synchronised for the fence.
-    QueueState* queue = nullptr;
-    std::uint64_t submit_number = 0;
+    // Set by vkrc::submit (DeviceState::submit), kept until the fence is
+    // seen signalled or unsignal() resets it. A fence signal covers all work
+    // submitted before it on that queue, so deferred destructions waiting for
+    // it run at that wait. A fence reset without unsignal() (raw
+    // vkResetFences) must have been waited for first, so the record never
+    // claims work that is pending. Written only by submit, wait, status and
+    // unsignal, which Vulkan already requires to be externally synchronised
+    // for the fence.
+    FencedSubmission submission;
     // Submitted and not yet seen signalled: the queue timeline passing its
     // value does not mean the fence's own signal operation has completed,
     // so destruction then waits for the fence (see destroy_submitted_fence).
-    bool in_flight = false;
-    // vkrc::submit fenced submission number on queue with this fence.
-    void note_submitted(QueueState& submitted_queue, std::uint64_t number) noexcept {
-        queue = &submitted_queue;
-        submit_number = number;
-        in_flight = true;
-    }
+    bool in_flight() const noexcept { return submission.queue != nullptr; }
     // After a successful wait or status: records the submission as complete.
     void note_signalled() noexcept {
-        in_flight = false;
-        if (queue) queue->timeline.note_completed(submit_number);
+        if (QueueState* q = submission.queue) {
+            q->timeline.note_completed(submission.number);
+            submission.queue = nullptr;
+        }
     }
     // Fence::unsignal reset the fence: it stands for no submission any more.
-    void note_unsignalled() noexcept {
-        queue = nullptr;
-        in_flight = false;
-    }
+    void note_unsignalled() noexcept { submission.queue = nullptr; }
     // After vkWaitForFences or vkGetFenceStatus returned r: a signalled
     // fence is no longer in flight; then DeviceState::finish_call.
     VkResult finish_query(VkResult r, const char* call) {

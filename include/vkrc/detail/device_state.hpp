@@ -75,6 +75,13 @@ private:
     PolicyAtomic<std::uint64_t> completed_{0};
 };
 
+// The vkrc submission a fence was last submitted with (FenceState): its
+// queue (null: none, or seen signalled since) and its number there.
+struct FencedSubmission {
+    QueueState* queue = nullptr;
+    std::uint64_t number = 0;
+};
+
 class QueueState {
 public:
     VkQueue queue = VK_NULL_HANDLE;
@@ -180,9 +187,11 @@ public:
     std::uint64_t limit() noexcept;
     // Moves the entries no longer held to the deferred queue, in order.
     void release(DeviceState& device) noexcept;
-    // collect()'s safety net: release when a hold happened since the last release.
+    // collect()'s safety net: release when a hold happened since the last
+    // release (stale_ is set only with an entry held, so one load decides).
     void release_if_stale(DeviceState& device) noexcept {
-        if (held_count_.load(__ATOMIC_RELAXED) != 0 && stale_.load(__ATOMIC_RELAXED)) release(device);
+        if (stale_.load(__ATOMIC_RELAXED)) [[unlikely]]
+            release(device);
     }
     // Teardown: runs what is still held.
     void run_all(DeviceState& device) noexcept;
@@ -358,24 +367,37 @@ public:
 
     // ---- Queues' timelines
     // Queue::submit: submits under the queue's lock, signalling the queue's
-    // timeline when asked to, and returns the submission's number. Inline:
-    // vkrc::submit's frame loop reaches vkQueueSubmit2 without another call.
-    std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence) {
+    // timeline when asked to, and returns the submission's number; fenced,
+    // if given, receives the queue and number (vkrc::submit's fence).
+    // Inline: vkrc::submit's frame loop reaches vkQueueSubmit2 without
+    // another call. The submission is noted before the driver call, so that
+    // nothing of it is kept in a register across the call: other threads
+    // may see its number a moment early, which only makes what waits for
+    // it wait for this submission too. When the call fails the number stays
+    // used (a wait for it is met by any later signal) and fenced is cleared.
+    std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
+                         FencedSubmission* fenced = nullptr) {
         VkResult r;
         std::uint64_t number;
         {
             LockGuard lock(queue.mutex);
             number = queue.timeline.next_number();
+            if (fenced) *fenced = {&queue, number};
             if (!queue.timeline.signal_requested()) [[likely]] {
+                queue.timeline.note_submitted(number);
                 r = fn.vkQueueSubmit2(queue.queue, static_cast<std::uint32_t>(submits.size()), submits.data(), fence);
-                if (r == VK_SUCCESS) queue.timeline.note_submitted(number);
             } else {
                 r = submit_signalling(queue, submits, fence, number);
             }
         }
-        finish_call(r, "vkQueueSubmit2");
+        if (r < 0) [[unlikely]]
+            fail_submit(r, fenced);
+        collect();
         return number;
     }
+    // submit's failure r: clears fenced (if any), marks the device lost when
+    // r says so, runs the completed deferred actions and throws Error.
+    [[noreturn]] void fail_submit(VkResult r, FencedSubmission* fenced);
     // Under the queue's lock: submits with the queue's timeline signal of
     // number added (into the last batch when its signals fit on the stack,
     // else into one more batch, which submission order still places after all
