@@ -617,6 +617,43 @@ TEST(FaultInjection, RenderingGoesOnAfterACaughtOutOfDeviceMemory) {
     vkrc_test::expect_no_validation_messages(*log);
 }
 
+// A vkQueueSubmit2 that fails leaves its fence as it was: unsubmitted, so
+// the same fence is submitted again and waited for, and a fence dropped
+// after its failed submit is destroyed without waiting for a signal that
+// never comes (the watchdog catches that wait). The failed submit's number
+// stays unused: a buffer dropped after it is destroyed once the next
+// submission is seen complete.
+TEST(FaultInjection, AFailedSubmitLeavesItsFenceUnsubmitted) {
+    vkrc_test::Watchdog watchdog("a fence after a failed submit");
+    auto log = std::make_shared<vkrc_test::ValidationLog>();
+    faults::arm(0, VK_SUCCESS);
+    {
+        auto instance = vkrc::Instance::create(injected_instance_info(log));
+        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
+        auto device = vkrc::Device::create(physical);
+        auto queue = device.default_queue();
+        auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+        auto cmd = pool.allocate();
+        cmd.begin();
+        cmd.end();
+        auto fence = vkrc::Fence::create(device);
+        auto fail_submit = [&](const vkrc::Fence& f) {
+            faults::arm_function("vkQueueSubmit2", VK_ERROR_OUT_OF_HOST_MEMORY, false);
+            EXPECT_THROW(vkrc::submit(queue, {.command_buffers = vkrc::Span(&cmd, 1)}, f), vkrc::Error);
+            EXPECT_TRUE(faults::fired());
+            faults::arm(0, VK_SUCCESS);
+        };
+        fail_submit(vkrc::Fence::create(device));  // dropped at once
+        fail_submit(fence);
+        auto buffer = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        buffer.reset();
+        vkrc::submit(queue, {.command_buffers = vkrc::Span(&cmd, 1)}, fence);
+        EXPECT_EQ(fence.wait(), VK_SUCCESS);
+        EXPECT_EQ(device.deferred_count(), 0u) << "the buffer dropped after the failed submit";
+    }
+    vkrc_test::expect_no_validation_messages(*log);
+}
+
 // Device loss reported while the GPU is held busy: a copy waits behind a
 // gate only the host opens when the device is lost (without the injector
 // letting the work finish first). The fence wait, the queue and device

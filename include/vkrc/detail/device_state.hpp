@@ -373,8 +373,9 @@ public:
     // another call. The submission is noted before the driver call, so that
     // nothing of it is kept in a register across the call: other threads
     // may see its number a moment early, which only makes what waits for
-    // it wait for this submission too. When the call fails the number stays
-    // used (a wait for it is met by any later signal) and fenced is cleared.
+    // it wait for this submission too. When the call fails, fenced is
+    // cleared and the number stays used (a wait for it is met by any later
+    // signal; submit_signalling, the rare path, gives it back itself).
     std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
                          FencedSubmission* fenced = nullptr) {
         VkResult r;
