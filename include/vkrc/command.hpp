@@ -101,7 +101,7 @@ public:
     }
     // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
     // RenderingInfo::max_color_attachments colour attachments.
-    void begin_rendering(const RenderingInfo& info) const {
+    [[gnu::always_inline]] void begin_rendering(const RenderingInfo& info) const {
 #if VKRC_RUNTIME_CHECKS
         VKRC_REQUIRE_RECORDER("vkrc::CommandBuffer::begin_rendering");
         if (info.color_attachments.size() > RenderingInfo::max_color_attachments) [[unlikely]] {

@@ -376,7 +376,7 @@ public:
     // it wait for this submission too. When the call fails, fenced is
     // cleared and the number stays used (a wait for it is met by any later
     // signal; submit_signalling, the rare path, gives it back itself).
-    std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
+    [[gnu::always_inline]] std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
                          FencedSubmission* fenced = nullptr) {
         VkResult r;
         std::uint64_t number;
