@@ -44,7 +44,9 @@ device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
   echo "# date: $(date -u +%Y-%m-%dT%H:%MZ)"
   echo "# command: bench/instructions.sh TEAPOT CSV $*"
   echo "# git: $(bench_revision "$(dirname "$teapot")/..")"
-  echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$(dirname "$teapot")/../CMakeCache.txt" | cut -d= -f2 || true)"
+  cache="$(dirname "$teapot")/../CMakeCache.txt"
+  compiler=$(grep -s '^CMAKE_CXX_COMPILER:' "$cache" | cut -d= -f2 || true)
+  echo "# build: $(grep -s '^CMAKE_BUILD_TYPE:' "$cache" | cut -d= -f2 || true)${compiler:+, $("$compiler" --version | head -1)}"
 } >"$dumps/header"
 python3 - "$dumps" "$csv" "$source_dir/bench" <<'PY'
 import glob, os, sys
