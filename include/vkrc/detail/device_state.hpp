@@ -377,7 +377,7 @@ public:
     // cleared and the number stays used (a wait for it is met by any later
     // signal; submit_signalling, the rare path, gives it back itself).
     [[gnu::always_inline]] std::uint64_t submit(QueueState& queue, Span<const VkSubmitInfo2> submits, VkFence fence,
-                         FencedSubmission* fenced = nullptr) {
+                                                FencedSubmission* fenced = nullptr) {
         VkResult r;
         std::uint64_t number;
         {
