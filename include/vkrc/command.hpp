@@ -100,7 +100,8 @@ public:
         fn_->vkCmdEndRenderPass(cmd_);
     }
     // With VKRC_RUNTIME_CHECKS, throws UsageError for more than
-    // RenderingInfo::max_color_attachments colour attachments.
+    // RenderingInfo::max_color_attachments colour attachments. Always inline:
+    // clang 14 called it, about 100 instructions a frame more than raw C.
     [[gnu::always_inline]] void begin_rendering(const RenderingInfo& info) const {
 #if VKRC_RUNTIME_CHECKS
         VKRC_REQUIRE_RECORDER("vkrc::CommandBuffer::begin_rendering");
