@@ -53,6 +53,13 @@ vkrc::InstanceCreateInfo injected_instance_info(const std::shared_ptr<vkrc_test:
     return info;
 }
 
+// A device of the test's default requirements on an injected instance (the
+// device keeps the instance alive).
+vkrc::Device injected_device(const std::shared_ptr<vkrc_test::ValidationLog>& log) {
+    auto instance = vkrc::Instance::create(injected_instance_info(log));
+    return vkrc::Device::create(vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements()));
+}
+
 // Each of the four errors at every call (12 s in Debug, 19 s under ASan on
 // the 2-core CI machine); under ThreadSanitizer, slower still, call
 // k gets injected_errors[k % 4] so that every call is still covered once.
@@ -573,9 +580,7 @@ TEST(FaultInjection, RenderingGoesOnAfterACaughtOutOfDeviceMemory) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     faults::arm(0, VK_SUCCESS);
     {
-        auto instance = vkrc::Instance::create(injected_instance_info(log));
-        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
-        auto device = vkrc::Device::create(physical);
+        auto device = injected_device(log);
         ClearedFrames frames(device.default_queue());
         EXPECT_TRUE(frames.render({255, 0, 0, 255}));
 
@@ -628,9 +633,7 @@ TEST(FaultInjection, AFailedSubmitLeavesItsFenceUnsubmitted) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     faults::arm(0, VK_SUCCESS);
     {
-        auto instance = vkrc::Instance::create(injected_instance_info(log));
-        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
-        auto device = vkrc::Device::create(physical);
+        auto device = injected_device(log);
         auto queue = device.default_queue();
         auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
         auto cmd = pool.allocate();
@@ -666,9 +669,7 @@ TEST(FaultInjection, LossIsReportedWhileTheGpuIsHeldBusy) {
     auto log = std::make_shared<vkrc_test::ValidationLog>();
     faults::arm(0, VK_SUCCESS);
     {
-        auto instance = vkrc::Instance::create(injected_instance_info(log));
-        auto physical = vkrc::PhysicalDevice::select(instance, vkrc_test::test_device_requirements());
-        auto device = vkrc::Device::create(physical);
+        auto device = injected_device(log);
         auto queue = device.default_queue();
         const std::array<std::uint32_t, 4> values{3, 5, 7, 9};
         auto src = vkrc::Buffer::create(device, {.size = sizeof values,
