@@ -41,7 +41,9 @@ DescriptorSetState::~DescriptorSetState() {
     if (!free_set && refs.empty()) return;
     LockGuard lock(p.mutex);
     if (!refs.empty()) unlink_refs(p, *this);
-    if (free_set && p.generation == generation) p.pending.push(*p.device.state(), handle, serial());
+    if (free_set && p.generation == generation) {
+        p.pending.push(*p.device.state(), DroppedSet{handle, std::move(layout), variable_count}, serial());
+    }
 }
 
 // Resets the pool's sets: each one's references are moved to released (the
@@ -227,18 +229,49 @@ void check_variable_count(const detail::Caller& caller, const detail::Descriptor
 
 }  // namespace
 
-DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
-                                       std::uint32_t variable_descriptor_count) const {
-    const detail::Caller caller{"vkrc::DescriptorPool::allocate"};
-    caller.require_handle(layout, "the DescriptorSetLayout");
-    caller.require(layout.device() == device(), "the DescriptorSetLayout belongs to another device");
-    check_variable_count(caller, *layout.state(), variable_descriptor_count);
-    auto& p = *state_;
-    auto& d = *p.device.state();
-    detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
-    s->pool = *this;
-    s->layout = layout;
-    s->variable_count = variable_descriptor_count;
+namespace {
+
+// Under the pool's lock: gives s a reusable set of its layout and count,
+// the most recently dropped first, with that set's layout reference.
+bool reuse_dropped_set(detail::DescriptorPoolState& p, detail::DescriptorSetState& s,
+                       const DescriptorSetLayout& layout) noexcept {
+    for (std::size_t i = p.reusable.size(); i-- > 0;) {
+        detail::DroppedSet& dropped = p.reusable[i];
+        if (dropped.layout != layout || dropped.variable_count != s.variable_count) continue;
+        s.handle = dropped.handle;
+        s.layout = std::move(dropped.layout);
+        if (i + 1 != p.reusable.size()) dropped = std::move(p.reusable.back());
+        p.reusable.pop_back();
+        return true;
+    }
+    return false;
+}
+
+// Under the pool's lock: frees the reusable sets, all of them or only those
+// whose layout nothing else holds (no allocate can ask for them again).
+void free_reusable(detail::DescriptorPoolState& p, bool all) {
+    List<VkDescriptorSet> freed;
+    for (const auto& dropped : p.reusable) {
+        if (all || dropped.layout.use_count() == 1) freed.push_back(dropped.handle);
+    }
+    if (freed.empty()) return;
+    check(p.device.fn().vkFreeDescriptorSets(p.device.vk(), p.handle, static_cast<std::uint32_t>(freed.size()),
+                                             freed.data()),
+          "vkFreeDescriptorSets");
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < p.reusable.size(); ++i) {
+        if (all || p.reusable[i].layout.use_count() == 1) continue;
+        if (kept != i) p.reusable[kept] = std::move(p.reusable[i]);
+        ++kept;
+    }
+    p.reusable.resize(kept);
+}
+
+// Under the pool's lock: a new set from the driver. When the pool is out of
+// memory, the reusable sets are freed and the allocation tried once more.
+VkDescriptorSet allocate_set(detail::DescriptorPoolState& p, const DescriptorSetLayout& layout,
+                             std::uint32_t variable_descriptor_count) {
+    free_reusable(p, false);
     VkDescriptorSetLayout raw_layout = layout.vk();
     VkDescriptorSetVariableDescriptorCountAllocateInfo variable{
         VK_STRUCTURE_TYPE_DESCRIPTOR_SET_VARIABLE_DESCRIPTOR_COUNT_ALLOCATE_INFO};
@@ -249,15 +282,35 @@ DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
     ai.descriptorPool = p.handle;
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &raw_layout;
-    thread_local List<VkDescriptorSet> ready;
-    LockGuard lock(p.mutex);
-    ready.clear();
-    p.pending.take_ready(d, ready);
-    if (!ready.empty()) {
-        check(d.fn.vkFreeDescriptorSets(d.device, p.handle, static_cast<std::uint32_t>(ready.size()), ready.data()),
-              "vkFreeDescriptorSets");
+    const auto& fn = p.device.fn();
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    VkResult r = fn.vkAllocateDescriptorSets(p.device.vk(), &ai, &set);
+    if ((r == VK_ERROR_OUT_OF_POOL_MEMORY || r == VK_ERROR_FRAGMENTED_POOL) && !p.reusable.empty()) {
+        free_reusable(p, true);
+        r = fn.vkAllocateDescriptorSets(p.device.vk(), &ai, &set);
     }
-    check(d.fn.vkAllocateDescriptorSets(d.device, &ai, &s->handle), "vkAllocateDescriptorSets");
+    check(r, "vkAllocateDescriptorSets");
+    return set;
+}
+
+}  // namespace
+
+DescriptorSet DescriptorPool::allocate(const DescriptorSetLayout& layout,
+                                       std::uint32_t variable_descriptor_count) const {
+    const detail::Caller caller{"vkrc::DescriptorPool::allocate"};
+    caller.require_handle(layout, "the DescriptorSetLayout");
+    caller.require(layout.device() == device(), "the DescriptorSetLayout belongs to another device");
+    check_variable_count(caller, *layout.state(), variable_descriptor_count);
+    auto& p = *state_;
+    detail::Ref<detail::DescriptorSetState> s(new detail::DescriptorSetState);
+    s->pool = *this;
+    s->variable_count = variable_descriptor_count;
+    LockGuard lock(p.mutex);
+    if (!p.pending.empty()) p.pending.take_ready(*p.device.state(), p.reusable);
+    if (!reuse_dropped_set(p, *s, layout)) {
+        s->handle = allocate_set(p, layout, variable_descriptor_count);
+        s->layout = layout;
+    }
     s->generation = p.generation;
     return DescriptorSet(std::move(s));
 }
@@ -287,6 +340,7 @@ void DescriptorPool::reset_sets() const {
     LockGuard lock(p.mutex);
     check(p.device.fn().vkResetDescriptorPool(p.device.vk(), p.handle, 0), "vkResetDescriptorPool");
     p.pending.clear();
+    p.reusable.clear();
     ++p.generation;
     detail::release_set_refs(p, released);
 }

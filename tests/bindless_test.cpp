@@ -220,4 +220,19 @@ TEST_F(VulkanTest, BindlessMisuseIsAUsageError) {
     }
 }
 
+// A dropped variable-count set is handed out again only for its own count.
+TEST_F(VulkanTest, DroppedVariableCountSetsAreReusedForTheirCount) {
+    if (auto missing = missing_bindless_features(physical_device); !missing.empty())
+        GTEST_SKIP() << "the device lacks descriptor indexing features: " << missing;
+    device = bindless_device(physical_device);
+    queue = device.default_queue();
+    auto set_layout = bindless_layout(device);
+    auto pool = bindless_pool(device);
+    vkrc_test::CountSetCalls calls(device);
+    const VkDescriptorSet sixteen = pool.allocate(set_layout, 16).vk();
+    EXPECT_NE(pool.allocate(set_layout, 32).vk(), sixteen);
+    EXPECT_EQ(pool.allocate(set_layout, 16).vk(), sixteen);
+    EXPECT_EQ(calls.allocated(), 2);
+}
+
 }  // namespace

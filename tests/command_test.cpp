@@ -187,6 +187,79 @@ TEST_F(VulkanTest, FreedDescriptorSetsReturnToTheirPool) {
     }
 }
 
+vkrc::DescriptorSetLayout storage_set_layout(const vkrc::Device& device) {
+    return vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}});
+}
+
+// A set dropped from a FREE_DESCRIPTOR_SET pool is handed out again by an
+// allocate of its layout, with no driver call, once the GPU is done with
+// the work submitted before the drop.
+TEST_F(VulkanTest, DroppedDescriptorSetsAreReusedOnceTheGpuIsDone) {
+    auto layout = storage_set_layout(device);
+    auto other = storage_set_layout(device);  // the same bindings, another layout
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 4, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 4}}});
+    auto buffer = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT});
+    vkrc_test::CountSetCalls calls(device);
+    VkDescriptorSet first = VK_NULL_HANDLE;
+    for (int i = 0; i < 4; ++i) {
+        auto set = pool.allocate(layout);
+        if (i == 0) first = set.vk();
+        EXPECT_EQ(set.vk(), first);
+        set.write_buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, buffer);
+    }
+    EXPECT_EQ(calls.allocated(), 1);
+    EXPECT_EQ(layout.use_count(), 2u) << "the dropped set keeps its layout";
+    EXPECT_NE(pool.allocate(other).vk(), first);
+    EXPECT_EQ(calls.allocated(), 2);
+
+    vkrc_test::GpuGate gate(device);
+    auto fence = vkrc::Fence::create(device);
+    auto command_pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = command_pool.allocate();
+    {
+        auto set = pool.allocate(layout);
+        EXPECT_EQ(set.vk(), first);
+        cmd.begin();
+        cmd.end();
+        gate.submit(queue, cmd, fence);
+    }
+    EXPECT_EQ(pool.pending_free_count(), 1u);
+    EXPECT_NE(pool.allocate(layout).vk(), first) << "a set reused while the GPU may still use it";
+    EXPECT_EQ(calls.allocated(), 3);
+    gate.open();
+    ASSERT_EQ(fence.wait(), VK_SUCCESS);
+    auto one = pool.allocate(layout);
+    auto two = pool.allocate(layout);
+    EXPECT_EQ(pool.pending_free_count(), 0u);
+    EXPECT_EQ(calls.allocated(), 3);
+    EXPECT_EQ(calls.freed(), 0);
+}
+
+// A full pool gives back its dropped sets: when vkAllocateDescriptorSets
+// refuses, all of them; before it is called, those whose layout is gone.
+TEST_F(VulkanTest, AFullDescriptorPoolFreesItsDroppedSets) {
+    auto layout = storage_set_layout(device);
+    auto other = storage_set_layout(device);
+    auto pool =
+        vkrc::DescriptorPool::create(device, {.max_sets = 1, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}}});
+    vkrc_test::CountSetCalls calls(device, 1);
+    pool.allocate(layout);
+    EXPECT_NE(pool.allocate(other).vk(), VK_NULL_HANDLE);
+    EXPECT_EQ(calls.refused(), 1) << "the dropped set of layout was kept for it";
+    EXPECT_EQ(calls.freed(), 1);
+    EXPECT_EQ(layout.use_count(), 1u);
+
+    other.reset();  // its dropped set now holds the last reference
+    EXPECT_NE(pool.allocate(layout).vk(), VK_NULL_HANDLE);
+    EXPECT_EQ(calls.refused(), 1) << "a set of a layout no one can ask for again was kept";
+    EXPECT_EQ(calls.freed(), 2);
+
+    pool.reset_sets();  // a reset drops the dropped sets with the rest
+    EXPECT_EQ(layout.use_count(), 1u);
+}
+
 // Secondaries recorded in parallel, one pool per thread, executed by one
 // primary. Under the multi-thread policy they are also dropped on their threads.
 TEST_F(VulkanTest, SecondariesFromFourThreads) {

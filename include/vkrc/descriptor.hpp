@@ -62,8 +62,9 @@ private:
 };
 
 // Mirrors VkDescriptorPoolCreateInfo. With VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT
-// a dropped set returns to the pool once the GPU is done with it; without it
-// sets are reclaimed only by reset_sets() or the pool's destruction.
+// a dropped set returns to the pool once the GPU is done with it (see
+// DescriptorPool::allocate); without it sets are reclaimed only by
+// reset_sets() or the pool's destruction.
 struct DescriptorPoolCreateInfo {
     // Optional (default: sets freed one by one, see above). Flags you set
     // replace the default, as Vulkan's field is replaced (a pool without
@@ -96,11 +97,18 @@ public:
     // VARIABLE_DESCRIPTOR_COUNT, how many descriptors the set's binding gets
     // (at most its descriptor_count; VkDescriptorSetVariableDescriptorCountAllocateInfo).
     // Must be 0 for other layouts (UsageError otherwise).
+    // With FREE_DESCRIPTOR_SET, a set dropped earlier with the same layout and
+    // count whose GPU work is done is handed out again, with no driver call
+    // (its descriptors are as last written, as a new set's are undefined).
+    // Dropped sets are freed when vkAllocateDescriptorSets finds the pool out
+    // of memory (then allocation is tried once more), when their layout is
+    // held by nothing else, and by reset_sets(); a dropped set keeps its
+    // layout alive until then.
     DescriptorSet allocate(const DescriptorSetLayout& layout, std::uint32_t variable_descriptor_count = 0) const;
     // vkResetDescriptorPool: every set allocated from it becomes invalid (its
     // handle may still be dropped). The caller ensures the GPU no longer uses them.
     void reset_sets() const;
-    // Sets dropped while the GPU may use them, not yet returned to the pool.
+    // Sets dropped while the GPU may use them, not yet reusable or freed.
     std::size_t pending_free_count() const;
 
 private:
@@ -199,15 +207,27 @@ struct DescriptorRefs {
 };
 class DescriptorSetState;
 
+// A set dropped from a FREE_DESCRIPTOR_SET pool, kept for an allocate() of
+// the same layout and variable count. The set's reference to its layout
+// moves with it, so reusing the set writes nothing on the layout, which
+// threads allocating from pools of their own share.
+struct DroppedSet {
+    VkDescriptorSet handle = VK_NULL_HANDLE;
+    DescriptorSetLayout layout;
+    std::uint32_t variable_count = 0;
+};
+
 class DescriptorPoolState final : public DeviceChildState<VkDescriptorPool> {
 public:
     static constexpr const char* type_name = "vkrc::DescriptorPool";
     ~DescriptorPoolState() override;
     bool can_free_sets = false;
     mutable Mutex mutex;
-    // Under mutex: sets dropped while in use, and how many resets happened
-    // (a set from before a reset is already gone).
-    PoolFreeList<VkDescriptorSet> pending;
+    // Under mutex: sets dropped while the GPU may use them; those it is done
+    // with, kept for reuse (freed when the pool runs out); and how many
+    // resets happened (a set from before a reset is already gone).
+    PoolFreeList<DroppedSet> pending;
+    List<DroppedSet> reusable;
     std::uint64_t generation = 0;
     // Under mutex: the sets that hold references, released by reset_sets().
     DescriptorSetState* sets_with_refs = nullptr;

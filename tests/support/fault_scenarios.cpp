@@ -128,8 +128,11 @@ ScenarioResult run_compute_scenario(const vkrc::InstanceCreateInfo& info) {
     vkrc::set_name(device, out, "compute output");
     auto pool =
         vkrc::DescriptorPool::create(device, {.max_sets = 2, .pool_sizes = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}}});
+    // A set dropped at once with its layout, which nothing else holds: the
+    // next allocate, finding no set of its own layout to reuse, frees it.
+    pool.allocate(vkrc::DescriptorSetLayout::create(
+        device, {.bindings = {{.binding = 0, .descriptor_type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}}}));
     auto set = pool.allocate(set_layout);
-    pool.allocate(set_layout);  // dropped at once: freed by the next allocate
     auto update = vkrc::DescriptorUpdateTemplate::create(
         device, {.entries = {{0, 0, 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0, sizeof(VkDescriptorBufferInfo)}},
                  .descriptor_set_layout = set_layout});

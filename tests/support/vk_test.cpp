@@ -149,6 +149,51 @@ void GpuGate::submit(const vkrc::Queue& queue, const vkrc::CommandBuffer& cmd, c
     vkrc::submit(queue, {.waits = std::span(&gate, 1), .command_buffers = std::span(&cmd, 1)}, fence);
 }
 
+namespace {
+struct SetCalls {
+    int allocated = 0;
+    int refused = 0;
+    int freed = 0;
+    int capacity = 0;
+    PFN_vkAllocateDescriptorSets real_allocate = nullptr;
+    PFN_vkFreeDescriptorSets real_free = nullptr;
+} set_calls;
+
+VKAPI_ATTR VkResult VKAPI_CALL counting_allocate_sets(VkDevice device, const VkDescriptorSetAllocateInfo* info,
+                                                      VkDescriptorSet* sets) {
+    const int count = static_cast<int>(info->descriptorSetCount);
+    if (set_calls.allocated - set_calls.freed + count > set_calls.capacity) {
+        ++set_calls.refused;
+        return VK_ERROR_OUT_OF_POOL_MEMORY;
+    }
+    const VkResult r = set_calls.real_allocate(device, info, sets);
+    if (r == VK_SUCCESS) set_calls.allocated += count;
+    return r;
+}
+
+VKAPI_ATTR VkResult VKAPI_CALL counting_free_sets(VkDevice device, VkDescriptorPool pool, std::uint32_t count,
+                                                  const VkDescriptorSet* sets) {
+    set_calls.freed += static_cast<int>(count);
+    return set_calls.real_free(device, pool, count, sets);
+}
+}  // namespace
+
+CountSetCalls::CountSetCalls(const vkrc::Device& device, int capacity) : fn_(device.state()->fn) {
+    set_calls = {
+        .capacity = capacity, .real_allocate = fn_.vkAllocateDescriptorSets, .real_free = fn_.vkFreeDescriptorSets};
+    fn_.vkAllocateDescriptorSets = counting_allocate_sets;
+    fn_.vkFreeDescriptorSets = counting_free_sets;
+}
+
+CountSetCalls::~CountSetCalls() {
+    fn_.vkAllocateDescriptorSets = set_calls.real_allocate;
+    fn_.vkFreeDescriptorSets = set_calls.real_free;
+}
+
+int CountSetCalls::allocated() const { return set_calls.allocated; }
+int CountSetCalls::refused() const { return set_calls.refused; }
+int CountSetCalls::freed() const { return set_calls.freed; }
+
 void expect_no_validation_messages(ValidationLog& log) {
     const auto messages = log.take();
     EXPECT_TRUE(messages.empty()) << messages.size()

@@ -123,6 +123,24 @@ private:
     vkrc::Semaphore semaphore_;
 };
 
+// Counts a device's descriptor set allocations and frees, through its
+// function table, while it lives; with a capacity, vkAllocateDescriptorSets
+// refuses sets beyond it (VK_ERROR_OUT_OF_POOL_MEMORY), as a full pool does
+// (lavapipe's pools never run out). One at a time.
+class CountSetCalls {
+public:
+    explicit CountSetCalls(const vkrc::Device& device, int capacity = 1 << 30);
+    CountSetCalls(const CountSetCalls&) = delete;
+    CountSetCalls& operator=(const CountSetCalls&) = delete;
+    ~CountSetCalls();
+    int allocated() const;  // sets the driver allocated
+    int refused() const;    // allocations refused for the capacity
+    int freed() const;      // sets freed
+
+private:
+    vkrc::DeviceFunctions& fn_;
+};
+
 // Asserts that log has no messages (prints them otherwise).
 void expect_no_validation_messages(ValidationLog& log);
 

@@ -74,6 +74,8 @@ public:
         new (data_ + size_) T(moves::move(item));
         return data_[size_++];
     }
+    // Drops the last element; the list must not be empty.
+    void pop_back() noexcept { data_[--size_].~T(); }
     // Appends copies of count items.
     void append(const T* items, std::size_t count) { append_copies(items, count); }
     // Grows with value-initialised elements or drops the last ones; keeps the storage.

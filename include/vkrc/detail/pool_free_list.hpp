@@ -3,9 +3,11 @@
 // vkFreeCommandBuffers / vkFreeDescriptorSets need the pool alive and
 // externally synchronised, which a reference-free DeferredAction cannot
 // guarantee. So a dying child's handle goes onto its pool's list, tagged with
-// the values submitted so far on every queue; the pool frees the completed
-// ones under its own lock at its next allocate/reset/begin, and destroying the
-// pool (itself deferred) frees whatever is left.
+// the values submitted so far on every queue; the pool frees (or, for
+// descriptor sets, reuses) the completed ones under its own lock at its next
+// allocate/reset/begin, and destroying the pool (itself deferred) frees
+// whatever is left. Entry: the raw handle, or a struct holding it and what
+// the pool keeps with it; entries are moved, never copied.
 #pragma once
 
 #include "vkrc/device.hpp"
@@ -15,25 +17,25 @@
 VKRC_BEGIN_NAMESPACE
 namespace detail {
 
-template <class VkHandle>
+template <class Entry>
 class PoolFreeList {
 public:
     // Caller holds the pool's lock. serial: the dying child's. Never throws:
-    // on allocation failure the handle is left to the pool's destruction,
-    // which frees it anyway.
-    void push(DeviceState& device, VkHandle handle, std::uint64_t serial) noexcept {
+    // on allocation failure the entry is dropped and its handle left to the
+    // pool's destruction, which frees it anyway.
+    void push(DeviceState& device, Entry entry, std::uint64_t serial) noexcept {
         try {
             // An open command buffer may still refer to it (OpenCommandBuffers).
             if (device.held_back(serial)) {
-                held_.push_back(Held{handle, serial});
+                held_.push_back(Held{moves::move(entry), serial});
                 return;
             }
-            push_now(device, handle);
+            push_now(device, entry);
         } catch (...) {}
     }
-    // Caller holds the pool's lock. Moves the handles whose GPU work has
-    // completed into out, in the order they were pushed.
-    void take_ready(DeviceState& device, List<VkHandle>& out) {
+    // Caller holds the pool's lock. Moves the entries whose GPU work has
+    // completed to the end of out, in the order they were pushed.
+    void take_ready(DeviceState& device, List<Entry>& out) {
         if (!held_.empty()) release_held(device);
         std::size_t ready = 0, handles = 0;
         for (; ready < batches_.size() && device.reached(batches_[ready].wait_values); ++ready) {
@@ -41,7 +43,9 @@ public:
         }
         // The only allocation comes first, so a failure leaves the queue as it was.
         out.reserve(out.size() + handles);
-        for (std::size_t i = 0; i < ready; ++i) out.append(batches_[i].handles.data(), batches_[i].handles.size());
+        for (std::size_t i = 0; i < ready; ++i) {
+            for (Entry& entry : batches_[i].handles) out.push_back(moves::move(entry));
+        }
         batches_.erase_front(ready);
     }
     bool empty() const noexcept { return batches_.empty() && held_.empty(); }
@@ -58,16 +62,19 @@ public:
 private:
     struct Batch {
         List<std::uint64_t> wait_values;
-        List<VkHandle> handles;
+        List<Entry> handles;
     };
     struct Held {
-        VkHandle handle;
+        Entry entry;
         std::uint64_t serial;
     };
-    void push_now(DeviceState& device, VkHandle handle) {
+    // Moves entry in, or leaves it as it was when out of host memory.
+    void push_now(DeviceState& device, Entry& entry) {
         device.submitted_snapshot(scratch_);
         if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
-        batches_.back().handles.push_back(handle);
+        List<Entry>& handles = batches_.back().handles;
+        handles.reserve(handles.size() + 1);
+        handles.push_back(moves::move(entry));
     }
     // The held handles no open command buffer refers to any more wait for
     // the work submitted so far, like a fresh drop; the others stay, in order.
@@ -77,11 +84,12 @@ private:
         for (std::size_t i = 0; i < held_.size(); ++i) {
             try {
                 if (held_[i].serial >= limit) {
-                    push_now(device, held_[i].handle);
+                    push_now(device, held_[i].entry);
                     continue;
                 }
             } catch (...) {}  // out of host memory: stays held until a later try
-            held_[kept++] = held_[i];
+            if (kept != i) held_[kept] = moves::move(held_[i]);
+            ++kept;
         }
         held_.resize(kept);
     }
