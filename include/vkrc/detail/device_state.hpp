@@ -427,6 +427,13 @@ public:
     // whether the GPU has completed the work they stand for.
     void submitted_snapshot(List<std::uint64_t>& out);
     bool reached(Span<const std::uint64_t> snapshot) noexcept;
+    // Whether that work is known complete without asking the GPU: no call.
+    bool known_reached(Span<const std::uint64_t> snapshot) const noexcept {
+        for (std::size_t i = 0; i < snapshot.size() && i < queues.size(); ++i) {
+            if (queues[i].timeline.completed() < snapshot[i]) return false;
+        }
+        return true;
+    }
     // Reads the queues' timelines; true when everything submitted has completed.
     bool idle_now() noexcept;
 

@@ -34,27 +34,30 @@ public:
         } catch (...) {}
     }
     // Caller holds the pool's lock. Moves the entries whose GPU work has
-    // completed to the end of out, in the order they were pushed.
+    // completed to the end of out.
     void take_ready(DeviceState& device, List<Entry>& out) {
         if (!held_.empty()) release_held(device);
-        std::size_t ready = 0, handles = 0;
+        std::size_t ready = 0, handles = ready_.size();
         for (; ready < batches_.size() && device.reached(batches_[ready].wait_values); ++ready) {
             handles += batches_[ready].handles.size();
         }
         // The only allocation comes first, so a failure leaves the queue as it was.
         out.reserve(out.size() + handles);
+        for (Entry& entry : ready_) out.push_back(moves::move(entry));
+        ready_.clear();
         for (std::size_t i = 0; i < ready; ++i) {
             for (Entry& entry : batches_[i].handles) out.push_back(moves::move(entry));
         }
         batches_.erase_front(ready);
     }
-    bool empty() const noexcept { return batches_.empty() && held_.empty(); }
+    bool empty() const noexcept { return ready_.empty() && batches_.empty() && held_.empty(); }
     std::size_t size() const noexcept {
-        std::size_t n = held_.size();
+        std::size_t n = ready_.size() + held_.size();
         for (auto& b : batches_) n += b.handles.size();
         return n;
     }
     void clear() noexcept {
+        ready_.clear();
         batches_.clear();
         held_.clear();
     }
@@ -68,13 +71,18 @@ private:
         Entry entry;
         std::uint64_t serial;
     };
-    // Moves entry in, or leaves it as it was when out of host memory.
+    // Moves entry in, or leaves it as it was when out of host memory. When
+    // the work it waits for is already known complete (nothing in flight), it
+    // is ready at once: no batch is made for it, nor freed for it later.
     void push_now(DeviceState& device, Entry& entry) {
         device.submitted_snapshot(scratch_);
-        if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
-        List<Entry>& handles = batches_.back().handles;
-        handles.reserve(handles.size() + 1);
-        handles.push_back(moves::move(entry));
+        List<Entry>* handles = &ready_;
+        if (!device.known_reached(scratch_)) {
+            if (batches_.empty() || batches_.back().wait_values != scratch_) batches_.push_back(Batch{scratch_, {}});
+            handles = &batches_.back().handles;
+        }
+        handles->reserve(handles->size() + 1);
+        handles->push_back(moves::move(entry));
     }
     // The held handles no open command buffer refers to any more wait for
     // the work submitted so far, like a fresh drop; the others stay, in order.
@@ -93,6 +101,7 @@ private:
         }
         held_.resize(kept);
     }
+    List<Entry> ready_;  // pushed when their work was already complete
     List<Batch> batches_;
     List<Held> held_;
     List<std::uint64_t> scratch_;
