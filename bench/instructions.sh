@@ -40,7 +40,12 @@ source "$source_dir/bench/run_header.sh"
 device=$(awk -F': ' '/^device: / {print $2; exit}' "$dumps/log")
 {
   echo "# device: ${device:-${DEVICE:-unknown}}"
-  echo "# driver: $(dpkg-query -W -f='mesa-vulkan-drivers ${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+  # The NVIDIA driver where one is installed (a run on the device machine), else lavapipe's package.
+  if command -v nvidia-smi >/dev/null 2>&1; then
+    echo "# driver: $(bench_driver)"
+  else
+    echo "# driver: $(dpkg-query -W -f='mesa-vulkan-drivers ${Version}' mesa-vulkan-drivers 2>/dev/null || echo unknown)"
+  fi
   echo "# date: $(date -u +%Y-%m-%dT%H:%MZ)"
   echo "# command: bench/instructions.sh TEAPOT CSV $*"
   echo "# git: $(bench_revision "$(dirname "$teapot")/..")"
