@@ -248,23 +248,27 @@ bool reuse_dropped_set(detail::DescriptorPoolState& p, detail::DescriptorSetStat
 }
 
 // Under the pool's lock: frees the reusable sets, all of them or only those
-// whose layout nothing else holds (no allocate can ask for them again).
+// whose layout nothing else holds (no allocate can ask for them again). Each
+// is judged once: under vkrc::mt another holder of a layout may drop it
+// meanwhile. Should the free fail, the sets stay allocated until the pool's
+// reset or destruction.
 void free_reusable(detail::DescriptorPoolState& p, bool all) {
     List<VkDescriptorSet> freed;
-    for (const auto& dropped : p.reusable) {
-        if (all || dropped.layout.use_count() == 1) freed.push_back(dropped.handle);
-    }
-    if (freed.empty()) return;
-    check(p.device.fn().vkFreeDescriptorSets(p.device.vk(), p.handle, static_cast<std::uint32_t>(freed.size()),
-                                             freed.data()),
-          "vkFreeDescriptorSets");
+    freed.reserve(p.reusable.size());  // the only allocation, before anything changes
     std::size_t kept = 0;
     for (std::size_t i = 0; i < p.reusable.size(); ++i) {
-        if (all || p.reusable[i].layout.use_count() == 1) continue;
+        if (all || p.reusable[i].layout.use_count() == 1) {
+            freed.push_back(p.reusable[i].handle);
+            continue;
+        }
         if (kept != i) p.reusable[kept] = std::move(p.reusable[i]);
         ++kept;
     }
     p.reusable.resize(kept);
+    if (freed.empty()) return;
+    check(p.device.fn().vkFreeDescriptorSets(p.device.vk(), p.handle, static_cast<std::uint32_t>(freed.size()),
+                                             freed.data()),
+          "vkFreeDescriptorSets");
 }
 
 // Under the pool's lock: a new set from the driver. When the pool is out of
