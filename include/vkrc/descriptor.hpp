@@ -101,9 +101,9 @@ public:
     // count whose GPU work is done is handed out again, with no driver call
     // (its descriptors are as last written, as a new set's are undefined).
     // Dropped sets are freed when vkAllocateDescriptorSets finds the pool out
-    // of memory (then allocation is tried once more), when their layout is
-    // held by nothing else, and by reset_sets(); a dropped set keeps its
-    // layout alive until then.
+    // of memory (then allocation is tried once more), before an allocation
+    // that reuses none when nothing else holds their layout, and by
+    // reset_sets(); a dropped set keeps its layout alive until then.
     DescriptorSet allocate(const DescriptorSetLayout& layout, std::uint32_t variable_descriptor_count = 0) const;
     // vkResetDescriptorPool: every set allocated from it becomes invalid (its
     // handle may still be dropped). The caller ensures the GPU no longer uses them.
