@@ -53,10 +53,35 @@ void fill_budget(DeviceView device, AllocatorStatistics& stats) noexcept {
 
 namespace detail {
 
+namespace {
+// choose_memory_type for request, remembered: its answer depends only on
+// the device's memory properties and these inputs, and a program allocates
+// many resources of few kinds. One answer per thread (no lock), keyed by the
+// device's process-unique id; a refusal is not kept.
+std::uint32_t memory_type_for(const Caller& caller, DeviceView device, const AllocationRequest& request) {
+    struct Question {
+        std::uint64_t device_id = 0;  // 0: empty
+        std::uint32_t type_bits = 0;
+        MemoryUsage usage{};
+        VkMemoryPropertyFlags required = 0;
+        VkMemoryPropertyFlags preferred = 0;
+        bool operator==(const Question&) const = default;
+    };
+    thread_local Question last;
+    thread_local std::uint32_t last_type = 0;
+    const MemoryIntent& intent = request.intent;
+    const Question q{device.state().id, request.requirements.memoryTypeBits, intent.usage, intent.required_flags,
+                     intent.preferred_flags};
+    if (q == last) return last_type;
+    last_type = choose_memory_type(device.memory_properties(), q.type_bits, intent, caller.name());
+    last = q;
+    return last_type;
+}
+}  // namespace
+
 std::uint32_t checked_memory_type(const Caller& caller, DeviceView device, const AllocationRequest& request) {
     const auto& props = device.memory_properties();
-    const std::uint32_t type =
-        choose_memory_type(props, request.requirements.memoryTypeBits, request.intent, caller.name());
+    const std::uint32_t type = memory_type_for(caller, device, request);
     caller.require(request.requirements.size != 0, "size is 0");
     caller.require(request.dedicated_buffer == VK_NULL_HANDLE || request.dedicated_image == VK_NULL_HANDLE,
                    "both dedicated_buffer and dedicated_image are set");
