@@ -3,6 +3,7 @@
 #include "vkrc/memory.hpp"
 
 #include "memory_internal.hpp"
+#include "recent_answers.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -57,7 +58,7 @@ namespace {
 // choose_memory_type for request, remembered: its answer depends only on
 // the device's memory properties and these inputs, and a program allocates
 // many resources of few kinds. One answer per thread (no lock), keyed by the
-// device's process-unique id; a refusal is not kept.
+// device's process-unique id (RecentAnswers); a refusal is not kept.
 std::uint32_t memory_type_for(const Caller& caller, DeviceView device, const AllocationRequest& request) {
     struct Question {
         std::uint64_t device_id = 0;  // 0: empty
@@ -67,15 +68,14 @@ std::uint32_t memory_type_for(const Caller& caller, DeviceView device, const All
         VkMemoryPropertyFlags preferred = 0;
         bool operator==(const Question&) const = default;
     };
-    thread_local Question last;
-    thread_local std::uint32_t last_type = 0;
+    thread_local RecentAnswers<Question, std::uint32_t, 1> types;
     const MemoryIntent& intent = request.intent;
     const Question q{device.state().id, request.requirements.memoryTypeBits, intent.usage, intent.required_flags,
                      intent.preferred_flags};
-    if (q == last) return last_type;
-    last_type = choose_memory_type(device.memory_properties(), q.type_bits, intent, caller.name());
-    last = q;
-    return last_type;
+    if (const std::uint32_t* type = types.find(q)) return *type;
+    const std::uint32_t type = choose_memory_type(device.memory_properties(), q.type_bits, intent, caller.name());
+    types.keep(q, type);
+    return type;
 }
 }  // namespace
 

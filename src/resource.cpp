@@ -2,6 +2,7 @@
 
 #include "object_state.hpp"
 #include "enum_names.hpp"
+#include "recent_answers.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -272,25 +273,19 @@ VkResult image_format_properties(const Device& device, const ImageCreateInfo& in
         bool operator==(const Question&) const = default;
     };
     struct Answer {
-        Question question;
         VkResult result{};
         VkImageFormatProperties properties{};
     };
-    constexpr std::size_t kept = 4;
-    thread_local Answer answers[kept];
-    thread_local std::size_t next = 0;
+    thread_local detail::RecentAnswers<Question, Answer, 4> answers;
     const Question q{device.state()->id, info.format, info.image_type, info.tiling, info.usage, info.flags};
-    for (const Answer& a : answers) {
-        if (a.question == q) {
-            p = a.properties;
-            return a.result;
-        }
+    if (const Answer* a = answers.find(q)) {
+        p = a->properties;
+        return a->result;
     }
     const PhysicalDevice& physical = device.physical_device();
     const VkResult r = physical.fn().vkGetPhysicalDeviceImageFormatProperties(physical.vk(), q.format, q.type, q.tiling,
                                                                               q.usage, q.flags, &p);
-    if (r == VK_SUCCESS || r == VK_ERROR_FORMAT_NOT_SUPPORTED)
-        answers[next++ % kept] = {q, r, p};  // not an out-of-memory
+    if (r == VK_SUCCESS || r == VK_ERROR_FORMAT_NOT_SUPPORTED) answers.keep(q, {r, p});  // not an out-of-memory
     return r;
 }
 
