@@ -523,8 +523,12 @@ inline void close_submitted(Span<const CommandBuffer> command_buffers) noexcept 
 
 inline void CommandBuffer::end() const {
     VKRC_REQUIRE_STATE("vkrc::CommandBuffer::end");
-    check(fn_->vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
+    // Before the driver's call: the window's end is a locked add, which
+    // would wait there for the stores vkEndCommandBuffer leaves buffered.
+    // Recording is over either way; a failed end leaves a command buffer
+    // that cannot be submitted, and the window closes at reset or free.
     state_->device().end_window(state_->window);
+    check(fn_->vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
 }
 
 inline void CommandPool::reset_commands(VkCommandPoolResetFlags flags) const {

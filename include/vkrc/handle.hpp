@@ -258,10 +258,6 @@ namespace detail {
 // moves the epoch may get the older value, which only holds its drop longer.
 inline Atomic<std::uint64_t> creation_epoch{1};
 inline std::uint64_t current_serial() noexcept { return creation_epoch.fetch_add(1, __ATOMIC_RELAXED) + 1; }
-// Above every serial taken before it, without moving the epoch on: the
-// epoch only grows, so a load ordered after an object's construction reads
-// at least that object's serial. No locked add.
-inline std::uint64_t next_serial() noexcept { return creation_epoch.load(__ATOMIC_RELAXED) + 1; }
 
 // Base of every state block. The count starts at one: the creator owns it.
 template <class Policy>

@@ -137,8 +137,8 @@ private:
 
 // One command buffer's recording window, as the device's OpenCommandBuffers
 // sees it. end is 0 while closed, UINT64_MAX while recording, and after
-// end() a value above the serial of every object made before it: the
-// command buffer may refer to objects with a lower serial only.
+// end() the creation counter's value then: the command buffer may refer to
+// objects with a lower serial only.
 struct RecordingWindow {
     PolicyAtomic<std::uint64_t> end{0};
     const void* pool = nullptr;  // the CommandPoolState, for pool resets
@@ -164,13 +164,7 @@ public:
         window.one_time = one_time;
         if (window.end.exchange(UINT64_MAX) == 0) open_.fetch_add(1);
     }
-    // A reusable command buffer may stay open for long, so its end moves the
-    // epoch on: objects made after it are not held by it. A ONE_TIME_SUBMIT
-    // primary closes at its submit, soon after, so its end does not: objects
-    // made between its end and its submit are held until then at worst, and
-    // the frame skips a locked add right after vkEndCommandBuffer, where the
-    // store buffer is full of the driver's writes.
-    void end(RecordingWindow& window) noexcept { window.end.store(window.one_time ? next_serial() : current_serial()); }
+    void end(RecordingWindow& window) noexcept { window.end.store(current_serial()); }
     void close(DeviceState& device, RecordingWindow& window) noexcept {
         const std::uint64_t end = window.end.exchange(0);
         if (end != 0) open_.fetch_sub(1);
