@@ -432,6 +432,45 @@ TEST_F(VulkanTest, ReusableCommandBufferHoldsABoundedSet) {
     EXPECT_TRUE(all_equal(readback, 7));
 }
 
+// The same bound for a ONE_TIME_SUBMIT command buffer that never closes:
+// submitted through Queue::submit (a raw submit, which closes nothing) and
+// kept. Objects made after its end() are not held by it, so a frame loop
+// that makes and drops a buffer each frame keeps the pending drops bounded
+// (f864a3a, whose one-time end() did not move the epoch on, held them all).
+TEST_F(VulkanTest, KeptOneTimeCommandBufferHoldsABoundedSet) {
+    auto pool = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto readback = make_readback(device);
+    auto source = make_buffer(device, VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    auto kept = pool.allocate();
+    kept.begin();
+    record_fill_copy(kept, source, readback, 7);
+    kept.end();
+    const VkCommandBufferSubmitInfo kept_info{.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO,
+                                              .commandBuffer = kept.vk()};
+    const VkSubmitInfo2 raw{
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO_2, .commandBufferInfoCount = 1, .pCommandBufferInfos = &kept_info};
+    queue.submit({&raw, 1});
+    queue.wait_idle();
+    auto frames = vkrc::CommandPool::create(device, {.queue_family_index = queue.family_index()});
+    auto cmd = frames.allocate();
+    auto fence = vkrc::Fence::create(device);
+    std::size_t most = 0;
+    for (int frame = 0; frame < 1000; ++frame) {
+        frames.reset_commands();
+        cmd.begin();
+        record_fill_copy(cmd, source, readback, 9);
+        cmd.end();
+        auto scratch = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+        scratch.reset();
+        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+        most = std::max(most, device.deferred_count());
+        ASSERT_EQ(fence.wait(), VK_SUCCESS);
+        fence.unsignal();
+    }
+    EXPECT_LE(most, 6u);
+    EXPECT_TRUE(all_equal(readback, 9));
+}
+
 // An adopted buffer's cleanup runs once the GPU is done with it, even when
 // it is dropped between recording and submission.
 TEST_F(VulkanTest, AdoptedBufferCleanupRunsAfterTheGpu) {

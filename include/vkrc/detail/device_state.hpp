@@ -322,7 +322,8 @@ public:
     // A command buffer is allocated or adopted (may throw bad_alloc), or freed.
     void register_window(RecordingWindow& window) { commands.add(window); }
     void unregister_window(RecordingWindow& window) noexcept { commands.remove(*this, window); }
-    // vkBeginCommandBuffer and vkEndCommandBuffer succeeded.
+    // vkBeginCommandBuffer succeeded; recording is over (end_window comes
+    // before vkEndCommandBuffer, CommandBuffer::end says why).
     void open_window(RecordingWindow& window, bool one_time) noexcept { commands.begin(window, one_time); }
     void end_window(RecordingWindow& window) noexcept { commands.end(window); }
     // The command buffer was reset, or its one-time submit went in.
