@@ -406,6 +406,19 @@ TEST_F(VulkanTest, NeverSubmittedCommandBufferReleasesOnFree) {
     EXPECT_EQ(device.deferred_count(), 0u);
 }
 
+// One frame of the bounded-hold tests: a buffer made and dropped, then cmd
+// submitted and waited for. Returns the drops pending after the submit.
+std::size_t frame_dropping_a_buffer(const vkrc::Device& device, const vkrc::Queue& queue,
+                                    const vkrc::CommandBuffer& cmd, const vkrc::Fence& fence) {
+    auto scratch = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
+    scratch.reset();
+    vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
+    const std::size_t pending = device.deferred_count();
+    EXPECT_EQ(fence.wait(), VK_SUCCESS);
+    fence.unsignal();
+    return pending;
+}
+
 // A reusable command buffer recorded once and submitted every frame holds
 // only objects made before its end(): what is made and dropped each frame
 // goes the normal deferred way.
@@ -421,12 +434,7 @@ TEST_F(VulkanTest, ReusableCommandBufferHoldsABoundedSet) {
     auto fence = vkrc::Fence::create(device);
     std::size_t most = 0;
     for (int frame = 0; frame < 10000; ++frame) {
-        auto scratch = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
-        scratch.reset();
-        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
-        most = std::max(most, device.deferred_count());
-        ASSERT_EQ(fence.wait(), VK_SUCCESS);
-        fence.unsignal();
+        most = std::max(most, frame_dropping_a_buffer(device, queue, cmd, fence));
     }
     EXPECT_LE(most, 6u);
     EXPECT_TRUE(all_equal(readback, 7));
@@ -460,12 +468,7 @@ TEST_F(VulkanTest, KeptOneTimeCommandBufferHoldsABoundedSet) {
         cmd.begin();
         record_fill_copy(cmd, source, readback, 9);
         cmd.end();
-        auto scratch = vkrc::Buffer::create(device, {.size = 256, .usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT});
-        scratch.reset();
-        vkrc::submit(queue, {.command_buffers = std::span(&cmd, 1)}, fence);
-        most = std::max(most, device.deferred_count());
-        ASSERT_EQ(fence.wait(), VK_SUCCESS);
-        fence.unsignal();
+        most = std::max(most, frame_dropping_a_buffer(device, queue, cmd, fence));
     }
     EXPECT_LE(most, 6u);
     EXPECT_TRUE(all_equal(readback, 9));
