@@ -322,9 +322,9 @@ public:
     // A command buffer is allocated or adopted (may throw bad_alloc), or freed.
     void register_window(RecordingWindow& window) { commands.add(window); }
     void unregister_window(RecordingWindow& window) noexcept { commands.remove(*this, window); }
-    // vkBeginCommandBuffer succeeded; recording is over (end_window comes
-    // before vkEndCommandBuffer, CommandBuffer::end says why).
+    // vkBeginCommandBuffer succeeded.
     void open_window(RecordingWindow& window, bool one_time) noexcept { commands.begin(window, one_time); }
+    // Recording is over; called before vkEndCommandBuffer (CommandBuffer::end says why).
     void end_window(RecordingWindow& window) noexcept { commands.end(window); }
     // The command buffer was reset, or its one-time submit went in.
     void close_window(RecordingWindow& window) noexcept { commands.close(*this, window); }
